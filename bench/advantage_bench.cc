@@ -1,0 +1,130 @@
+#include "bench/advantage_bench.h"
+
+#include <ATen/ATen.h>
+#include <ATen/Parallel.h>
+#include <benchmark/benchmark.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "absl/strings/str_cat.h"
+#include "common/advantage/advantage.h"
+#include "common/advantage/advantage_config.h"
+
+namespace vantage {
+namespace {
+
+// Records the median real time per benchmark while printing as usual.
+class MedianCollector : public benchmark::ConsoleReporter {
+ public:
+  void ReportRuns(const std::vector<Run>& runs) override {
+    for (const Run& run : runs) {
+      if (run.run_type == Run::RT_Aggregate && run.aggregate_name == "median") {
+        median_seconds_[run.run_name.function_name] =
+            run.GetAdjustedRealTime() /
+            benchmark::GetTimeUnitMultiplier(run.time_unit);
+      }
+    }
+    ConsoleReporter::ReportRuns(runs);
+  }
+  double Seconds(const std::string& name) const {
+    auto it = median_seconds_.find(name);
+    return it == median_seconds_.end() ? -1.0 : it->second;
+  }
+
+ private:
+  std::map<std::string, double> median_seconds_;
+};
+
+// A float32 rollout like the learner's: Gaussian rewards and values, about
+// one termination per 500 steps and one truncation per 1000.
+AdvantageInputs RandomRollout(int64_t steps, int64_t streams) {
+  at::manual_seed(0);
+  AdvantageInputs in;
+  in.rewards = at::randn({steps, streams});
+  in.values = at::randn({steps, streams}) * 10.0;
+  in.terminated = at::rand({steps, streams}) < 0.002;
+  in.truncated = at::rand({steps, streams}) < 0.001;
+  in.truncation_values = at::randn({steps, streams});
+  in.last_values = at::randn({streams});
+  return in;
+}
+
+std::vector<int64_t> PowersOfTwo(int count) {
+  std::vector<int64_t> ks;
+  for (int i = 0; i < count; ++i) ks.push_back(int64_t{1} << i);
+  return ks;
+}
+
+}  // namespace
+
+int RunAdvantageBenchmark(int64_t steps, int64_t streams) {
+  // Every timed call is single-threaded, as in the learner's estimator.
+  at::set_num_threads(1);
+  const AdvantageInputs inputs = RandomRollout(steps, streams);
+  const double gamma = 0.99;
+  const double lambda = 0.95;
+
+  // Medians of repeated runs, since this machine is shared and noisy.
+  const auto configure = [](benchmark::internal::Benchmark* b) {
+    b->Repetitions(5)->ReportAggregatesOnly(true)->Unit(
+        benchmark::kMicrosecond);
+  };
+  configure(benchmark::RegisterBenchmark("gae", [&](benchmark::State& state) {
+    for (auto _ : state) {
+      benchmark::DoNotOptimize(ComputeGae(inputs, gamma, lambda));
+    }
+  }));
+  const std::map<std::string, std::vector<int64_t>> ensembles = {
+      {"e4", {1, 16, 64, 2048}}, {"e12", PowersOfTwo(12)}};
+  std::map<std::string, std::vector<std::string>> names_by_ensemble;
+  for (const auto& [label, ensemble] : ensembles) {
+    const std::string middle =
+        absl::StrCat("order:", (ensemble.size() + 1) / 2);
+    for (const std::string& statistic : {std::string("max"), std::string("min"),
+                                         std::string("maxabs"), middle}) {
+      AdvantageConfig config;
+      config.gamma = gamma;
+      config.lambda = lambda;
+      config.ensemble = ensemble;
+      config.statistic = *ParseStatistic(statistic);
+      const std::string name = absl::StrCat(label, "/", statistic);
+      names_by_ensemble[label].push_back(name);
+      configure(benchmark::RegisterBenchmark(
+          name.c_str(), [&inputs, config](benchmark::State& state) {
+            for (auto _ : state) {
+              benchmark::DoNotOptimize(ComputeBiasedAdvantage(inputs, config));
+            }
+          }));
+    }
+  }
+  std::printf("advantages: T=%ld x %ld streams, float32 inputs, 1 thread\n",
+              static_cast<long>(steps), static_cast<long>(streams));
+  MedianCollector collector;
+  benchmark::RunSpecifiedBenchmarks(&collector);
+
+  const double gae_seconds = collector.Seconds("gae");
+  if (gae_seconds <= 0) {
+    std::fprintf(stderr, "bench advantages: the GAE benchmark did not run\n");
+    return 1;
+  }
+  std::printf("\n%-16s %12s %10s\n", "estimate", "median_us", "vs_gae");
+  std::printf("%-16s %12.1f %10.2f\n", "gae", gae_seconds * 1e6, 1.0);
+  std::map<std::string, double> worst_ratio;
+  for (const auto& [label, names] : names_by_ensemble) {
+    for (const std::string& name : names) {
+      const double seconds = collector.Seconds(name);
+      const double ratio = seconds / gae_seconds;
+      worst_ratio[label] = std::max(worst_ratio[label], ratio);
+      std::printf("%-16s %12.1f %10.2f\n", name.c_str(), seconds * 1e6, ratio);
+    }
+  }
+  std::printf("RESULT advantages ratio_e4=%.2f ratio_e12=%.2f\n",
+              worst_ratio["e4"], worst_ratio["e12"]);
+  return 0;
+}
+
+}  // namespace vantage

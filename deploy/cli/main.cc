@@ -1,0 +1,108 @@
+// The `vantage` command-line tool: one binary, one subcommand per task.
+
+#include <benchmark/benchmark.h>
+
+#include <cstdio>
+#include <functional>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "absl/flags/flag.h"
+#include "absl/flags/parse.h"
+#include "absl/flags/usage.h"
+#include "absl/strings/str_join.h"
+#include "bench/advantage_bench.h"
+#include "deploy/cli/advantages_command.h"
+
+ABSL_FLAG(std::string, input, "",
+          "advantages: JSON file with one rollout and the estimator settings");
+ABSL_FLAG(bool, example, false,
+          "advantages: print every estimator on a built-in rollout");
+ABSL_FLAG(int64_t, bench_steps, 2048, "bench advantages: rollout length T");
+ABSL_FLAG(int64_t, bench_streams, 16,
+          "bench advantages: number of env streams");
+
+namespace vantage {
+namespace {
+
+constexpr int kUsageExitCode = 2;
+
+using Command = std::function<int(const std::vector<std::string>& args)>;
+
+int RunAdvantages(const std::vector<std::string>& args) {
+  if (!args.empty()) {
+    std::fprintf(stderr, "vantage advantages: unexpected argument '%s'\n",
+                 args[0].c_str());
+    return kUsageExitCode;
+  }
+  if (absl::GetFlag(FLAGS_example)) return RunAdvantagesExample();
+  return RunAdvantagesCommand(absl::GetFlag(FLAGS_input));
+}
+
+int RunBench(const std::vector<std::string>& args) {
+  const std::map<std::string, std::function<int()>> benchmarks = {
+      {"advantages",
+       [] {
+         const int64_t steps = absl::GetFlag(FLAGS_bench_steps);
+         const int64_t streams = absl::GetFlag(FLAGS_bench_streams);
+         if (steps < 1 || streams < 1) {
+           std::fprintf(stderr,
+                        "vantage bench advantages: --bench_steps and "
+                        "--bench_streams must be >= 1\n");
+           return kUsageExitCode;
+         }
+         return RunAdvantageBenchmark(steps, streams);
+       }},
+  };
+  std::vector<std::string> names;
+  for (const auto& entry : benchmarks) names.push_back(entry.first);
+  if (args.size() != 1 || benchmarks.count(args[0]) == 0) {
+    std::fprintf(stderr, "vantage bench: name one benchmark of: %s\n",
+                 absl::StrJoin(names, ", ").c_str());
+    return kUsageExitCode;
+  }
+  return benchmarks.at(args[0])();
+}
+
+const std::map<std::string, Command>& Commands() {
+  static const auto* commands = new std::map<std::string, Command>{
+      {"advantages", RunAdvantages},
+      {"bench", RunBench},
+  };
+  return *commands;
+}
+
+std::string CommandNames() {
+  std::vector<std::string> names;
+  for (const auto& entry : Commands()) names.push_back(entry.first);
+  return absl::StrJoin(names, ", ");
+}
+
+}  // namespace
+}  // namespace vantage
+
+int main(int argc, char** argv) {
+  // Google Benchmark takes its own --benchmark_* flags out of argv first.
+  benchmark::Initialize(&argc, argv);
+  absl::SetProgramUsageMessage(
+      "vantage <command> [flags]\n"
+      "  advantages --input=FILE.json   estimates of one rollout as JSON\n"
+      "  advantages --example           every estimator on a built-in rollout\n"
+      "  bench advantages               path ensemble vs GAE benchmark\n");
+  const std::vector<char*> positional = absl::ParseCommandLine(argc, argv);
+  if (positional.size() < 2) {
+    std::fprintf(stderr, "%s", absl::ProgramUsageMessage().data());
+    return vantage::kUsageExitCode;
+  }
+  const std::string name = positional[1];
+  const auto& commands = vantage::Commands();
+  auto command = commands.find(name);
+  if (command == commands.end()) {
+    std::fprintf(stderr, "vantage: unknown command '%s'; commands: %s\n",
+                 name.c_str(), vantage::CommandNames().c_str());
+    return vantage::kUsageExitCode;
+  }
+  return command->second(
+      std::vector<std::string>(positional.begin() + 2, positional.end()));
+}
