@@ -68,117 +68,101 @@ absl::Status CheckStructure(const AdvantageInputs& in) {
   return CheckTensor(in.last_values, "last_values", {streams}, false);
 }
 
-// The TD errors and continuation flags that every estimator shares,
-// computed once from the inputs.
-class PreparedRollout {
+// The inputs as contiguous arrays in the rewards' dtype (no copies when they
+// already are), ready for the kernels.
+class RolloutArrays {
  public:
-  static absl::StatusOr<PreparedRollout> Create(const AdvantageInputs& in,
-                                                double gamma) {
-    if (absl::Status status = CheckStructure(in); !status.ok()) return status;
-    PreparedRollout prepared;
-    prepared.gamma_ = gamma;
-    prepared.steps_ = in.rewards.size(0);
-    prepared.streams_ = in.rewards.size(1);
-    const at::ScalarType dtype = in.rewards.scalar_type();
-    prepared.delta_ =
-        at::empty({prepared.steps_, prepared.streams_}, at::kDouble);
-    prepared.continues_ = at::empty_like(prepared.delta_);
-    if (dtype == at::kFloat) {
-      prepared.Prepare<float>(in);
-    } else {
-      prepared.Prepare<double>(in);
-    }
-    return prepared;
-  }
+  explicit RolloutArrays(const AdvantageInputs& in)
+      : dtype_(in.rewards.scalar_type()),
+        rewards_(in.rewards.contiguous()),
+        values_(in.values.to(dtype_).contiguous()),
+        terminated_(in.terminated.contiguous()),
+        truncated_(in.truncated.contiguous()),
+        truncation_values_(in.truncation_values.to(dtype_).contiguous()),
+        last_values_(in.last_values.to(dtype_).contiguous()) {}
 
-  at::Tensor Gae(double lambda) const {
-    at::Tensor gae = NewOutput();
-    if (gae.scalar_type() == at::kFloat) {
-      GaeKernel(steps_, streams_, delta(), continues(), gamma_, lambda,
-                gae.data_ptr<float>());
-    } else {
-      GaeKernel(steps_, streams_, delta(), continues(), gamma_, lambda,
-                gae.data_ptr<double>());
-    }
-    return gae;
-  }
-
-  // `storage` keeps the arrays behind the returned pointers alive.
-  PathEnsembleBasis Basis(at::Tensor* storage) const {
-    *storage = at::empty({2, steps_, streams_}, at::kDouble);
-    double* longest = storage->data_ptr<double>();
-    double* remaining = longest + steps_ * streams_;
-    ComputePathEnsembleBasis(steps_, streams_, delta(), continues(), gamma_,
-                             longest, remaining);
-    return PathEnsembleBasis{longest, remaining};
-  }
-
-  // The configured statistic; config.gamma must be this rollout's gamma.
-  at::Tensor Biased(const AdvantageConfig& config) const {
-    if (config.statistic.kind == StatisticKind::kGae) return Gae(config.lambda);
-    std::vector<int64_t> ensemble = config.ensemble;
-    std::sort(ensemble.begin(), ensemble.end());
-    const at::Tensor basis = at::empty({2, steps_, streams_}, at::kDouble);
-    double* longest = basis.data_ptr<double>();
-    double* remaining = longest + steps_ * streams_;
-    at::Tensor biased = NewOutput();
-    if (biased.scalar_type() == at::kFloat) {
-      EnsembleStatisticKernel(steps_, streams_, delta(), continues(), gamma_,
-                              ensemble, config.statistic, longest, remaining,
-                              biased.data_ptr<float>());
-    } else {
-      EnsembleStatisticKernel(steps_, streams_, delta(), continues(), gamma_,
-                              ensemble, config.statistic, longest, remaining,
-                              biased.data_ptr<double>());
-    }
-    return biased;
-  }
-
-  int64_t steps() const { return steps_; }
-  int64_t streams() const { return streams_; }
-  at::ScalarType output_dtype() const { return output_dtype_; }
-
- private:
-  PreparedRollout() = default;
+  at::ScalarType dtype() const { return dtype_; }
+  int64_t steps() const { return rewards_.size(0); }
+  int64_t streams() const { return rewards_.size(1); }
 
   template <typename Scalar>
-  void Prepare(const AdvantageInputs& in) {
-    output_dtype_ = in.rewards.scalar_type();
-    // The float inputs in the rewards' dtype; no copies when they already are.
-    const at::Tensor rewards = in.rewards.contiguous();
-    const at::Tensor values = in.values.to(output_dtype_).contiguous();
-    const at::Tensor truncation_values =
-        in.truncation_values.to(output_dtype_).contiguous();
-    const at::Tensor last_values =
-        in.last_values.to(output_dtype_).contiguous();
-    const at::Tensor terminated = in.terminated.contiguous();
-    const at::Tensor truncated = in.truncated.contiguous();
+  RolloutView<Scalar> View() const {
     RolloutView<Scalar> view;
-    view.steps = steps_;
-    view.streams = streams_;
-    view.rewards = rewards.data_ptr<Scalar>();
-    view.values = values.data_ptr<Scalar>();
-    view.terminated = terminated.data_ptr<bool>();
-    view.truncated = truncated.data_ptr<bool>();
-    view.truncation_values = truncation_values.data_ptr<Scalar>();
-    view.last_values = last_values.data_ptr<Scalar>();
-    ComputeTdErrors(view, gamma_, delta_.data_ptr<double>(),
-                    continues_.data_ptr<double>());
+    view.steps = steps();
+    view.streams = streams();
+    view.rewards = rewards_.data_ptr<Scalar>();
+    view.values = values_.data_ptr<Scalar>();
+    view.terminated = terminated_.data_ptr<bool>();
+    view.truncated = truncated_.data_ptr<bool>();
+    view.truncation_values = truncation_values_.data_ptr<Scalar>();
+    view.last_values = last_values_.data_ptr<Scalar>();
+    return view;
   }
 
-  at::Tensor NewOutput() const {
-    return at::empty({steps_, streams_}, output_dtype_);
-  }
-  const double* delta() const { return delta_.data_ptr<double>(); }
-  const double* continues() const { return continues_.data_ptr<double>(); }
-
-  double gamma_ = 1.0;
-  int64_t steps_ = 0;
-  int64_t streams_ = 0;
-  at::ScalarType output_dtype_ = at::kDouble;
-  at::Tensor delta_;
-  at::Tensor continues_;
+ private:
+  at::ScalarType dtype_;
+  at::Tensor rewards_;
+  at::Tensor values_;
+  at::Tensor terminated_;
+  at::Tensor truncated_;
+  at::Tensor truncation_values_;
+  at::Tensor last_values_;
 };
+
+// Fills the requested tensors (undefined: not requested) in one pass. gae
+// and biased take the inputs' dtype; basis is double [2, T, N].
+struct RequestedOutputs {
+  at::Tensor gae;
+  at::Tensor biased;
+  at::Tensor basis;
+};
+
+template <typename Scalar>
+void RunTyped(const RolloutArrays& arrays, const EstimatorSettings& settings,
+              RequestedOutputs* requested) {
+  EstimatorOutputs<Scalar> outputs;
+  if (requested->gae.defined()) outputs.gae = requested->gae.data_ptr<Scalar>();
+  if (requested->biased.defined()) {
+    outputs.biased = requested->biased.data_ptr<Scalar>();
+  }
+  if (requested->basis.defined()) {
+    outputs.longest = requested->basis.data_ptr<double>();
+    outputs.remaining = outputs.longest + arrays.steps() * arrays.streams();
+  }
+  RunEstimators(arrays.View<Scalar>(), settings, outputs);
+}
+
+// Computes what `want_gae` / `want_biased` / `want_basis` ask for.
+RequestedOutputs Run(const RolloutArrays& arrays,
+                     const EstimatorSettings& settings, bool want_gae,
+                     bool want_biased, bool want_basis) {
+  RequestedOutputs requested;
+  const int64_t steps = arrays.steps();
+  const int64_t streams = arrays.streams();
+  if (want_gae) requested.gae = at::empty({steps, streams}, arrays.dtype());
+  if (want_biased) {
+    requested.biased = at::empty({steps, streams}, arrays.dtype());
+  }
+  if (want_biased || want_basis) {
+    requested.basis = at::empty({2, steps, streams}, at::kDouble);
+  }
+  if (arrays.dtype() == at::kFloat) {
+    RunTyped<float>(arrays, settings, &requested);
+  } else {
+    RunTyped<double>(arrays, settings, &requested);
+  }
+  return requested;
+}
+
+EstimatorSettings SettingsFor(const AdvantageConfig& config) {
+  EstimatorSettings settings;
+  settings.gamma = config.gamma;
+  settings.lambda = config.lambda;
+  settings.ensemble = config.ensemble;
+  std::sort(settings.ensemble.begin(), settings.ensemble.end());
+  settings.statistic = config.statistic;
+  return settings;
+}
 
 absl::Status CheckFinite(const at::Tensor& tensor, const char* name) {
   const at::Tensor finite = at::isfinite(tensor);
@@ -213,10 +197,15 @@ absl::Status ValidateAdvantageInputs(const AdvantageInputs& inputs) {
 
 absl::StatusOr<at::Tensor> ComputeGae(const AdvantageInputs& inputs,
                                       double gamma, double lambda) {
-  absl::StatusOr<PreparedRollout> prepared =
-      PreparedRollout::Create(inputs, gamma);
-  if (!prepared.ok()) return prepared.status();
-  return prepared->Gae(lambda);
+  if (absl::Status status = CheckStructure(inputs); !status.ok()) {
+    return status;
+  }
+  EstimatorSettings settings;
+  settings.gamma = gamma;
+  settings.lambda = lambda;
+  return Run(RolloutArrays(inputs), settings, /*want_gae=*/true,
+             /*want_biased=*/false, /*want_basis=*/false)
+      .gae;
 }
 
 absl::StatusOr<at::Tensor> ComputeKStepEstimates(
@@ -228,40 +217,56 @@ absl::StatusOr<at::Tensor> ComputeKStepEstimates(
           absl::StrCat("k-step estimates need k >= 1, got ", k));
     }
   }
-  absl::StatusOr<PreparedRollout> prepared =
-      PreparedRollout::Create(inputs, gamma);
-  if (!prepared.ok()) return prepared.status();
-  at::Tensor storage;
-  const PathEnsembleBasis basis = prepared->Basis(&storage);
-  const int64_t steps = prepared->steps();
-  const int64_t streams = prepared->streams();
+  if (absl::Status status = CheckStructure(inputs); !status.ok()) {
+    return status;
+  }
+  const RolloutArrays arrays(inputs);
+  EstimatorSettings settings;
+  settings.gamma = gamma;
+  const at::Tensor basis = Run(arrays, settings, /*want_gae=*/false,
+                               /*want_biased=*/false, /*want_basis=*/true)
+                               .basis;
+  const int64_t steps = arrays.steps();
+  const int64_t streams = arrays.streams();
+  const double* longest = basis.data_ptr<double>();
   at::Tensor estimates =
       at::empty({static_cast<int64_t>(ks.size()), steps, streams}, at::kDouble);
   for (size_t m = 0; m < ks.size(); ++m) {
-    KStepKernel(basis, steps, streams, ks[m], gamma,
-                estimates.data_ptr<double>() + m * steps * streams);
+    KStepFromBasis(longest, longest + steps * streams, steps, streams, ks[m],
+                   gamma, estimates.data_ptr<double>() + m * steps * streams);
   }
-  return estimates.to(prepared->output_dtype());
+  return estimates.to(arrays.dtype());
 }
 
 absl::StatusOr<at::Tensor> ComputeBiasedAdvantage(
     const AdvantageInputs& inputs, const AdvantageConfig& config) {
   if (absl::Status status = config.Validate(); !status.ok()) return status;
-  absl::StatusOr<PreparedRollout> prepared =
-      PreparedRollout::Create(inputs, config.gamma);
-  if (!prepared.ok()) return prepared.status();
-  return prepared->Biased(config);
+  if (absl::Status status = CheckStructure(inputs); !status.ok()) {
+    return status;
+  }
+  const bool unbiased = config.statistic.kind == StatisticKind::kGae;
+  RequestedOutputs out = Run(RolloutArrays(inputs), SettingsFor(config),
+                             /*want_gae=*/unbiased, /*want_biased=*/!unbiased,
+                             /*want_basis=*/false);
+  return unbiased ? out.gae : out.biased;
 }
 
 at::Tensor DrawBiasMask(at::IntArrayRef shape, double rho,
                         std::mt19937_64& rng) {
+  // rho = 0 and rho = 1 need no randomness (and draw none).
+  if (!(rho > 0.0)) return at::zeros(shape, at::kBool);
+  if (!(rho < 1.0)) return at::ones(shape, at::kBool);
   at::Tensor mask = at::empty(shape, at::kBool);
   bool* data = mask.data_ptr<bool>();
-  for (int64_t i = 0; i < mask.numel(); ++i) {
-    // 53 random bits give a uniform double in [0, 1): never below 0, always
-    // below 1, so rho = 0 and rho = 1 are exact.
-    const double uniform = static_cast<double>(rng() >> 11) * 0x1.0p-53;
-    data[i] = uniform < rho;
+  const int64_t count = mask.numel();
+  // Each 64-bit draw gives two uniforms on the 2^-32 grid: m = u < rho.
+  const double scale = 0x1.0p-32;
+  for (int64_t i = 0; i < count; i += 2) {
+    const uint64_t bits = rng();
+    data[i] = static_cast<double>(bits >> 32) * scale < rho;
+    if (i + 1 < count) {
+      data[i + 1] = static_cast<double>(bits & 0xffffffffu) * scale < rho;
+    }
   }
   return mask;
 }
@@ -270,14 +275,17 @@ absl::StatusOr<Advantages> ComputeAdvantages(const AdvantageInputs& inputs,
                                              const AdvantageConfig& config,
                                              std::mt19937_64& rng) {
   if (absl::Status status = config.Validate(); !status.ok()) return status;
-  absl::StatusOr<PreparedRollout> prepared =
-      PreparedRollout::Create(inputs, config.gamma);
-  if (!prepared.ok()) return prepared.status();
+  if (absl::Status status = CheckStructure(inputs); !status.ok()) {
+    return status;
+  }
+  const bool unbiased = config.statistic.kind == StatisticKind::kGae;
+  // GAE and the biased estimate share one pass over the rollout.
+  RequestedOutputs computed =
+      Run(RolloutArrays(inputs), SettingsFor(config), /*want_gae=*/true,
+          /*want_biased=*/!unbiased, /*want_basis=*/false);
   Advantages out;
-  out.gae = prepared->Gae(config.lambda);
-  out.biased = config.statistic.kind == StatisticKind::kGae
-                   ? out.gae
-                   : prepared->Biased(config);
+  out.gae = computed.gae;
+  out.biased = unbiased ? computed.gae : computed.biased;
   out.mask = DrawBiasMask(out.gae.sizes(), config.rho, rng);
   // A select, not m*A + (1-m)*Â, so that unmasked samples are GAE bit for bit.
   out.mixed = at::where(out.mask, out.biased, out.gae);

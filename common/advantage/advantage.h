@@ -54,8 +54,9 @@ absl::StatusOr<at::Tensor> ComputeKStepEstimates(
 absl::StatusOr<at::Tensor> ComputeBiasedAdvantage(
     const AdvantageInputs& inputs, const AdvantageConfig& config);
 
-// Bool tensor of `shape` (row-major order of draws), each entry true with
-// probability rho: rho = 0 gives all false, rho = 1 all true.
+// Bool tensor of `shape`, each entry true with probability rho, in
+// row-major order from `rng` (two entries per 64-bit draw). rho = 0 gives
+// all false and rho = 1 all true, and neither draws from `rng`.
 at::Tensor DrawBiasMask(at::IntArrayRef shape, double rho,
                         std::mt19937_64& rng);
 

@@ -1,32 +1,26 @@
-#include "common/advantage/estimator_kernels.h"
+// Compiled once per instruction set (see common/CMakeLists.txt): the
+// build defines VANTAGE_KERNEL_ISA as the namespace of this copy, and
+// estimator_dispatch.cc picks one at run time. Every copy performs the same
+// IEEE operations in the same order (no FMA contraction), so all give
+// bit-identical results.
 
 #include <algorithm>
 #include <cmath>
 #include <cstring>
 
+#include "common/advantage/estimator_kernels_isa.h"
+
+#ifndef VANTAGE_KERNEL_ISA
+#define VANTAGE_KERNEL_ISA isa_baseline
+#endif
+
 namespace vantage {
+namespace VANTAGE_KERNEL_ISA {
 namespace {
 
-// Rows of the fused backward pass in EnsembleStatisticKernel hold about
-// this many elements: the basis rows just computed are still in L1 when the
-// statistic reads them.
-constexpr int64_t kBlockElements = 1024;
-
-// Four doubles: one AVX register, or two SSE2 ones on a baseline x86-64
-// build. GCC's vector extensions keep this portable.
-constexpr int kLanes = 2;
-typedef double Vec __attribute__((vector_size(kLanes * sizeof(double))));
-
-inline Vec Load(const double* p) {
-  Vec v;
-  std::memcpy(&v, p, sizeof(v));
-  return v;
-}
-inline void Store(double* p, Vec v) { std::memcpy(p, &v, sizeof(v)); }
-inline Vec Splat(double x) { return Vec{x, x}; }
-inline Vec Max(Vec a, Vec b) { return a > b ? a : b; }
-inline Vec Min(Vec a, Vec b) { return a < b ? a : b; }
-inline Vec Abs(Vec a) { return a < Splat(0.0) ? -a : a; }
+// Elements per block of the backward pass: the block's TD errors, basis
+// rows and running statistic stay in L1/L2 while the members read them.
+constexpr int64_t kBlockElements = 512;
 
 // One ensemble member, with k clamped to the rollout length: every k >=
 // steps gives the longest estimate, and clamping keeps k * streams from
@@ -50,341 +44,272 @@ Member MakeMember(int64_t k, int64_t steps, int64_t streams, double gamma) {
   return member;
 }
 
-// A^(k)_i for an element before member.in_range_end. A select between two
-// constants is what GCC vectorises; with a finite longest[],
-// 0 * longest[i + offset] leaves longest[i] exact.
-inline double KStepAt(const Member& member, const double* longest,
-                      const double* remaining, int64_t i) {
-  const double factor = member.k < remaining[i] ? member.gamma_k : 0.0;
-  return longest[i] - factor * longest[i + member.offset];
-}
-
-// The basis rows [first_row, end_row), computed backwards; rows at or after
-// end_row must be done already.
-void BasisRows(int64_t steps, int64_t streams, const double* __restrict delta,
-               const double* __restrict continues, double gamma,
-               int64_t first_row, int64_t end_row, double* __restrict longest,
-               double* __restrict remaining) {
-  const int64_t n = streams;
-  for (int64_t t = end_row - 1; t >= first_row; --t) {
-    if (t == steps - 1) {
-      for (int64_t i = t * n; i < (t + 1) * n; ++i) {
-        longest[i] = delta[i];
-        remaining[i] = 1.0;
-      }
-      continue;
-    }
-    // longest[t] = delta_t + gamma * longest[t+1] inside an episode: the
-    // telescoped sum of TD errors up to the episode's or rollout's end.
-    // continues[] is 0 or 1 and everything is finite, so multiplying by it
-    // resets exactly and keeps the loop branch-free.
-    for (int64_t i = t * n; i < (t + 1) * n; ++i) {
-      longest[i] = delta[i] + gamma * continues[i] * longest[i + n];
-      remaining[i] = continues[i] * remaining[i + n] + 1.0;
-    }
+// Folds one member's A^(k) over the elements [begin, end) into acc[0, end -
+// begin): acc[j] = combine(acc[j], A^(k)). Before member.in_range_end the
+// select between two constants and the unconditional read of
+// longest[i + offset] let GCC vectorise (with a finite longest[],
+// 0 * longest[i + offset] leaves longest[i] exact); after it the member is
+// the longest estimate.
+template <typename Combine>
+inline void FoldMember(const Member& member, const double* __restrict longest,
+                       const double* __restrict remaining, int64_t begin,
+                       int64_t end, double* __restrict acc, Combine combine) {
+  const int64_t split = std::clamp(member.in_range_end, begin, end);
+  const double k = member.k;
+  const double gamma_k = member.gamma_k;
+  const double* __restrict tail = longest + member.offset;
+  for (int64_t i = begin; i < split; ++i) {
+    const double factor = k < remaining[i] ? gamma_k : 0.0;
+    acc[i - begin] = combine(acc[i - begin], longest[i] - factor * tail[i]);
+  }
+  for (int64_t i = split; i < end; ++i) {
+    acc[i - begin] = combine(acc[i - begin], longest[i]);
   }
 }
 
-// The statistic over the members (sorted by ascending k) on flat elements.
+inline double Assign(double, double estimate) { return estimate; }
+inline double Larger(double best, double a) { return std::max(best, a); }
+inline double Smaller(double best, double a) { return std::min(best, a); }
+// Strictly larger |A| only: folded in ascending k, ties keep the smaller k.
+inline double LargerMagnitude(double best, double a) {
+  return std::fabs(a) > std::fabs(best) ? a : best;
+}
+
+// The statistic over the members (sorted by ascending k) for a block of
+// elements, member by member so that every loop is long and vectorised.
 class EnsembleReducer {
  public:
-  EnsembleReducer(const std::vector<Member>& members,
-                  const Statistic& statistic, const double* longest,
-                  const double* remaining)
-      : members_(members),
+  EnsembleReducer(std::vector<Member> members, const Statistic& statistic,
+                  int64_t max_block)
+      : members_(std::move(members)),
         statistic_(statistic),
-        longest_(longest),
-        remaining_(remaining),
         network_(statistic.kind == StatisticKind::kOrder
-                     ? SortingNetwork(static_cast<int>(members.size()))
+                     ? SelectionNetwork(static_cast<int>(members_.size()),
+                                        statistic.order - 1)
                      : std::vector<std::pair<int, int>>()),
-        vector_scratch_(members.size()),
-        scalar_scratch_(members.size()) {}
+        max_block_(max_block),
+        buffers_(
+            (statistic.kind == StatisticKind::kOrder ? members_.size() : 1) *
+            max_block) {}
 
-  // Elements [begin, end) into out[0, end - begin).
-  void Reduce(int64_t begin, int64_t end, double* out) {
-    const int count = static_cast<int>(members_.size());
-    // Members are sorted by k, so their in_range_end decreases: the first
-    // `active` are in range for the whole chunk, the rest collapse to the
-    // longest estimate unless one straddles the chunk.
-    int active = count;
-    int64_t i = begin;
-    for (; i + kLanes <= end; i += kLanes) {
-      while (active > 0 && members_[active - 1].in_range_end < i + kLanes) {
-        --active;
+  // Elements [begin, end), at most max_block of them; returns the block's
+  // results, valid until the next call.
+  const double* Reduce(const double* longest, const double* remaining,
+                       int64_t begin, int64_t end) {
+    double* acc = buffers_.data();
+    const auto fold_all = [&](auto combine) {
+      FoldMember(members_[0], longest, remaining, begin, end, acc, Assign);
+      for (size_t m = 1; m < members_.size(); ++m) {
+        FoldMember(members_[m], longest, remaining, begin, end, acc, combine);
       }
-      if (active < count && members_[active].in_range_end > i) {
-        for (int64_t j = i; j < i + kLanes; ++j) out[j - begin] = ReduceOne(j);
-        continue;
-      }
-      Store(out + (i - begin), ReduceChunk(i, active));
+    };
+    switch (statistic_.kind) {
+      case StatisticKind::kMax:
+        fold_all(Larger);
+        break;
+      case StatisticKind::kMin:
+        fold_all(Smaller);
+        break;
+      case StatisticKind::kMaxAbs:
+        fold_all(LargerMagnitude);
+        break;
+      case StatisticKind::kOrder:
+        return SelectOrder(longest, remaining, begin, end);
+      case StatisticKind::kGae:
+        break;
     }
-    for (; i < end; ++i) out[i - begin] = ReduceOne(i);
+    return acc;
   }
 
  private:
-  inline Vec KStepChunk(const Member& member, Vec longest, Vec remaining,
-                        int64_t i) const {
-    const Vec factor =
-        Splat(member.k) < remaining ? Splat(member.gamma_k) : Splat(0.0);
-    return longest - factor * Load(longest_ + i + member.offset);
+  const double* SelectOrder(const double* longest, const double* remaining,
+                            int64_t begin, int64_t end) {
+    const int64_t len = end - begin;
+    for (size_t m = 0; m < members_.size(); ++m) {
+      FoldMember(members_[m], longest, remaining, begin, end,
+                 buffers_.data() + m * max_block_, Assign);
+    }
+    for (const auto& [a, b] : network_) {
+      double* __restrict lo = buffers_.data() + a * max_block_;
+      double* __restrict hi = buffers_.data() + b * max_block_;
+      for (int64_t j = 0; j < len; ++j) {
+        const double x = lo[j];
+        const double y = hi[j];
+        lo[j] = std::min(x, y);
+        hi[j] = std::max(x, y);
+      }
+    }
+    return buffers_.data() + (statistic_.order - 1) * max_block_;
   }
 
-  Vec ReduceChunk(int64_t i, int active) {
-    const int count = static_cast<int>(members_.size());
-    const Vec longest = Load(longest_ + i);
-    const Vec remaining = Load(remaining_ + i);
-    const bool collapsed = active < count;
-    switch (statistic_.kind) {
-      case StatisticKind::kMax: {
-        // The collapsed members all equal the longest estimate.
-        Vec best = collapsed ? longest
-                             : KStepChunk(members_[0], longest, remaining, i);
-        for (int m = collapsed ? 0 : 1; m < active; ++m) {
-          best = Max(best, KStepChunk(members_[m], longest, remaining, i));
-        }
-        return best;
-      }
-      case StatisticKind::kMin: {
-        // The collapsed members all equal the longest estimate.
-        Vec best = collapsed ? longest
-                             : KStepChunk(members_[0], longest, remaining, i);
-        for (int m = collapsed ? 0 : 1; m < active; ++m) {
-          best = Min(best, KStepChunk(members_[m], longest, remaining, i));
-        }
-        return best;
-      }
-      case StatisticKind::kMaxAbs: {
-        // In ascending k, replacing only on a strictly larger |A|: ties go
-        // to the smaller k. The collapsed members have the largest k.
-        Vec best = active > 0 ? KStepChunk(members_[0], longest, remaining, i)
-                              : longest;
-        for (int m = 1; m < active; ++m) {
-          const Vec a = KStepChunk(members_[m], longest, remaining, i);
-          best = Abs(a) > Abs(best) ? a : best;
-        }
-        if (collapsed) best = Abs(longest) > Abs(best) ? longest : best;
-        return best;
-      }
-      case StatisticKind::kOrder: {
-        Vec* values = vector_scratch_.data();
-        for (int m = 0; m < active; ++m) {
-          values[m] = KStepChunk(members_[m], longest, remaining, i);
-        }
-        for (int m = active; m < count; ++m) values[m] = longest;
-        for (const auto& [a, b] : network_) {
-          const Vec x = values[a];
-          const Vec y = values[b];
-          values[a] = Min(x, y);
-          values[b] = Max(x, y);
-        }
-        return values[statistic_.order - 1];
-      }
-      case StatisticKind::kGae:
-        break;
-    }
-    return longest;
-  }
-
-  // The same statistic for one element, for chunks that straddle a
-  // member's in_range_end and for the tail.
-  double ReduceOne(int64_t i) {
-    double* values = scalar_scratch_.data();
-    const int count = static_cast<int>(members_.size());
-    for (int m = 0; m < count; ++m) {
-      values[m] = i < members_[m].in_range_end
-                      ? KStepAt(members_[m], longest_, remaining_, i)
-                      : longest_[i];
-    }
-    switch (statistic_.kind) {
-      case StatisticKind::kMax:
-        return *std::max_element(values, values + count);
-      case StatisticKind::kMin:
-        return *std::min_element(values, values + count);
-      case StatisticKind::kMaxAbs: {
-        double best = values[0];
-        for (int m = 1; m < count; ++m) {
-          if (std::fabs(values[m]) > std::fabs(best)) best = values[m];
-        }
-        return best;
-      }
-      case StatisticKind::kOrder:
-        std::nth_element(values, values + statistic_.order - 1, values + count);
-        return values[statistic_.order - 1];
-      case StatisticKind::kGae:
-        break;
-    }
-    return longest_[i];
-  }
-
-  const std::vector<Member>& members_;
+  const std::vector<Member> members_;
   const Statistic statistic_;
-  const double* longest_;
-  const double* remaining_;
   const std::vector<std::pair<int, int>> network_;
-  std::vector<Vec> vector_scratch_;
-  std::vector<double> scalar_scratch_;
+  const int64_t max_block_;
+  std::vector<double> buffers_;
 };
 
-// True if any of the 8 flags starting at `flags` is set.
-inline bool AnyOfEight(const bool* flags) {
-  uint64_t word;
-  std::memcpy(&word, flags, sizeof(word));
-  return word != 0;
+// True if any of the 32 flags starting at `flags` is set.
+inline bool AnyOf32(const bool* flags) {
+  uint64_t words[4];
+  std::memcpy(words, flags, sizeof(words));
+  return (words[0] | words[1] | words[2] | words[3]) != 0;
 }
 
-}  // namespace
-
+// delta and continues (1 if step t+1 belongs to t's episode inside the
+// rollout, else 0) for rows [first_row, end_row), written from index 0.
 template <typename Scalar>
-void ComputeTdErrors(const RolloutView<Scalar>& rollout, double gamma,
-                     double* __restrict delta, double* __restrict continues) {
+void TdErrorRows(const RolloutView<Scalar>& rollout, double gamma,
+                 int64_t first_row, int64_t end_row, double* __restrict delta,
+                 double* __restrict continues) {
   const int64_t n = rollout.streams;
-  const int64_t total = rollout.steps * n;
-  const int64_t last_row = total - n;
+  const int64_t begin = first_row * n;
+  const int64_t inner_end = std::min(end_row, rollout.steps - 1) * n;
+  const int64_t end = end_row * n;
   const Scalar* __restrict r = rollout.rewards;
   const Scalar* __restrict v = rollout.values;
-  // The common case, vectorised: no episode ends, bootstrap from V(s_{t+1})
-  // and V(s_T) on the last row.
-  for (int64_t i = 0; i < last_row; ++i) {
-    delta[i] = static_cast<double>(r[i]) +
-               gamma * static_cast<double>(v[i + n]) -
-               static_cast<double>(v[i]);
-    continues[i] = 1.0;
+  // The common case, vectorised: no episode end, bootstrap from V(s_{t+1}),
+  // and from V(s_T) on the rollout's last row.
+  for (int64_t i = begin; i < inner_end; ++i) {
+    delta[i - begin] = static_cast<double>(r[i]) +
+                       gamma * static_cast<double>(v[i + n]) -
+                       static_cast<double>(v[i]);
+    continues[i - begin] = 1.0;
   }
-  for (int64_t i = last_row; i < total; ++i) {
-    delta[i] = static_cast<double>(r[i]) +
-               gamma * static_cast<double>(rollout.last_values[i - last_row]) -
-               static_cast<double>(v[i]);
-    continues[i] = 0.0;
+  for (int64_t i = inner_end; i < end; ++i) {
+    delta[i - begin] =
+        static_cast<double>(r[i]) +
+        gamma * static_cast<double>(rollout.last_values[i - inner_end]) -
+        static_cast<double>(v[i]);
+    continues[i - begin] = 0.0;
   }
-  // Episode ends are rare: patch them, skipping 8 flag bytes at a time.
+  // Episode ends are rare: patch them, skipping 32 flag bytes at a time.
   const bool* terminated = rollout.terminated;
   const bool* truncated = rollout.truncated;
-  for (int64_t begin = 0; begin < total; begin += 8) {
-    if (begin + 8 <= total && !AnyOfEight(terminated + begin) &&
-        !AnyOfEight(truncated + begin)) {
+  for (int64_t chunk = begin; chunk < end; chunk += 32) {
+    const int64_t chunk_end = std::min(end, chunk + 32);
+    if (chunk_end - chunk == 32 && !AnyOf32(terminated + chunk) &&
+        !AnyOf32(truncated + chunk)) {
       continue;
     }
-    for (int64_t i = begin; i < std::min(total, begin + 8); ++i) {
+    for (int64_t i = chunk; i < chunk_end; ++i) {
       if (!terminated[i] && !truncated[i]) continue;
       const double bootstrap =
           terminated[i] ? 0.0
                         : static_cast<double>(rollout.truncation_values[i]);
-      delta[i] = static_cast<double>(r[i]) + gamma * bootstrap -
-                 static_cast<double>(v[i]);
-      continues[i] = 0.0;
+      delta[i - begin] = static_cast<double>(r[i]) + gamma * bootstrap -
+                         static_cast<double>(v[i]);
+      continues[i - begin] = 0.0;
     }
   }
 }
 
+// One backward step of GAE over a row of streams, kept in double in `row`
+// and written to `out`:  gae_t = delta_t + decay * continues_t * gae_{t+1}.
+// continues is 0 or 1 and everything is finite, so multiplying by it resets
+// exactly and keeps the loop branch-free.
 template <typename Out>
-void GaeKernel(int64_t steps, int64_t streams, const double* __restrict delta,
-               const double* __restrict continues, double gamma, double lambda,
-               Out* __restrict gae) {
-  const double decay = gamma * lambda;
-  // The running estimate of the next row, kept in double precision.
-  std::vector<double> next(streams, 0.0);
-  double* __restrict carry = next.data();
-  for (int64_t t = steps - 1; t >= 0; --t) {
-    const double* __restrict d = delta + t * streams;
-    const double* __restrict c = continues + t * streams;
-    Out* __restrict row = gae + t * streams;
-    // continues[] is 0 or 1 and everything is finite, so multiplying by it
-    // resets exactly and keeps the loop branch-free.
-    for (int64_t s = 0; s < streams; ++s) {
-      carry[s] = d[s] + decay * c[s] * carry[s];
-      row[s] = static_cast<Out>(carry[s]);
-    }
+inline void GaeRow(int64_t streams, const double* __restrict delta,
+                   const double* __restrict continues, double decay,
+                   const double* __restrict next, double* __restrict row,
+                   Out* __restrict out) {
+  for (int64_t s = 0; s < streams; ++s) {
+    row[s] = delta[s] + decay * continues[s] * next[s];
+    out[s] = static_cast<Out>(row[s]);
   }
 }
 
-void ComputePathEnsembleBasis(int64_t steps, int64_t streams,
-                              const double* delta, const double* continues,
-                              double gamma, double* longest,
-                              double* remaining) {
-  BasisRows(steps, streams, delta, continues, gamma, 0, steps, longest,
-            remaining);
-}
-
-void KStepKernel(const PathEnsembleBasis& basis, int64_t steps, int64_t streams,
-                 int64_t k, double gamma, double* __restrict out) {
-  const Member member = MakeMember(k, steps, streams, gamma);
-  for (int64_t i = 0; i < member.in_range_end; ++i) {
-    out[i] = KStepAt(member, basis.longest, basis.remaining, i);
-  }
-  for (int64_t i = member.in_range_end; i < steps * streams; ++i) {
-    out[i] = basis.longest[i];
+// One backward step of the basis: longest_t = delta_t + gamma * longest_{t+1}
+// inside an episode (the telescoped sum of TD errors up to its end) and
+// remaining_t = 1 + remaining_{t+1}, both reset where continues is 0.
+inline void BasisRow(int64_t streams, const double* __restrict delta,
+                     const double* __restrict continues, double gamma,
+                     const double* __restrict next_longest,
+                     const double* __restrict next_remaining,
+                     double* __restrict longest, double* __restrict remaining) {
+  for (int64_t s = 0; s < streams; ++s) {
+    longest[s] = delta[s] + gamma * continues[s] * next_longest[s];
+    remaining[s] = 1.0 + continues[s] * next_remaining[s];
   }
 }
 
-template <typename Out>
-void EnsembleStatisticKernel(int64_t steps, int64_t streams,
-                             const double* delta, const double* continues,
-                             double gamma, const std::vector<int64_t>& ensemble,
-                             const Statistic& statistic, double* longest,
-                             double* remaining, Out* out) {
+}  // namespace
+
+template <typename Scalar, typename Out>
+void RunEstimators(const RolloutView<Scalar>& rollout,
+                   const EstimatorSettings& settings,
+                   const EstimatorOutputs<Out>& outputs) {
+  const int64_t steps = rollout.steps;
+  const int64_t n = rollout.streams;
+  const double gamma = settings.gamma;
+  const double decay = settings.gamma * settings.lambda;
+  const int64_t rows_per_block = std::max<int64_t>(1, kBlockElements / n);
+  const int64_t block = rows_per_block * n;
+  const bool want_basis = outputs.longest != nullptr;
+
+  std::vector<double> scratch(2 * block + 2 * n, 0.0);
+  double* delta = scratch.data();
+  double* continues = delta + block;
+  // GAE of the row after the current one; zero past the rollout's end,
+  // where continues is 0 anyway.
+  double* gae_next = continues + block;
+  double* gae_row = gae_next + n;
+  const std::vector<double> zeros(n, 0.0);
+
   std::vector<Member> members;
-  for (int64_t k : ensemble) {
-    members.push_back(MakeMember(k, steps, streams, gamma));
+  for (int64_t k : settings.ensemble) {
+    members.push_back(MakeMember(k, steps, n, gamma));
   }
-  EnsembleReducer reducer(members, statistic, longest, remaining);
-  const int64_t rows_per_block = std::max<int64_t>(1, kBlockElements / streams);
-  std::vector<double> block(rows_per_block * streams);
-  // Backwards, a block of rows at a time: each member reads rows t + k,
-  // which are either in this block or in one done before it.
+  const bool want_biased = outputs.biased != nullptr;
+  EnsembleReducer reducer(want_biased ? members : std::vector<Member>(),
+                          settings.statistic, want_biased ? block : 0);
+
+  // Backwards a block of rows at a time: each member reads rows t + k,
+  // which are in this block or in one done before it.
   for (int64_t end_row = steps; end_row > 0;) {
     const int64_t first_row = std::max<int64_t>(0, end_row - rows_per_block);
-    BasisRows(steps, streams, delta, continues, gamma, first_row, end_row,
-              longest, remaining);
-    const int64_t begin = first_row * streams;
-    const int64_t end = end_row * streams;
-    reducer.Reduce(begin, end, block.data());
-    for (int64_t i = begin; i < end; ++i) {
-      out[i] = static_cast<Out>(block[i - begin]);
+    TdErrorRows(rollout, gamma, first_row, end_row, delta, continues);
+    for (int64_t t = end_row - 1; t >= first_row; --t) {
+      const double* d = delta + (t - first_row) * n;
+      const double* c = continues + (t - first_row) * n;
+      if (outputs.gae != nullptr) {
+        GaeRow(n, d, c, decay, gae_next, gae_row, outputs.gae + t * n);
+        std::swap(gae_next, gae_row);
+      }
+      if (want_basis) {
+        const bool last = t + 1 == steps;
+        BasisRow(n, d, c, gamma,
+                 last ? zeros.data() : outputs.longest + (t + 1) * n,
+                 last ? zeros.data() : outputs.remaining + (t + 1) * n,
+                 outputs.longest + t * n, outputs.remaining + t * n);
+      }
+    }
+    if (want_biased) {
+      const int64_t begin = first_row * n;
+      const int64_t end = end_row * n;
+      const double* result =
+          reducer.Reduce(outputs.longest, outputs.remaining, begin, end);
+      for (int64_t i = begin; i < end; ++i) {
+        outputs.biased[i] = static_cast<Out>(result[i - begin]);
+      }
     }
     end_row = first_row;
   }
 }
 
-std::vector<std::pair<int, int>> SortingNetwork(int n) {
-  std::vector<std::pair<int, int>> pairs;
-  if (n < 2) return pairs;
-  int top = 1;  // 2^(t-1) with t = ceil(log2 n), Knuth's Algorithm 5.2.2M
-  while (2 * top < n) top *= 2;
-  for (int p = top; p > 0; p /= 2) {
-    int q = top;
-    int r = 0;
-    int d = p;
-    while (true) {
-      for (int i = 0; i + d < n; ++i) {
-        if ((i & p) == r) pairs.emplace_back(i, i + d);
-      }
-      if (q == p) break;
-      d = q - p;
-      q /= 2;
-      r = p;
-    }
-  }
-  return pairs;
+void KStepFromBasis(const double* longest, const double* remaining,
+                    int64_t steps, int64_t streams, int64_t k, double gamma,
+                    double* out) {
+  FoldMember(MakeMember(k, steps, streams, gamma), longest, remaining, 0,
+             steps * streams, out, Assign);
 }
 
-template void ComputeTdErrors<float>(const RolloutView<float>&, double, double*,
-                                     double*);
-template void ComputeTdErrors<double>(const RolloutView<double>&, double,
-                                      double*, double*);
-template void GaeKernel<float>(int64_t, int64_t, const double*, const double*,
-                               double, double, float*);
-template void GaeKernel<double>(int64_t, int64_t, const double*, const double*,
-                                double, double, double*);
-template void EnsembleStatisticKernel<float>(int64_t, int64_t, const double*,
-                                             const double*, double,
-                                             const std::vector<int64_t>&,
-                                             const Statistic&, double*, double*,
-                                             float*);
-template void EnsembleStatisticKernel<double>(int64_t, int64_t, const double*,
-                                              const double*, double,
-                                              const std::vector<int64_t>&,
-                                              const Statistic&, double*,
-                                              double*, double*);
+template void RunEstimators<float, float>(const RolloutView<float>&,
+                                          const EstimatorSettings&,
+                                          const EstimatorOutputs<float>&);
+template void RunEstimators<double, double>(const RolloutView<double>&,
+                                            const EstimatorSettings&,
+                                            const EstimatorOutputs<double>&);
 
+}  // namespace VANTAGE_KERNEL_ISA
 }  // namespace vantage

@@ -21,6 +21,7 @@ struct RolloutView {
   int64_t streams = 0;
   const Scalar* rewards = nullptr;
   const Scalar* values = nullptr;  // V(s_t)
+  // Terminated wins where both flags are set.
   const bool* terminated = nullptr;
   const bool* truncated = nullptr;
   // Read only where truncated is set.
@@ -28,56 +29,56 @@ struct RolloutView {
   const Scalar* last_values = nullptr;  // [streams] V(s_T)
 };
 
-// What every estimator needs, one pass over the inputs:
-//   delta[t] = r_t + gamma * B_t - V_t with the bootstrap B_t = 0 if the
-//     episode terminated at t, V(final observation) if it was truncated at
-//     t, V(s_T) at the rollout's last step, V(s_{t+1}) otherwise
-//     (terminated wins over truncated);
-//   continues[t] = 1 if step t+1 belongs to t's episode inside this rollout,
-//     else 0.
-template <typename Scalar>
-void ComputeTdErrors(const RolloutView<Scalar>& rollout, double gamma,
-                     double* delta, double* continues);
+struct EstimatorSettings {
+  double gamma = 0.99;
+  double lambda = 0.95;
+  // Sorted ascending (maxabs breaks ties towards the smaller k).
+  std::vector<int64_t> ensemble;
+  Statistic statistic;
+};
 
-// GAE(gamma, lambda), one backward pass.
-template <typename Out>
-void GaeKernel(int64_t steps, int64_t streams, const double* delta,
-               const double* continues, double gamma, double lambda, Out* gae);
-
-// The path ensemble in compact form: longest[t] is the longest estimate
-// available at t (to the end of t's episode or of the rollout) and
-// remaining[t] its number of steps L_t. Every k-step estimate follows as
+// Every output is optional (null: not computed). All are [steps, streams].
+//
+// The path ensemble is kept in compact form, the basis: longest[t] is the
+// longest estimate available at t (to the end of t's episode or of the
+// rollout) and remaining[t] its number of steps L_t, stored as double so it
+// vectorises with longest. Every k-step estimate follows from it as
 //   A^(k)_t = longest[t] - gamma^k * longest[t+k]   if k < L_t,
 //   A^(k)_t = longest[t]                            otherwise,
-// because the discounted sums telescope inside one episode. remaining is
-// stored as double so that it vectorises together with longest.
-struct PathEnsembleBasis {
-  const double* longest = nullptr;
-  const double* remaining = nullptr;
-};
-void ComputePathEnsembleBasis(int64_t steps, int64_t streams,
-                              const double* delta, const double* continues,
-                              double gamma, double* longest, double* remaining);
-
-// A^(k) for one k over the whole rollout.
-void KStepKernel(const PathEnsembleBasis& basis, int64_t steps, int64_t streams,
-                 int64_t k, double gamma, double* out);
-
-// The order statistic over {A^(k) : k in ensemble} at every element, in
-// O(steps * streams * |E|) plus a sorting network for order:d. Computes the
-// basis into longest/remaining ([steps, streams] each) on the way, in one
-// blocked backward pass. `ensemble` must be sorted ascending (maxabs breaks
-// ties towards the smaller k); statistic.kind must not be kGae.
+// because discounted sums telescope inside one episode.
 template <typename Out>
-void EnsembleStatisticKernel(int64_t steps, int64_t streams,
-                             const double* delta, const double* continues,
-                             double gamma, const std::vector<int64_t>& ensemble,
-                             const Statistic& statistic, double* longest,
-                             double* remaining, Out* out);
+struct EstimatorOutputs {
+  Out* gae = nullptr;     // GAE(gamma, lambda)
+  Out* biased = nullptr;  // settings.statistic over settings.ensemble
+  // The basis; required when `biased` is requested.
+  double* longest = nullptr;
+  double* remaining = nullptr;
+};
+
+// One blocked backward pass over the rollout computes the TD errors
+//   delta_t = r_t + gamma * B_t - V_t, with B_t = 0 if the episode
+//   terminated at t, V(final observation) if it was truncated at t, V(s_T)
+//   at the rollout's last step and V(s_{t+1}) otherwise,
+// then every requested output. Blocks keep what they compute in cache for
+// the members that read it. Cost O(steps * streams * |E|) plus a sorting
+// network per element for order:d.
+template <typename Scalar, typename Out>
+void RunEstimators(const RolloutView<Scalar>& rollout,
+                   const EstimatorSettings& settings,
+                   const EstimatorOutputs<Out>& outputs);
+
+// A^(k) for one k over the whole rollout from a computed basis.
+void KStepFromBasis(const double* longest, const double* remaining,
+                    int64_t steps, int64_t streams, int64_t k, double gamma,
+                    double* out);
 
 // The compare-exchange pairs (i < j) of a sorting network for n inputs
-// (Batcher's merge exchange, valid for any n).
+// (Batcher's merge exchange, valid for any n), applied in order.
 std::vector<std::pair<int, int>> SortingNetwork(int n);
+
+// SortingNetwork(n) without the pairs that cannot affect output `position`
+// (0-based): afterwards that output holds the value of that rank.
+std::vector<std::pair<int, int>> SelectionNetwork(int n, int position);
 
 }  // namespace vantage
 

@@ -392,6 +392,16 @@ TEST(DrawBiasMaskTest, MeanIsNearRho) {
   }
 }
 
+TEST(DrawBiasMaskTest, ExtremesDrawNothingAndOddSizesWork) {
+  std::mt19937_64 rng(9), untouched(9);
+  EXPECT_FALSE(DrawBiasMask({7, 3}, 0.0, rng).any().item<bool>());
+  EXPECT_TRUE(DrawBiasMask({7, 3}, 1.0, rng).all().item<bool>());
+  EXPECT_EQ(rng(), untouched());
+  const at::Tensor odd = DrawBiasMask({5, 3}, 0.5, rng);
+  EXPECT_EQ(odd.numel(), 15);
+  EXPECT_EQ(odd.scalar_type(), at::kBool);
+}
+
 TEST(DrawBiasMaskTest, SeededAndDeterministic) {
   std::mt19937_64 a(5), b(5), c(6);
   const at::Tensor first = DrawBiasMask({64, 8}, 0.5, a);

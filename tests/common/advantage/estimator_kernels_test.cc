@@ -2,8 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
+#include <memory>
+#include <random>
 #include <vector>
 
+#include "common/advantage/estimator_kernels_isa.h"
 #include "gtest/gtest.h"
 
 namespace vantage {
@@ -28,40 +32,83 @@ TEST(SortingNetworkTest, SortsEveryBinaryInput) {
   }
 }
 
+// The 0-1 principle holds for selection networks too.
+TEST(SelectionNetworkTest, SelectsEveryRankOfEveryBinaryInput) {
+  for (int n = 1; n <= 13; ++n) {
+    for (int position = 0; position < n; ++position) {
+      const auto network = SelectionNetwork(n, position);
+      EXPECT_LE(network.size(), SortingNetwork(n).size());
+      for (int bits = 0; bits < (1 << n); ++bits) {
+        std::vector<int> values(n);
+        for (int i = 0; i < n; ++i) values[i] = (bits >> i) & 1;
+        std::vector<int> sorted = values;
+        std::sort(sorted.begin(), sorted.end());
+        for (const auto& [a, b] : network) {
+          if (values[b] < values[a]) std::swap(values[a], values[b]);
+        }
+        ASSERT_EQ(values[position], sorted[position])
+            << "n=" << n << " position=" << position << " bits=" << bits;
+      }
+    }
+  }
+  // Pruning pays off at the extremes: the minimum of 12 needs 11 pairs.
+  EXPECT_EQ(SelectionNetwork(12, 0).size(), 11u);
+}
+
 TEST(SortingNetworkTest, NoPairsBelowTwoInputs) {
   EXPECT_TRUE(SortingNetwork(0).empty());
   EXPECT_TRUE(SortingNetwork(1).empty());
   EXPECT_EQ(SortingNetwork(2).size(), 1u);
 }
 
-// The fused, blocked and vectorised statistic kernel against a plain
-// reduction of KStepKernel's columns: stream counts that are and are not
-// multiples of the vector width, rollouts longer than a block, members that
-// collapse part-way through a vector chunk.
-TEST(EnsembleStatisticKernelTest, MatchesPlainReductionOfKStepColumns) {
+// The fused, blocked and vectorised pass against a plain reduction of
+// KStepFromBasis' columns: stream counts that are and are not multiples of
+// the vector width, rollouts shorter and longer than a block, members that
+// collapse part-way through a block.
+TEST(RunEstimatorsTest, StatisticMatchesPlainReductionOfKStepColumns) {
   const double gamma = 0.9;
   for (const int64_t streams : {1, 3, 4, 16}) {
     for (const int64_t steps : {1, 5, 300, 1100}) {
       const int64_t total = steps * streams;
-      std::vector<double> delta(total), continues(total);
+      std::vector<double> rewards(total), values(total), truncation(total);
+      std::unique_ptr<bool[]> terminated(new bool[total]);
+      std::unique_ptr<bool[]> truncated(new bool[total]);
+      std::vector<double> last_values(streams, 0.5);
       for (int64_t i = 0; i < total; ++i) {
-        delta[i] = ((i * 7919) % 113) / 10.0 - 5.0;
+        rewards[i] = ((i * 7919) % 113) / 10.0 - 5.0;
+        values[i] = ((i * 104729) % 37) / 7.0 - 2.0;
+        truncation[i] = 1.5;
         const int64_t t = i / streams;
-        // Episodes of length 37, offset per stream; the last row ends.
-        const bool ends = (t + i % streams) % 37 == 36 || t == steps - 1;
-        continues[i] = ends ? 0.0 : 1.0;
+        // Episodes of length 37, offset per stream, some cut by time limits.
+        terminated[i] = (t + i % streams) % 37 == 36;
+        truncated[i] = (t + 2 * (i % streams)) % 53 == 52;
       }
+      RolloutView<double> rollout;
+      rollout.steps = steps;
+      rollout.streams = streams;
+      rollout.rewards = rewards.data();
+      rollout.values = values.data();
+      rollout.terminated = terminated.get();
+      rollout.truncated = truncated.get();
+      rollout.truncation_values = truncation.data();
+      rollout.last_values = last_values.data();
+
       std::vector<double> longest(total), remaining(total);
-      ComputePathEnsembleBasis(steps, streams, delta.data(), continues.data(),
-                               gamma, longest.data(), remaining.data());
-      const PathEnsembleBasis basis{longest.data(), remaining.data()};
+      EstimatorSettings basis_only;
+      basis_only.gamma = gamma;
+      EstimatorOutputs<double> basis_outputs;
+      basis_outputs.longest = longest.data();
+      basis_outputs.remaining = remaining.data();
+      RunEstimators(rollout, basis_only, basis_outputs);
+
       for (const std::vector<int64_t>& ensemble :
            std::vector<std::vector<int64_t>>{
                {1}, {1, 2, 5, 9, 30, 500}, {3, 64, 2048}, {2, 1000000}}) {
         std::vector<std::vector<double>> columns;
         for (int64_t k : ensemble) {
           columns.emplace_back(total);
-          KStepKernel(basis, steps, streams, k, gamma, columns.back().data());
+          KStepFromBasis(longest.data(), remaining.data(), steps, streams, k,
+                         gamma, columns.back().data());
         }
         std::vector<Statistic> statistics = {{StatisticKind::kMax, 0},
                                              {StatisticKind::kMin, 0},
@@ -70,12 +117,17 @@ TEST(EnsembleStatisticKernelTest, MatchesPlainReductionOfKStepColumns) {
           statistics.push_back({StatisticKind::kOrder, d});
         }
         for (const Statistic& statistic : statistics) {
+          EstimatorSettings settings;
+          settings.gamma = gamma;
+          settings.ensemble = ensemble;
+          settings.statistic = statistic;
           std::vector<double> out(total), fused_longest(total),
               fused_remaining(total);
-          EnsembleStatisticKernel(steps, streams, delta.data(),
-                                  continues.data(), gamma, ensemble, statistic,
-                                  fused_longest.data(), fused_remaining.data(),
-                                  out.data());
+          EstimatorOutputs<double> outputs;
+          outputs.biased = out.data();
+          outputs.longest = fused_longest.data();
+          outputs.remaining = fused_remaining.data();
+          RunEstimators(rollout, settings, outputs);
           ASSERT_EQ(fused_longest, longest);
           ASSERT_EQ(fused_remaining, remaining);
           for (int64_t i = 0; i < total; ++i) {
@@ -109,6 +161,71 @@ TEST(EnsembleStatisticKernelTest, MatchesPlainReductionOfKStepColumns) {
       }
     }
   }
+}
+
+// Every instruction-set copy of the kernels must give the same bits, or
+// results would depend on the machine a learner runs on.
+TEST(KernelIsaTest, EveryCopyGivesIdenticalBits) {
+#if !defined(VANTAGE_HAVE_AVX2_KERNELS)
+  GTEST_SKIP() << "this build has only the baseline kernels";
+#else
+  __builtin_cpu_init();
+  if (!__builtin_cpu_supports("avx2")) GTEST_SKIP() << "CPU without AVX2";
+  const int64_t steps = 700;
+  const int64_t streams = 7;
+  const int64_t total = steps * streams;
+  std::mt19937_64 rng(3);
+  std::normal_distribution<float> normal;
+  std::bernoulli_distribution rare(0.01);
+  std::vector<float> rewards(total), values(total), truncation(total);
+  std::vector<float> last_values(streams);
+  std::unique_ptr<bool[]> terminated(new bool[total]);
+  std::unique_ptr<bool[]> truncated(new bool[total]);
+  for (int64_t i = 0; i < total; ++i) {
+    rewards[i] = normal(rng);
+    values[i] = 5.0f * normal(rng);
+    truncation[i] = normal(rng);
+    terminated[i] = rare(rng);
+    truncated[i] = rare(rng);
+  }
+  for (float& v : last_values) v = normal(rng);
+  RolloutView<float> rollout;
+  rollout.steps = steps;
+  rollout.streams = streams;
+  rollout.rewards = rewards.data();
+  rollout.values = values.data();
+  rollout.terminated = terminated.get();
+  rollout.truncated = truncated.get();
+  rollout.truncation_values = truncation.data();
+  rollout.last_values = last_values.data();
+  for (const char* name : {"max", "min", "maxabs", "order:3", "order:7"}) {
+    EstimatorSettings settings;
+    settings.ensemble = {1, 2, 4, 8, 16, 64, 256, 2048};
+    settings.statistic = *ParseStatistic(name);
+    std::vector<float> gae[2], biased[2];
+    std::vector<double> longest[2], remaining[2];
+    for (int copy = 0; copy < 2; ++copy) {
+      gae[copy].resize(total);
+      biased[copy].resize(total);
+      longest[copy].resize(total);
+      remaining[copy].resize(total);
+      EstimatorOutputs<float> outputs;
+      outputs.gae = gae[copy].data();
+      outputs.biased = biased[copy].data();
+      outputs.longest = longest[copy].data();
+      outputs.remaining = remaining[copy].data();
+      if (copy == 0) {
+        isa_baseline::RunEstimators(rollout, settings, outputs);
+      } else {
+        isa_avx2::RunEstimators(rollout, settings, outputs);
+      }
+    }
+    EXPECT_EQ(std::memcmp(gae[0].data(), gae[1].data(), total * 4), 0);
+    EXPECT_EQ(std::memcmp(biased[0].data(), biased[1].data(), total * 4), 0)
+        << name;
+    EXPECT_EQ(std::memcmp(longest[0].data(), longest[1].data(), total * 8), 0);
+  }
+#endif
 }
 
 }  // namespace

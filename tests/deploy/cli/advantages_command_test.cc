@@ -112,7 +112,7 @@ TEST(AdvantagesCommandTest, GoldenOutput) {
   //   gae: [1 + .25*1, 1, 5 + .25*8, 8] = [1.25, 1, 7, 8]
   //   A^(2): [1 + .5*2 - .5, 1, 4 + .5*8 + .25*4, 8] = [1.5, 1, 9, 8]
   //   max(A^(1), A^(2)) = [1.5, 1, 9, 8]; returns = V + gae.
-  // The mask of seed 5 is [0, 1, 1, 0]: mixed takes max at t = 1, 2.
+  // The mask of seed 8 is [1, 0, 0, 0]: mixed takes max at t = 0 only.
   const Outcome outcome = RunVantage(absl::StrCat(
       "advantages --input=", VANTAGE_TESTDATA, "/golden_request.json"));
   ASSERT_EQ(outcome.exit_code, 0) << outcome.err;
@@ -121,7 +121,7 @@ TEST(AdvantagesCommandTest, GoldenOutput) {
   EXPECT_THAT(outcome.out, HasSubstr("\"gae\":[1.25,1,7,8]"));
   EXPECT_THAT(outcome.out, HasSubstr("\"biased\":[1.5,1,9,8]"));
   EXPECT_THAT(outcome.out, HasSubstr("\"returns\":[1.75,2,7,10]"));
-  EXPECT_THAT(outcome.out, HasSubstr("\"mixed\":[1.25,1,9,8]"));
+  EXPECT_THAT(outcome.out, HasSubstr("\"mixed\":[1.5,1,7,8]"));
 }
 
 TEST(AdvantagesCommandTest, ValidRequestSucceeds) {
