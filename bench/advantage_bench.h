@@ -10,7 +10,7 @@ namespace vantage {
 // Prints Google Benchmark's table, then a line per statistic and finally
 // `RESULT advantages ratio_e4=<x> ratio_e12=<y> order_ratio_e4=<a>
 // order_ratio_e12=<b>`: the time of the slowest of max/min/maxabs (and of
-// order:d) over GAE's, fastest of 10 repetitions each. Returns the exit
+// order:d) over GAE's, fastest of 30 repetitions each. Returns the exit
 // code.
 int RunAdvantageBenchmark(int64_t steps, int64_t streams);
 
