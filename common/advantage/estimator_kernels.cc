@@ -7,6 +7,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <optional>
+#include <utility>
+#include <vector>
 
 #include "common/advantage/estimator_kernels_isa.h"
 
@@ -260,9 +263,10 @@ void RunEstimators(const RolloutView<Scalar>& rollout,
   for (int64_t k : settings.ensemble) {
     members.push_back(MakeMember(k, steps, n, gamma));
   }
-  const bool want_biased = outputs.biased != nullptr;
-  EnsembleReducer reducer(want_biased ? members : std::vector<Member>(),
-                          settings.statistic, want_biased ? block : 0);
+  std::optional<EnsembleReducer> reducer;
+  if (outputs.biased != nullptr) {
+    reducer.emplace(std::move(members), settings.statistic, block);
+  }
 
   // Backwards a block of rows at a time: each member reads rows t + k,
   // which are in this block or in one done before it.
@@ -284,11 +288,11 @@ void RunEstimators(const RolloutView<Scalar>& rollout,
                  outputs.longest + t * n, outputs.remaining + t * n);
       }
     }
-    if (want_biased) {
+    if (reducer.has_value()) {
       const int64_t begin = first_row * n;
       const int64_t end = end_row * n;
       const double* result =
-          reducer.Reduce(outputs.longest, outputs.remaining, begin, end);
+          reducer->Reduce(outputs.longest, outputs.remaining, begin, end);
       for (int64_t i = begin; i < end; ++i) {
         outputs.biased[i] = static_cast<Out>(result[i - begin]);
       }

@@ -32,7 +32,8 @@ struct RolloutView {
 struct EstimatorSettings {
   double gamma = 0.99;
   double lambda = 0.95;
-  // Sorted ascending (maxabs breaks ties towards the smaller k).
+  // Sorted ascending (maxabs breaks ties towards the smaller k), distinct,
+  // positive; non-empty when `biased` is requested.
   std::vector<int64_t> ensemble;
   Statistic statistic;
 };

@@ -13,6 +13,38 @@
 namespace vantage {
 namespace {
 
+// Owns the arrays behind a RolloutView.
+template <typename Scalar>
+struct OwnedRollout {
+  OwnedRollout(int64_t steps, int64_t streams)
+      : steps(steps),
+        streams(streams),
+        rewards(steps * streams),
+        values(steps * streams),
+        truncation_values(steps * streams),
+        last_values(streams),
+        terminated(new bool[steps * streams]()),
+        truncated(new bool[steps * streams]()) {}
+
+  RolloutView<Scalar> View() const {
+    RolloutView<Scalar> view;
+    view.steps = steps;
+    view.streams = streams;
+    view.rewards = rewards.data();
+    view.values = values.data();
+    view.terminated = terminated.get();
+    view.truncated = truncated.get();
+    view.truncation_values = truncation_values.data();
+    view.last_values = last_values.data();
+    return view;
+  }
+
+  int64_t steps;
+  int64_t streams;
+  std::vector<Scalar> rewards, values, truncation_values, last_values;
+  std::unique_ptr<bool[]> terminated, truncated;
+};
+
 // By the 0-1 principle a comparator network sorts every input iff it sorts
 // every 0/1 input.
 TEST(SortingNetworkTest, SortsEveryBinaryInput) {
@@ -70,28 +102,18 @@ TEST(RunEstimatorsTest, StatisticMatchesPlainReductionOfKStepColumns) {
   for (const int64_t streams : {1, 3, 4, 16}) {
     for (const int64_t steps : {1, 5, 300, 1100}) {
       const int64_t total = steps * streams;
-      std::vector<double> rewards(total), values(total), truncation(total);
-      std::unique_ptr<bool[]> terminated(new bool[total]);
-      std::unique_ptr<bool[]> truncated(new bool[total]);
-      std::vector<double> last_values(streams, 0.5);
+      OwnedRollout<double> owned(steps, streams);
+      std::fill(owned.last_values.begin(), owned.last_values.end(), 0.5);
       for (int64_t i = 0; i < total; ++i) {
-        rewards[i] = ((i * 7919) % 113) / 10.0 - 5.0;
-        values[i] = ((i * 104729) % 37) / 7.0 - 2.0;
-        truncation[i] = 1.5;
+        owned.rewards[i] = ((i * 7919) % 113) / 10.0 - 5.0;
+        owned.values[i] = ((i * 104729) % 37) / 7.0 - 2.0;
+        owned.truncation_values[i] = 1.5;
         const int64_t t = i / streams;
         // Episodes of length 37, offset per stream, some cut by time limits.
-        terminated[i] = (t + i % streams) % 37 == 36;
-        truncated[i] = (t + 2 * (i % streams)) % 53 == 52;
+        owned.terminated[i] = (t + i % streams) % 37 == 36;
+        owned.truncated[i] = (t + 2 * (i % streams)) % 53 == 52;
       }
-      RolloutView<double> rollout;
-      rollout.steps = steps;
-      rollout.streams = streams;
-      rollout.rewards = rewards.data();
-      rollout.values = values.data();
-      rollout.terminated = terminated.get();
-      rollout.truncated = truncated.get();
-      rollout.truncation_values = truncation.data();
-      rollout.last_values = last_values.data();
+      const RolloutView<double> rollout = owned.View();
 
       std::vector<double> longest(total), remaining(total);
       EstimatorSettings basis_only;
@@ -177,27 +199,16 @@ TEST(KernelIsaTest, EveryCopyGivesIdenticalBits) {
   std::mt19937_64 rng(3);
   std::normal_distribution<float> normal;
   std::bernoulli_distribution rare(0.01);
-  std::vector<float> rewards(total), values(total), truncation(total);
-  std::vector<float> last_values(streams);
-  std::unique_ptr<bool[]> terminated(new bool[total]);
-  std::unique_ptr<bool[]> truncated(new bool[total]);
+  OwnedRollout<float> owned(steps, streams);
   for (int64_t i = 0; i < total; ++i) {
-    rewards[i] = normal(rng);
-    values[i] = 5.0f * normal(rng);
-    truncation[i] = normal(rng);
-    terminated[i] = rare(rng);
-    truncated[i] = rare(rng);
+    owned.rewards[i] = normal(rng);
+    owned.values[i] = 5.0f * normal(rng);
+    owned.truncation_values[i] = normal(rng);
+    owned.terminated[i] = rare(rng);
+    owned.truncated[i] = rare(rng);
   }
-  for (float& v : last_values) v = normal(rng);
-  RolloutView<float> rollout;
-  rollout.steps = steps;
-  rollout.streams = streams;
-  rollout.rewards = rewards.data();
-  rollout.values = values.data();
-  rollout.terminated = terminated.get();
-  rollout.truncated = truncated.get();
-  rollout.truncation_values = truncation.data();
-  rollout.last_values = last_values.data();
+  for (float& v : owned.last_values) v = normal(rng);
+  const RolloutView<float> rollout = owned.View();
   for (const char* name : {"max", "min", "maxabs", "order:3", "order:7"}) {
     EstimatorSettings settings;
     settings.ensemble = {1, 2, 4, 8, 16, 64, 256, 2048};
