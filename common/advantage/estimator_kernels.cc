@@ -5,6 +5,7 @@
 // bit-identical results.
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <optional>
@@ -71,12 +72,76 @@ inline void FoldMember(const Member& member, const double* __restrict longest,
 }
 
 inline double Assign(double, double estimate) { return estimate; }
-inline double Larger(double best, double a) { return std::max(best, a); }
-inline double Smaller(double best, double a) { return std::min(best, a); }
-// Strictly larger |A| only: folded in ascending k, ties keep the smaller k.
-inline double LargerMagnitude(double best, double a) {
-  return std::fabs(a) > std::fabs(best) ? a : best;
+
+// Ensembles up to this size reduce element by element with the members
+// unrolled at compile time, so each element's running statistic stays in a
+// register; larger ones (and order:d) go member by member.
+constexpr int kMaxUnrolledMembers = 16;
+
+// The running statistic over elements [begin, end) in which members
+// [0, kActive) are in range and, if kCollapsed, the rest collapse to the
+// longest estimate. Members are in ascending k and the collapsed ones come
+// last, as maxabs's tie rule needs.
+template <int kActive, bool kCollapsed, typename Combine>
+void ReduceSegment(const Member* members, const double* __restrict longest,
+                   const double* __restrict remaining, int64_t begin,
+                   int64_t end, double* __restrict out) {
+  double k[kActive > 0 ? kActive : 1];
+  double gamma_k[kActive > 0 ? kActive : 1];
+  const double* tail[kActive > 0 ? kActive : 1];
+  for (int m = 0; m < kActive; ++m) {
+    k[m] = members[m].k;
+    gamma_k[m] = members[m].gamma_k;
+    tail[m] = longest + members[m].offset;
+  }
+  const Combine combine;
+  for (int64_t i = begin; i < end; ++i) {
+    const double whole = longest[i];
+    double best = whole;
+    if constexpr (kActive > 0) {
+      // As in FoldMember, for bit-identical members.
+      best = whole - (k[0] < remaining[i] ? gamma_k[0] : 0.0) * tail[0][i];
+      for (int m = 1; m < kActive; ++m) {
+        const double factor = k[m] < remaining[i] ? gamma_k[m] : 0.0;
+        best = combine(best, whole - factor * tail[m][i]);
+      }
+      if constexpr (kCollapsed) best = combine(best, whole);
+    }
+    out[i - begin] = best;
+  }
 }
+
+using SegmentReducer = void (*)(const Member*, const double*, const double*,
+                                int64_t, int64_t, double*);
+
+// table[active][collapsed] for one statistic.
+template <typename Combine, int... kActive>
+constexpr std::array<std::array<SegmentReducer, 2>, sizeof...(kActive)>
+SegmentTable(std::integer_sequence<int, kActive...>) {
+  return {{{&ReduceSegment<kActive, false, Combine>,
+            &ReduceSegment<kActive, true, Combine>}...}};
+}
+
+template <typename Combine>
+const std::array<std::array<SegmentReducer, 2>, kMaxUnrolledMembers + 1>&
+SegmentReducers() {
+  static constexpr auto table = SegmentTable<Combine>(
+      std::make_integer_sequence<int, kMaxUnrolledMembers + 1>());
+  return table;
+}
+
+struct LargerOf {
+  double operator()(double best, double a) const { return std::max(best, a); }
+};
+struct SmallerOf {
+  double operator()(double best, double a) const { return std::min(best, a); }
+};
+// Strictly larger |A| only: folded in ascending k, ties keep the smaller k.
+struct LargerMagnitudeOf {
+  double operator()(double best, double a) const {
+    return std::fabs(a) > std::fabs(best) ? a : best;
+  }
+};
 
 // The statistic over the members (sorted by ascending k) for a block of
 // elements, member by member so that every loop is long and vectorised.
@@ -99,32 +164,51 @@ class EnsembleReducer {
   // results, valid until the next call.
   const double* Reduce(const double* longest, const double* remaining,
                        int64_t begin, int64_t end) {
-    double* acc = buffers_.data();
-    const auto fold_all = [&](auto combine) {
-      FoldMember(members_[0], longest, remaining, begin, end, acc, Assign);
-      for (size_t m = 1; m < members_.size(); ++m) {
-        FoldMember(members_[m], longest, remaining, begin, end, acc, combine);
-      }
-    };
     switch (statistic_.kind) {
       case StatisticKind::kMax:
-        fold_all(Larger);
-        break;
+        return Running<LargerOf>(longest, remaining, begin, end);
       case StatisticKind::kMin:
-        fold_all(Smaller);
-        break;
+        return Running<SmallerOf>(longest, remaining, begin, end);
       case StatisticKind::kMaxAbs:
-        fold_all(LargerMagnitude);
-        break;
+        return Running<LargerMagnitudeOf>(longest, remaining, begin, end);
       case StatisticKind::kOrder:
         return SelectOrder(longest, remaining, begin, end);
       case StatisticKind::kGae:
         break;
     }
-    return acc;
+    return buffers_.data();
   }
 
  private:
+  // max, min or maxabs: a running fold.
+  template <typename Combine>
+  const double* Running(const double* longest, const double* remaining,
+                        int64_t begin, int64_t end) {
+    double* acc = buffers_.data();
+    const int count = static_cast<int>(members_.size());
+    if (count > kMaxUnrolledMembers) {
+      FoldMember(members_[0], longest, remaining, begin, end, acc, Assign);
+      for (int m = 1; m < count; ++m) {
+        FoldMember(members_[m], longest, remaining, begin, end, acc, Combine());
+      }
+      return acc;
+    }
+    // Split the block where a member leaves its range: members are sorted
+    // by k, so the in-range ones are always a prefix, shrinking with i.
+    int active = count;
+    while (active > 0 && members_[active - 1].in_range_end <= begin) --active;
+    for (int64_t i = begin; i < end;) {
+      const int64_t segment_end =
+          active > 0 ? std::min(end, members_[active - 1].in_range_end) : end;
+      SegmentReducers<Combine>()[active][active < count ? 1 : 0](
+          members_.data(), longest, remaining, i, segment_end,
+          acc + (i - begin));
+      i = segment_end;
+      while (active > 0 && members_[active - 1].in_range_end <= i) --active;
+    }
+    return acc;
+  }
+
   const double* SelectOrder(const double* longest, const double* remaining,
                             int64_t begin, int64_t end) {
     const int64_t len = end - begin;
