@@ -84,7 +84,16 @@ std::string CommandNames() {
 
 int main(int argc, char** argv) {
   // Google Benchmark takes its own --benchmark_* flags out of argv first.
-  benchmark::Initialize(&argc, argv);
+  // Interleaving the repetitions of all benchmarks spreads a noisy
+  // machine's slow moments over all of them instead of skewing one ratio;
+  // a later --benchmark_enable_random_interleaving=false still wins.
+  std::vector<char*> args(argv, argv + argc);
+  char interleave[] = "--benchmark_enable_random_interleaving=true";
+  args.insert(args.begin() + 1, interleave);
+  int args_count = static_cast<int>(args.size());
+  benchmark::Initialize(&args_count, args.data());
+  argc = args_count;
+  argv = args.data();
   absl::SetProgramUsageMessage(
       "vantage <command> [flags]\n"
       "  advantages --input=FILE.json   estimates of one rollout as JSON\n"
