@@ -14,11 +14,16 @@
 #include "absl/strings/str_join.h"
 #include "bench/advantage_bench.h"
 #include "deploy/cli/advantages_command.h"
+#include "deploy/cli/env_commands.h"
 
 ABSL_FLAG(std::string, input, "",
           "advantages: JSON file with one rollout and the estimator settings");
 ABSL_FLAG(bool, example, false,
           "advantages: print every estimator on a built-in rollout");
+ABSL_FLAG(std::string, env, "",
+          "rollout: environment name (see `vantage envs`) or mjcf:PATH");
+ABSL_FLAG(int64_t, episodes, 10, "rollout: number of episodes");
+ABSL_FLAG(uint64_t, seed, 0, "rollout: random seed");
 ABSL_FLAG(int64_t, bench_steps, 2048, "bench advantages: rollout length T");
 ABSL_FLAG(int64_t, bench_streams, 16,
           "bench advantages: number of env streams");
@@ -38,6 +43,26 @@ int RunAdvantages(const std::vector<std::string>& args) {
   }
   if (absl::GetFlag(FLAGS_example)) return RunAdvantagesExample();
   return RunAdvantagesCommand(absl::GetFlag(FLAGS_input));
+}
+
+// For commands that take no positional arguments.
+int NoArguments(const char* command, const std::vector<std::string>& args) {
+  if (args.empty()) return 0;
+  std::fprintf(stderr, "vantage %s: unexpected argument '%s'\n", command,
+               args[0].c_str());
+  return kUsageExitCode;
+}
+
+int RunEnvs(const std::vector<std::string>& args) {
+  if (int code = NoArguments("envs", args); code != 0) return code;
+  return RunEnvsCommand();
+}
+
+int RunRollout(const std::vector<std::string>& args) {
+  if (int code = NoArguments("rollout", args); code != 0) return code;
+  return RunRolloutCommand(absl::GetFlag(FLAGS_env),
+                           absl::GetFlag(FLAGS_episodes),
+                           absl::GetFlag(FLAGS_seed));
 }
 
 int RunBench(const std::vector<std::string>& args) {
@@ -69,6 +94,8 @@ const std::map<std::string, Command>& Commands() {
   static const auto* commands = new std::map<std::string, Command>{
       {"advantages", RunAdvantages},
       {"bench", RunBench},
+      {"envs", RunEnvs},
+      {"rollout", RunRollout},
   };
   return *commands;
 }
@@ -98,6 +125,8 @@ int main(int argc, char** argv) {
       "vantage <command> [flags]\n"
       "  advantages --input=FILE.json   estimates of one rollout as JSON\n"
       "  advantages --example           every estimator on a built-in rollout\n"
+      "  envs                           registered environments\n"
+      "  rollout --env=NAME --episodes=N --seed=S   random-policy episodes\n"
       "  bench advantages               path ensemble vs GAE benchmark\n");
   const std::vector<char*> positional = absl::ParseCommandLine(argc, argv);
   if (positional.size() < 2) {

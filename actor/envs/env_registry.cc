@@ -1,0 +1,65 @@
+#include "actor/envs/env_registry.h"
+
+#include <functional>
+#include <map>
+#include <utility>
+
+#include "absl/strings/match.h"
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_join.h"
+#include "absl/strings/strip.h"
+#include "actor/envs/mujoco/gym_tasks.h"
+#include "actor/envs/mujoco/pendulum_envs.h"
+#include "common/env/time_limit.h"
+
+namespace vantage {
+namespace {
+
+using Factory = std::function<absl::StatusOr<std::unique_ptr<Environment>>()>;
+
+const std::map<std::string, Factory>& Factories() {
+  static const auto* factories = new std::map<std::string, Factory>{
+      {"Ant", MakeAnt},
+      {"HalfCheetah", MakeHalfCheetah},
+      {"Hopper", MakeHopper},
+      {"InvertedDoublePendulum", MakeInvertedDoublePendulum},
+      {"InvertedPendulum", MakeInvertedPendulum},
+      {"SparseHalfCheetah", MakeSparseHalfCheetah},
+      {"Walker2d", MakeWalker2d},
+  };
+  return *factories;
+}
+
+}  // namespace
+
+absl::StatusOr<std::unique_ptr<Environment>> MakeEnvironment(
+    absl::string_view name) {
+  absl::StatusOr<std::unique_ptr<Environment>> env;
+  absl::string_view path = name;
+  if (absl::ConsumePrefix(&path, "mjcf:")) {
+    if (path.empty()) {
+      return absl::InvalidArgumentError(
+          "mjcf: needs a path, e.g. --env=mjcf:/path/model.xml");
+    }
+    env = MakeMjcfEnv(std::string(path));
+  } else {
+    auto factory = Factories().find(std::string(name));
+    if (factory == Factories().end()) {
+      return absl::NotFoundError(absl::StrCat(
+          "unknown environment '", name,
+          "'; registered: ", absl::StrJoin(RegisteredEnvironments(), ", "),
+          ", or mjcf:/path/model.xml"));
+    }
+    env = factory->second();
+  }
+  if (!env.ok()) return env.status();
+  return std::unique_ptr<Environment>(new TimeLimit(std::move(*env)));
+}
+
+std::vector<std::string> RegisteredEnvironments() {
+  std::vector<std::string> names;
+  for (const auto& entry : Factories()) names.push_back(entry.first);
+  return names;
+}
+
+}  // namespace vantage

@@ -1,0 +1,190 @@
+#include "actor/envs/mujoco/gym_tasks.h"
+
+#include <cmath>
+#include <utility>
+
+#include "absl/strings/match.h"
+#include "absl/strings/str_cat.h"
+#include "actor/envs/mujoco/locomotion_env.h"
+#include "actor/envs/mujoco/models.h"
+
+namespace vantage {
+namespace {
+
+absl::StatusOr<std::unique_ptr<Environment>> Build(const LocomotionTask& task,
+                                                   const char* xml) {
+  absl::StatusOr<MjModelPtr> model = LoadModelFromString(task.name, xml);
+  if (!model.ok()) return model.status();
+  return MakeLocomotionEnv(task, std::move(*model));
+}
+
+LocomotionTask HalfCheetahTask() {
+  LocomotionTask task;
+  task.name = "HalfCheetah";
+  task.frame_skip = 5;  // dt 0.05 s
+  task.ctrl_cost = 0.1;
+  task.observe_qpos_from = 1;  // 8 + 9 = 17
+  task.reset_noise = 0.1;
+  task.normal_qvel_noise = true;
+  return task;
+}
+
+}  // namespace
+
+absl::StatusOr<std::unique_ptr<Environment>> MakeHalfCheetah() {
+  return Build(HalfCheetahTask(), kHalfCheetahXml);
+}
+
+absl::StatusOr<std::unique_ptr<Environment>> MakeSparseHalfCheetah() {
+  LocomotionTask task = HalfCheetahTask();
+  task.name = "SparseHalfCheetah";
+  task.sparse_x_threshold = 5.0;
+  return Build(task, kHalfCheetahXml);
+}
+
+absl::StatusOr<std::unique_ptr<Environment>> MakeHopper() {
+  LocomotionTask task;
+  task.name = "Hopper";
+  task.frame_skip = 4;  // dt 0.008 s
+  task.ctrl_cost = 1e-3;
+  task.healthy_reward = 1.0;
+  task.terminate_when_unhealthy = true;
+  task.min_z = 0.7;
+  task.angle_index = 2;
+  task.min_angle = -0.2;
+  task.max_angle = 0.2;
+  task.state_limit = 100.0;
+  task.observe_qpos_from = 1;  // 5 + 6 = 11
+  task.qvel_clip = 10.0;
+  task.reset_noise = 5e-3;
+  return Build(task, kHopperXml);
+}
+
+absl::StatusOr<std::unique_ptr<Environment>> MakeWalker2d() {
+  LocomotionTask task;
+  task.name = "Walker2d";
+  task.frame_skip = 4;  // dt 0.008 s
+  task.ctrl_cost = 1e-3;
+  task.healthy_reward = 1.0;
+  task.terminate_when_unhealthy = true;
+  task.min_z = 0.8;
+  task.max_z = 2.0;
+  task.angle_index = 2;
+  task.min_angle = -1.0;
+  task.max_angle = 1.0;
+  task.observe_qpos_from = 1;  // 8 + 9 = 17
+  task.qvel_clip = 10.0;
+  task.reset_noise = 5e-3;
+  return Build(task, kWalker2dXml);
+}
+
+absl::StatusOr<std::unique_ptr<Environment>> MakeAnt() {
+  LocomotionTask task;
+  task.name = "Ant";
+  task.frame_skip = 5;  // dt 0.05 s
+  task.ctrl_cost = 0.5;
+  task.healthy_reward = 1.0;
+  task.terminate_when_unhealthy = true;
+  task.min_z = 0.2;
+  task.max_z = 1.0;
+  task.observe_qpos_from = 2;  // 13 + 14 = 27
+  task.reset_noise = 0.1;
+  task.normal_qvel_noise = true;
+  return Build(task, kAntXml);
+}
+
+absl::StatusOr<std::unique_ptr<Environment>> MakeMjcfEnv(
+    const std::string& path) {
+  absl::StatusOr<MjModelPtr> loaded = LoadModelFromFile(path);
+  if (!loaded.ok()) return loaded.status();
+  const mjModel* m = loaded->get();
+  LocomotionTask task;
+  task.name = absl::StrCat("mjcf:", path);
+  task.forward_body.clear();
+  const auto bad = [&](absl::string_view key, absl::string_view why) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(path, ": <custom> entry '", key, "' ", why));
+  };
+  for (int i = 0; i < m->ntext; ++i) {
+    const std::string key = m->names + m->name_textadr[i];
+    const std::string value = m->text_data + m->text_adr[i];
+    if (key == "vantage_forward_body") {
+      if (mj_name2id(m, mjOBJ_BODY, value.c_str()) < 0) {
+        return bad(key, absl::StrCat("names body '", value,
+                                     "', which the model does not have"));
+      }
+      task.forward_body = value;
+    } else if (absl::StartsWith(key, "vantage_")) {
+      return bad(key,
+                 "is not a vantage text setting (known: "
+                 "vantage_forward_body)");
+    }
+  }
+  bool has_healthy_z = false;
+  for (int i = 0; i < m->nnumeric; ++i) {
+    const std::string key = m->names + m->name_numericadr[i];
+    if (!absl::StartsWith(key, "vantage_")) continue;
+    const mjtNum* values = m->numeric_data + m->numeric_adr[i];
+    const int size = m->numeric_size[i];
+    for (int j = 0; j < size; ++j) {
+      if (!std::isfinite(values[j])) return bad(key, "has a non-finite value");
+    }
+    const auto one = [&]() -> absl::StatusOr<double> {
+      if (size != 1) return bad(key, "needs exactly one number");
+      return values[0];
+    };
+    const auto positive_integer = [&]() -> absl::StatusOr<int64_t> {
+      absl::StatusOr<double> value = one();
+      if (!value.ok()) return value.status();
+      if (*value < 1 || *value != std::floor(*value)) {
+        return bad(key, "needs a whole number >= 1");
+      }
+      return static_cast<int64_t>(*value);
+    };
+    if (key == "vantage_forward_weight") {
+      absl::StatusOr<double> value = one();
+      if (!value.ok()) return value.status();
+      task.forward_weight = *value;
+    } else if (key == "vantage_ctrl_cost") {
+      absl::StatusOr<double> value = one();
+      if (!value.ok()) return value.status();
+      if (*value < 0) return bad(key, "must be >= 0");
+      task.ctrl_cost = *value;
+    } else if (key == "vantage_alive_bonus") {
+      absl::StatusOr<double> value = one();
+      if (!value.ok()) return value.status();
+      task.healthy_reward = *value;
+    } else if (key == "vantage_healthy_z") {
+      if (size != 2 || !(values[0] < values[1])) {
+        return bad(key, "needs two numbers lo < hi");
+      }
+      task.min_z = values[0];
+      task.max_z = values[1];
+      task.terminate_when_unhealthy = true;
+      has_healthy_z = true;
+    } else if (key == "vantage_frame_skip") {
+      absl::StatusOr<int64_t> value = positive_integer();
+      if (!value.ok()) return value.status();
+      task.frame_skip = static_cast<int>(*value);
+    } else if (key == "vantage_max_steps") {
+      absl::StatusOr<int64_t> value = positive_integer();
+      if (!value.ok()) return value.status();
+      task.max_episode_steps = *value;
+    } else {
+      return bad(key,
+                 "is not a vantage setting (known: vantage_forward_weight, "
+                 "vantage_ctrl_cost, vantage_alive_bonus, vantage_healthy_z, "
+                 "vantage_frame_skip, vantage_max_steps)");
+    }
+  }
+  if (has_healthy_z && task.forward_body.empty()) {
+    return bad("vantage_healthy_z", "needs vantage_forward_body");
+  }
+  if (m->nu == 0) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(path, ": the model has no actuators to control"));
+  }
+  return MakeLocomotionEnv(task, std::move(*loaded));
+}
+
+}  // namespace vantage

@@ -1,0 +1,125 @@
+#include "actor/envs/mujoco/locomotion_env.h"
+
+#include <algorithm>
+#include <cmath>
+#include <utility>
+
+#include "absl/strings/str_cat.h"
+
+namespace vantage {
+namespace {
+
+class LocomotionEnv : public MujocoEnv {
+ public:
+  LocomotionEnv(const LocomotionTask& task, EnvSpec spec, MjModelPtr model,
+                MjDataPtr data, int forward_body)
+      : MujocoEnv(std::move(spec), std::move(model), std::move(data),
+                  task.frame_skip),
+        task_(task),
+        forward_body_(forward_body) {}
+
+ protected:
+  void ResetState(std::mt19937_64& rng) override {
+    mjData* d = mutable_data();
+    AddUniformNoise(rng, task_.reset_noise, d->qpos, model()->nq);
+    if (task_.normal_qvel_noise) {
+      AddNormalNoise(rng, task_.reset_noise, d->qvel, model()->nv);
+    } else {
+      AddUniformNoise(rng, task_.reset_noise, d->qvel, model()->nv);
+    }
+  }
+
+  void BeforeStep() override { x_before_ = ForwardX(); }
+
+  StepResult Evaluate(absl::Span<const double> action) override {
+    StepResult result;
+    const bool healthy = Healthy();
+    if (task_.sparse_x_threshold > -std::numeric_limits<double>::infinity()) {
+      result.reward = ForwardX() > task_.sparse_x_threshold ? 1.0 : 0.0;
+    } else {
+      const double velocity = (ForwardX() - x_before_) / spec().control_dt;
+      double effort = 0.0;
+      for (double a : action) effort += a * a;
+      result.reward =
+          task_.forward_weight * velocity - task_.ctrl_cost * effort;
+      if (healthy || task_.terminate_when_unhealthy) {
+        result.reward += task_.healthy_reward;
+      }
+    }
+    result.terminated = task_.terminate_when_unhealthy && !healthy;
+    return result;
+  }
+
+  void Observe(double* observation) const override {
+    const mjModel* m = model();
+    const mjData* d = data();
+    double* out = observation;
+    for (int i = task_.observe_qpos_from; i < m->nq; ++i) *out++ = d->qpos[i];
+    for (int i = 0; i < m->nv; ++i) {
+      *out++ = std::clamp(d->qvel[i], -task_.qvel_clip, task_.qvel_clip);
+    }
+  }
+
+ private:
+  // Without a forward body there is no forward reward and no height rule.
+  double ForwardX() const {
+    return forward_body_ < 0 ? 0.0 : data()->xpos[3 * forward_body_];
+  }
+
+  bool Healthy() const {
+    const mjModel* m = model();
+    const mjData* d = data();
+    if (forward_body_ >= 0) {
+      const double z = d->xpos[3 * forward_body_ + 2];
+      if (!(z > task_.min_z && z < task_.max_z)) return false;
+    }
+    if (task_.angle_index >= 0) {
+      const double angle = d->qpos[task_.angle_index];
+      if (!(angle > task_.min_angle && angle < task_.max_angle)) return false;
+    }
+    for (int i = 2; i < m->nq; ++i) {
+      if (!(std::fabs(d->qpos[i]) < task_.state_limit)) return false;
+    }
+    for (int i = 0; i < m->nv; ++i) {
+      if (!(std::fabs(d->qvel[i]) < task_.state_limit)) return false;
+    }
+    return true;
+  }
+
+  const LocomotionTask task_;
+  const int forward_body_;
+  double x_before_ = 0.0;
+};
+
+}  // namespace
+
+absl::StatusOr<std::unique_ptr<Environment>> MakeLocomotionEnv(
+    const LocomotionTask& task, MjModelPtr model) {
+  const int body =
+      task.forward_body.empty()
+          ? -1
+          : mj_name2id(model.get(), mjOBJ_BODY, task.forward_body.c_str());
+  if (!task.forward_body.empty() && body < 0) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        task.name, ": the model has no body named '", task.forward_body, "'"));
+  }
+  if (task.observe_qpos_from > model->nq) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(task.name, ": cannot skip ", task.observe_qpos_from,
+                     " of ", model->nq, " qpos entries"));
+  }
+  if (task.angle_index >= model->nq) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        task.name, ": angle index ", task.angle_index, " is past qpos"));
+  }
+  absl::StatusOr<MjDataPtr> data = MakeData(model.get());
+  if (!data.ok()) return data.status();
+  EnvSpec spec;
+  spec.name = task.name;
+  spec.observation_size = model->nq - task.observe_qpos_from + model->nv;
+  spec.max_episode_steps = task.max_episode_steps;
+  return std::unique_ptr<Environment>(new LocomotionEnv(
+      task, std::move(spec), std::move(model), std::move(*data), body));
+}
+
+}  // namespace vantage

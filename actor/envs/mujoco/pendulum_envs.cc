@@ -1,0 +1,112 @@
+#include "actor/envs/mujoco/pendulum_envs.h"
+
+#include <algorithm>
+#include <cmath>
+#include <utility>
+
+#include "actor/envs/mujoco/models.h"
+#include "actor/envs/mujoco/mujoco_env.h"
+
+namespace vantage {
+namespace {
+
+class InvertedPendulum : public MujocoEnv {
+ public:
+  InvertedPendulum(EnvSpec spec, MjModelPtr model, MjDataPtr data)
+      : MujocoEnv(std::move(spec), std::move(model), std::move(data),
+                  /*frame_skip=*/2) {}
+
+ protected:
+  void ResetState(std::mt19937_64& rng) override {
+    AddUniformNoise(rng, 0.01, mutable_data()->qpos, model()->nq);
+    AddUniformNoise(rng, 0.01, mutable_data()->qvel, model()->nv);
+  }
+  StepResult Evaluate(absl::Span<const double>) override {
+    StepResult result;
+    result.reward = 1.0;
+    const double angle = data()->qpos[1];
+    bool finite = true;
+    for (int i = 0; i < model()->nq; ++i)
+      finite &= std::isfinite(data()->qpos[i]);
+    for (int i = 0; i < model()->nv; ++i)
+      finite &= std::isfinite(data()->qvel[i]);
+    result.terminated = !finite || std::fabs(angle) > 0.2;
+    return result;
+  }
+  void Observe(double* observation) const override {
+    std::copy(data()->qpos, data()->qpos + 2, observation);
+    std::copy(data()->qvel, data()->qvel + 2, observation + 2);
+  }
+};
+
+class InvertedDoublePendulum : public MujocoEnv {
+ public:
+  InvertedDoublePendulum(EnvSpec spec, MjModelPtr model, MjDataPtr data,
+                         int tip)
+      : MujocoEnv(std::move(spec), std::move(model), std::move(data),
+                  /*frame_skip=*/5),
+        tip_(tip) {}
+
+ protected:
+  void ResetState(std::mt19937_64& rng) override {
+    AddUniformNoise(rng, 0.1, mutable_data()->qpos, model()->nq);
+    AddNormalNoise(rng, 0.1, mutable_data()->qvel, model()->nv);
+  }
+  StepResult Evaluate(absl::Span<const double>) override {
+    const mjData* d = data();
+    const double x = d->site_xpos[3 * tip_];
+    const double y = d->site_xpos[3 * tip_ + 2];
+    const double w1 = d->qvel[1];
+    const double w2 = d->qvel[2];
+    StepResult result;
+    result.reward = 10.0 - (0.01 * x * x + (y - 2.0) * (y - 2.0)) -
+                    (1e-3 * w1 * w1 + 5e-3 * w2 * w2);
+    result.terminated = y <= 1.0;
+    return result;
+  }
+  void Observe(double* observation) const override {
+    const mjData* d = data();
+    double* out = observation;
+    *out++ = d->qpos[0];
+    for (int i = 1; i < 3; ++i) *out++ = std::sin(d->qpos[i]);
+    for (int i = 1; i < 3; ++i) *out++ = std::cos(d->qpos[i]);
+    for (int i = 0; i < 3; ++i) *out++ = std::clamp(d->qvel[i], -10.0, 10.0);
+    for (int i = 0; i < 3; ++i) {
+      *out++ = std::clamp(d->qfrc_constraint[i], -10.0, 10.0);
+    }
+  }
+
+ private:
+  const int tip_;
+};
+
+template <typename Env, typename... Args>
+absl::StatusOr<std::unique_ptr<Environment>> Build(const char* name,
+                                                   const char* xml,
+                                                   int64_t observation_size,
+                                                   Args... args) {
+  absl::StatusOr<MjModelPtr> model = LoadModelFromString(name, xml);
+  if (!model.ok()) return model.status();
+  absl::StatusOr<MjDataPtr> data = MakeData(model->get());
+  if (!data.ok()) return data.status();
+  EnvSpec spec;
+  spec.name = name;
+  spec.observation_size = observation_size;
+  spec.max_episode_steps = 1000;
+  return std::unique_ptr<Environment>(
+      new Env(std::move(spec), std::move(*model), std::move(*data), args...));
+}
+
+}  // namespace
+
+absl::StatusOr<std::unique_ptr<Environment>> MakeInvertedPendulum() {
+  return Build<InvertedPendulum>("InvertedPendulum", kInvertedPendulumXml, 4);
+}
+
+absl::StatusOr<std::unique_ptr<Environment>> MakeInvertedDoublePendulum() {
+  // The tip site is the model's only site.
+  return Build<InvertedDoublePendulum>("InvertedDoublePendulum",
+                                       kInvertedDoublePendulumXml, 11, 0);
+}
+
+}  // namespace vantage

@@ -1,0 +1,74 @@
+#ifndef VANTAGE_ACTOR_VECTOR_ENV_H_
+#define VANTAGE_ACTOR_VECTOR_ENV_H_
+
+#include <cstdint>
+#include <memory>
+#include <random>
+#include <vector>
+
+#include "absl/status/status.h"
+#include "absl/status/statusor.h"
+#include "absl/strings/string_view.h"
+#include "absl/types/span.h"
+#include "common/env/environment.h"
+
+namespace vantage {
+
+struct FinishedEpisode {
+  int env_index = 0;
+  double episode_return = 0.0;
+  int64_t length = 0;
+  bool truncated = false;  // else terminated
+};
+
+// M environments of one kind stepped together with automatic reset, all
+// results in preallocated row-major buffers (for batched inference).
+// After Step, observations() holds each env's next observation; where an
+// episode ended that is the new episode's first one and the observation
+// that ended it is in final_observations().
+class VectorEnv {
+ public:
+  // Environment `name` (see MakeEnvironment) x `count`; episode seeds are
+  // drawn from `seed`, so the same seed replays the same episodes.
+  static absl::StatusOr<std::unique_ptr<VectorEnv>> Create(
+      absl::string_view name, int count, uint64_t seed);
+
+  const EnvSpec& spec() const { return envs_[0]->spec(); }
+  int size() const { return static_cast<int>(envs_.size()); }
+
+  absl::Status Reset();
+  // actions: [size, action values]. An error names the environment; the
+  // others have stepped and kept their results.
+  absl::Status Step(absl::Span<const double> actions);
+
+  absl::Span<const double> observations() const { return observations_; }
+  absl::Span<const double> final_observations() const {
+    return final_observations_;
+  }
+  absl::Span<const double> rewards() const { return rewards_; }
+  const std::vector<uint8_t>& terminated() const { return terminated_; }
+  const std::vector<uint8_t>& truncated() const { return truncated_; }
+  // Episodes that ended during the last Step.
+  const std::vector<FinishedEpisode>& finished() const { return finished_; }
+
+ private:
+  VectorEnv(std::vector<std::unique_ptr<Environment>> envs, uint64_t seed);
+  absl::Status ResetOne(int index);
+
+  std::vector<std::unique_ptr<Environment>> envs_;
+  std::mt19937_64 seeds_;
+  int64_t observation_size_;
+  int64_t action_width_;
+  std::vector<double> observations_;
+  std::vector<double> final_observations_;
+  std::vector<double> rewards_;
+  std::vector<uint8_t> terminated_;
+  std::vector<uint8_t> truncated_;
+  std::vector<double> episode_returns_;
+  std::vector<int64_t> episode_lengths_;
+  std::vector<FinishedEpisode> finished_;
+};
+
+}  // namespace vantage
+
+#endif  // VANTAGE_ACTOR_VECTOR_ENV_H_

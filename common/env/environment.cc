@@ -1,0 +1,35 @@
+#include "common/env/environment.h"
+
+#include <cmath>
+
+#include "absl/strings/str_cat.h"
+
+namespace vantage {
+
+std::string EnvSpec::ActionString() const {
+  return absl::StrCat(discrete ? "discrete:" : "continuous:", action_size);
+}
+
+absl::Status CheckAction(const EnvSpec& spec, absl::Span<const double> action) {
+  const size_t expected = spec.discrete ? 1 : spec.action_size;
+  if (action.size() != expected) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(spec.name, ": action has ", action.size(),
+                     " values, expected ", expected));
+  }
+  for (size_t i = 0; i < action.size(); ++i) {
+    if (!std::isfinite(action[i])) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          spec.name, ": action[", i, "] is not finite (", action[i], ")"));
+    }
+  }
+  if (spec.discrete && (action[0] != std::floor(action[0]) || action[0] < 0 ||
+                        action[0] >= static_cast<double>(spec.action_size))) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(spec.name, ": discrete action ", action[0],
+                     " is not an integer in [0, ", spec.action_size, ")"));
+  }
+  return absl::OkStatus();
+}
+
+}  // namespace vantage

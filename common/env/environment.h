@@ -1,0 +1,70 @@
+#ifndef VANTAGE_COMMON_ENV_ENVIRONMENT_H_
+#define VANTAGE_COMMON_ENV_ENVIRONMENT_H_
+
+// The environment interface actors step and the spec the learner receives.
+// Physics engines live behind it in actor/envs; nothing here links them.
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "absl/status/status.h"
+#include "absl/status/statusor.h"
+#include "absl/types/span.h"
+
+namespace vantage {
+
+struct EnvSpec {
+  std::string name;
+  int64_t observation_size = 0;  // observations are flat [observation_size]
+  bool discrete = false;
+  // Continuous: the action dimension, with [action_low, action_high] bounds.
+  // Discrete: the number of actions, and the bounds are empty.
+  int64_t action_size = 0;
+  std::vector<double> action_low;
+  std::vector<double> action_high;
+  // Steps after which the time limit truncates an episode (0: none).
+  int64_t max_episode_steps = 1000;
+  // Simulated seconds per step (physics timestep x frame skip).
+  double control_dt = 0.0;
+
+  // "continuous:6" or "discrete:4".
+  std::string ActionString() const;
+};
+
+struct StepResult {
+  double reward = 0.0;
+  // s_{t+1} is terminal: the learner bootstraps with 0.
+  bool terminated = false;
+  // A time limit ended the episode; the observation written by Step is the
+  // final one, which the learner bootstraps from.
+  bool truncated = false;
+};
+
+// One environment instance; not thread-safe. Observation spans must hold
+// spec().observation_size values, actions spec().action_size (discrete: one
+// value holding the action index).
+class Environment {
+ public:
+  virtual ~Environment() = default;
+
+  virtual const EnvSpec& spec() const = 0;
+
+  // Starts an episode deterministically from `seed` and writes its first
+  // observation.
+  virtual absl::Status Reset(uint64_t seed, absl::Span<double> observation) = 0;
+
+  // Applies `action` (continuous actions are clipped to the bounds; a
+  // non-finite or wrongly sized action is an InvalidArgument error) and
+  // writes the next observation. Never resets by itself.
+  virtual absl::StatusOr<StepResult> Step(absl::Span<const double> action,
+                                          absl::Span<double> observation) = 0;
+};
+
+// Checks an action's size and finiteness against the spec (and, if
+// discrete, that it is an integer in range); the message names the entry.
+absl::Status CheckAction(const EnvSpec& spec, absl::Span<const double> action);
+
+}  // namespace vantage
+
+#endif  // VANTAGE_COMMON_ENV_ENVIRONMENT_H_

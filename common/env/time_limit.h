@@ -1,0 +1,33 @@
+#ifndef VANTAGE_COMMON_ENV_TIME_LIMIT_H_
+#define VANTAGE_COMMON_ENV_TIME_LIMIT_H_
+
+#include <cstdint>
+#include <memory>
+
+#include "common/env/environment.h"
+
+namespace vantage {
+
+// Truncates episodes after spec().max_episode_steps steps (never marking
+// them terminated), and refuses to step an episode that has not been reset
+// or has already ended.
+class TimeLimit : public Environment {
+ public:
+  explicit TimeLimit(std::unique_ptr<Environment> inner);
+
+  const EnvSpec& spec() const override { return inner_->spec(); }
+  absl::Status Reset(uint64_t seed, absl::Span<double> observation) override;
+  absl::StatusOr<StepResult> Step(absl::Span<const double> action,
+                                  absl::Span<double> observation) override;
+
+  int64_t elapsed_steps() const { return elapsed_steps_; }
+
+ private:
+  std::unique_ptr<Environment> inner_;
+  int64_t elapsed_steps_ = 0;
+  bool running_ = false;
+};
+
+}  // namespace vantage
+
+#endif  // VANTAGE_COMMON_ENV_TIME_LIMIT_H_
