@@ -74,6 +74,9 @@ absl::StatusOr<StepResult> MujocoEnv::Step(absl::Span<const double> action,
   }
   absl::Status status = GuardMujoco([&] {
     for (int i = 0; i < frame_skip_; ++i) mj_step(model_.get(), d);
+    // mj_step leaves body and site positions at the start of its last
+    // substep; rewards and observations read them at the end.
+    mj_kinematics(model_.get(), d);
   });
   if (status.ok()) {
     for (const auto& [warning, what] :

@@ -1,68 +1,17 @@
-// Runs the real `vantage` binary, as a user would.
-
-#include <sys/wait.h>
-
-#include <cstdio>
-#include <cstdlib>
-#include <fstream>
+#include <algorithm>
 #include <map>
-#include <sstream>
 #include <string>
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_join.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
+#include "tests/deploy/cli/run_vantage.h"
 
 namespace vantage {
 namespace {
 
 using ::testing::HasSubstr;
-using ::testing::Not;
-
-struct Outcome {
-  int exit_code = -1;
-  std::string out;
-  std::string err;
-};
-
-std::string ReadFile(const std::string& path) {
-  std::ifstream file(path);
-  std::stringstream contents;
-  contents << file.rdbuf();
-  return contents.str();
-}
-
-// ctest runs the tests of this file as parallel processes: every file gets
-// the test's name and a counter so that none share one.
-std::string TempPath(const std::string& name) {
-  static int counter = 0;
-  return absl::StrCat(
-      ::testing::TempDir(), "/vantage_",
-      ::testing::UnitTest::GetInstance()->current_test_info()->name(), "_",
-      counter++, "_", name);
-}
-
-std::string WriteTemp(const std::string& name, const std::string& text) {
-  const std::string path = TempPath(name);
-  std::ofstream(path) << text;
-  return path;
-}
-
-Outcome RunVantage(const std::string& args) {
-  const std::string out = TempPath("stdout.txt");
-  const std::string err = TempPath("stderr.txt");
-  const std::string command =
-      absl::StrCat(VANTAGE_BINARY, " ", args, " >", out, " 2>", err);
-  const int status = std::system(command.c_str());
-  Outcome outcome;
-  outcome.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  outcome.out = ReadFile(out);
-  outcome.err = ReadFile(err);
-  std::remove(out.c_str());
-  std::remove(err.c_str());
-  return outcome;
-}
 
 // A valid request as key -> JSON value, so tests can drop or break one key.
 std::map<std::string, std::string> ValidRequest() {

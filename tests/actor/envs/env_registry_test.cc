@@ -1,0 +1,296 @@
+#include "actor/envs/env_registry.h"
+
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "absl/strings/str_cat.h"
+#include "actor/envs/mujoco/mujoco_model.h"
+#include "gmock/gmock.h"
+#include "gtest/gtest.h"
+
+namespace vantage {
+namespace {
+
+using ::testing::HasSubstr;
+
+std::unique_ptr<Environment> Make(const std::string& name) {
+  absl::StatusOr<std::unique_ptr<Environment>> env = MakeEnvironment(name);
+  EXPECT_TRUE(env.ok()) << env.status();
+  return env.ok() ? std::move(*env) : nullptr;
+}
+
+std::vector<double> RandomAction(const EnvSpec& spec, std::mt19937_64& rng) {
+  std::vector<double> action(spec.action_size);
+  for (int64_t i = 0; i < spec.action_size; ++i) {
+    action[i] = std::uniform_real_distribution<double>(
+        spec.action_low[i], spec.action_high[i])(rng);
+  }
+  return action;
+}
+
+// Runs one episode (at most `max_steps`) and returns every observation.
+std::vector<std::vector<double>> Episode(Environment& env, uint64_t seed,
+                                         int max_steps, StepResult* last) {
+  std::mt19937_64 rng(seed);
+  std::vector<double> observation(env.spec().observation_size);
+  EXPECT_TRUE(env.Reset(seed, absl::MakeSpan(observation)).ok());
+  std::vector<std::vector<double>> seen = {observation};
+  for (int t = 0; t < max_steps; ++t) {
+    absl::StatusOr<StepResult> result =
+        env.Step(RandomAction(env.spec(), rng), absl::MakeSpan(observation));
+    EXPECT_TRUE(result.ok()) << result.status();
+    if (!result.ok()) break;
+    seen.push_back(observation);
+    *last = *result;
+    if (result->terminated || result->truncated) break;
+  }
+  return seen;
+}
+
+TEST(EnvRegistryTest, SpecsMatchTheGymnasiumTasks) {
+  const std::map<std::string, std::pair<int, int>> expected = {
+      {"HalfCheetah", {17, 6}},      {"Hopper", {11, 3}},
+      {"Walker2d", {17, 6}},         {"Ant", {27, 8}},
+      {"InvertedPendulum", {4, 1}},  {"InvertedDoublePendulum", {11, 1}},
+      {"SparseHalfCheetah", {17, 6}}};
+  for (const auto& [name, sizes] : expected) {
+    const auto env = Make(name);
+    ASSERT_NE(env, nullptr);
+    EXPECT_EQ(env->spec().observation_size, sizes.first) << name;
+    EXPECT_EQ(env->spec().action_size, sizes.second) << name;
+    EXPECT_EQ(env->spec().max_episode_steps, 1000) << name;
+  }
+}
+
+TEST(EnvRegistryTest, EveryRegisteredEnvStepsWithFiniteValues) {
+  for (const std::string& name : RegisteredEnvironments()) {
+    const auto env = Make(name);
+    ASSERT_NE(env, nullptr) << name;
+    const EnvSpec& spec = env->spec();
+    EXPECT_EQ(spec.action_low.size(), static_cast<size_t>(spec.action_size));
+    EXPECT_GT(spec.control_dt, 0.0);
+    StepResult last;
+    for (const auto& observation : Episode(*env, 3, 200, &last)) {
+      ASSERT_EQ(observation.size(), static_cast<size_t>(spec.observation_size));
+      for (double value : observation)
+        ASSERT_TRUE(std::isfinite(value)) << name;
+    }
+    EXPECT_TRUE(std::isfinite(last.reward)) << name;
+  }
+}
+
+TEST(EnvRegistryTest, SameSeedSameEpisodeOtherSeedOther) {
+  for (const std::string& name : RegisteredEnvironments()) {
+    const auto a = Make(name);
+    const auto b = Make(name);
+    StepResult last;
+    const auto first = Episode(*a, 11, 50, &last);
+    EXPECT_EQ(first, Episode(*b, 11, 50, &last)) << name;
+    EXPECT_NE(first, Episode(*b, 12, 50, &last)) << name;
+  }
+}
+
+TEST(EnvRegistryTest, TimeLimitTruncatesWithTheFinalObservation) {
+  const auto env = Make("HalfCheetah");  // never terminates
+  StepResult last;
+  const auto seen = Episode(*env, 5, 2000, &last);
+  EXPECT_EQ(seen.size(), 1001u);
+  EXPECT_TRUE(last.truncated);
+  EXPECT_FALSE(last.terminated);
+  std::vector<double> observation(17);
+  const std::vector<double> action(6, 0.0);
+  absl::StatusOr<StepResult> after =
+      env->Step(action, absl::MakeSpan(observation));
+  EXPECT_EQ(after.status().code(), absl::StatusCode::kFailedPrecondition);
+  // The observation Step wrote with truncated set is the final one; the
+  // next episode starts elsewhere.
+  EXPECT_TRUE(env->Reset(6, absl::MakeSpan(observation)).ok());
+  EXPECT_NE(observation, seen.back());
+}
+
+TEST(EnvRegistryTest, FallingBodiesTerminate) {
+  for (const char* name :
+       {"Hopper", "Walker2d", "InvertedPendulum", "InvertedDoublePendulum"}) {
+    const auto env = Make(name);
+    std::vector<double> observation(env->spec().observation_size);
+    ASSERT_TRUE(env->Reset(1, absl::MakeSpan(observation)).ok());
+    // Full torque on every actuator tips every one of them over.
+    const std::vector<double> action(env->spec().action_size, 1.0);
+    int steps = 0;
+    StepResult result;
+    while (steps < 1000) {
+      absl::StatusOr<StepResult> stepped =
+          env->Step(action, absl::MakeSpan(observation));
+      ASSERT_TRUE(stepped.ok()) << stepped.status();
+      result = *stepped;
+      ++steps;
+      if (result.terminated || result.truncated) break;
+    }
+    EXPECT_TRUE(result.terminated) << name;
+    EXPECT_FALSE(result.truncated) << name;
+    EXPECT_LT(steps, 1000) << name;
+  }
+}
+
+TEST(EnvRegistryTest, ActionsAreClippedToTheirBounds) {
+  const auto clipped = Make("HalfCheetah");
+  const auto bounded = Make("HalfCheetah");
+  std::vector<double> a(17), b(17);
+  ASSERT_TRUE(clipped->Reset(2, absl::MakeSpan(a)).ok());
+  ASSERT_TRUE(bounded->Reset(2, absl::MakeSpan(b)).ok());
+  const std::vector<double> huge = {5, -7, 100, -1e9, 2, 1.5};
+  const std::vector<double> edge = {1, -1, 1, -1, 1, 1};
+  absl::StatusOr<StepResult> x = clipped->Step(huge, absl::MakeSpan(a));
+  absl::StatusOr<StepResult> y = bounded->Step(edge, absl::MakeSpan(b));
+  ASSERT_TRUE(x.ok() && y.ok());
+  EXPECT_EQ(a, b);
+  EXPECT_EQ(x->reward, y->reward);  // the control cost uses clipped actions
+}
+
+TEST(EnvRegistryTest, BadActionsAreRefusedAndTheEpisodeGoesOn) {
+  const auto env = Make("Hopper");
+  std::vector<double> observation(11);
+  ASSERT_TRUE(env->Reset(4, absl::MakeSpan(observation)).ok());
+  const std::vector<double> before = observation;
+  absl::StatusOr<StepResult> nan =
+      env->Step({0.1, std::nan(""), 0.0}, absl::MakeSpan(observation));
+  EXPECT_EQ(nan.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(nan.status().message(), HasSubstr("action[1] is not finite"));
+  EXPECT_EQ(observation, before);
+  absl::StatusOr<StepResult> short_action =
+      env->Step({0.1, 0.2}, absl::MakeSpan(observation));
+  EXPECT_THAT(short_action.status().message(),
+              HasSubstr("action has 2 values, expected 3"));
+  EXPECT_TRUE(env->Step({0.1, 0.2, 0.3}, absl::MakeSpan(observation)).ok());
+}
+
+TEST(EnvRegistryTest, UnknownNameListsTheRegisteredOnes) {
+  absl::StatusOr<std::unique_ptr<Environment>> env =
+      MakeEnvironment("HalfCheeta");
+  ASSERT_FALSE(env.ok());
+  EXPECT_THAT(env.status().message(), HasSubstr("unknown environment"));
+  EXPECT_THAT(env.status().message(), HasSubstr("HalfCheetah, Hopper"));
+  EXPECT_THAT(env.status().message(), HasSubstr("mjcf:"));
+}
+
+TEST(MujocoGuardTest, MujocoErrorsBecomeStatuses) {
+  const absl::Status status = GuardMujoco([] { mju_error("boom"); });
+  EXPECT_EQ(status.code(), absl::StatusCode::kInternal);
+  EXPECT_THAT(status.message(), HasSubstr("boom"));
+}
+
+// ---------------------------------------------------------------------------
+// mjcf:PATH
+
+class MjcfEnvTest : public ::testing::Test {
+ protected:
+  std::string Write(const std::string& name, const std::string& xml) {
+    const std::string path =
+        absl::StrCat(::testing::TempDir(), "/vantage_mjcf_", name, ".xml");
+    std::ofstream(path) << xml;
+    return path;
+  }
+};
+
+// A sliding, hopping box with a motor on each axis.
+std::string BoxModel(const std::string& custom) {
+  return absl::StrCat(R"xml(
+<mujoco model="box">
+  <option timestep="0.01"/>
+  <custom>)xml",
+                      custom, R"xml(</custom>
+  <worldbody>
+    <geom name="floor" type="plane" size="10 10 1"/>
+    <body name="box" pos="0 0 0.5">
+      <joint name="x" type="slide" axis="1 0 0"/>
+      <joint name="z" type="slide" axis="0 0 1"/>
+      <geom type="box" size="0.1 0.1 0.1" mass="1"/>
+    </body>
+  </worldbody>
+  <actuator>
+    <motor joint="x" gear="10" ctrllimited="true" ctrlrange="-1 1"/>
+    <motor joint="z" gear="40" ctrllimited="true" ctrlrange="-1 1"/>
+  </actuator>
+</mujoco>)xml");
+}
+
+TEST_F(MjcfEnvTest, CustomBlockDefinesTheTask) {
+  const std::string path = Write("good", BoxModel(R"xml(
+    <text name="vantage_forward_body" data="box"/>
+    <numeric name="vantage_forward_weight" data="2"/>
+    <numeric name="vantage_ctrl_cost" data="0.5"/>
+    <numeric name="vantage_alive_bonus" data="1"/>
+    <numeric name="vantage_healthy_z" data="0.05 1.0"/>
+    <numeric name="vantage_frame_skip" data="2"/>
+    <numeric name="vantage_max_steps" data="50"/>)xml"));
+  const auto env = Make("mjcf:" + path);
+  ASSERT_NE(env, nullptr);
+  const EnvSpec& spec = env->spec();
+  EXPECT_EQ(spec.observation_size, 4);  // qpos 2 + qvel 2
+  EXPECT_EQ(spec.action_size, 2);
+  EXPECT_EQ(spec.max_episode_steps, 50);
+  EXPECT_DOUBLE_EQ(spec.control_dt, 0.02);
+  std::vector<double> observation(4);
+  ASSERT_TRUE(env->Reset(0, absl::MakeSpan(observation)).ok());
+  // Pushing forward only: reward = 2 * (dx / dt) + 1 - 0.5 * 1^2.
+  const double x_before = observation[0];
+  absl::StatusOr<StepResult> step =
+      env->Step({1.0, 0.0}, absl::MakeSpan(observation));
+  ASSERT_TRUE(step.ok()) << step.status();
+  const double velocity = (observation[0] - x_before) / 0.02;
+  EXPECT_GT(velocity, 0.0);
+  EXPECT_NEAR(step->reward, 2.0 * velocity + 1.0 - 0.5, 1e-9);
+  // Full upward thrust lifts the box above 1.0: unhealthy, terminated.
+  bool terminated = false;
+  for (int t = 0; t < 49 && !terminated; ++t) {
+    absl::StatusOr<StepResult> up =
+        env->Step({0.0, 1.0}, absl::MakeSpan(observation));
+    ASSERT_TRUE(up.ok());
+    terminated = up->terminated;
+  }
+  EXPECT_TRUE(terminated);
+}
+
+TEST_F(MjcfEnvTest, BadCustomEntriesAreNamed) {
+  const std::map<std::string, std::string> cases = {
+      {R"(<numeric name="vantage_speed" data="1"/>)", "'vantage_speed'"},
+      {R"(<numeric name="vantage_frame_skip" data="0.5"/>)",
+       "'vantage_frame_skip' needs a whole number"},
+      {R"(<numeric name="vantage_ctrl_cost" data="-1"/>)",
+       "'vantage_ctrl_cost' must be >= 0"},
+      {R"(<numeric name="vantage_healthy_z" data="1"/>)",
+       "'vantage_healthy_z' needs two numbers"},
+      {R"(<text name="vantage_forward_body" data="wheel"/>)",
+       "names body 'wheel'"},
+      {R"(<numeric name="vantage_healthy_z" data="0 1"/>)",
+       "needs vantage_forward_body"},
+  };
+  int i = 0;
+  for (const auto& [custom, message] : cases) {
+    const std::string path = Write(absl::StrCat("bad", i++), BoxModel(custom));
+    absl::StatusOr<std::unique_ptr<Environment>> env =
+        MakeEnvironment("mjcf:" + path);
+    ASSERT_FALSE(env.ok()) << custom;
+    EXPECT_EQ(env.status().code(), absl::StatusCode::kInvalidArgument);
+    EXPECT_THAT(env.status().message(), HasSubstr(message)) << custom;
+  }
+}
+
+TEST_F(MjcfEnvTest, BrokenOrMissingModelsAreErrors) {
+  const std::string broken = Write("broken", "<mujoco><worldbody><body>");
+  absl::StatusOr<std::unique_ptr<Environment>> env =
+      MakeEnvironment("mjcf:" + broken);
+  ASSERT_FALSE(env.ok());
+  EXPECT_THAT(env.status().message(), HasSubstr("cannot load MJCF"));
+  env = MakeEnvironment("mjcf:/nonexistent/model.xml");
+  ASSERT_FALSE(env.ok());
+  EXPECT_THAT(env.status().message(), HasSubstr("/nonexistent/model.xml"));
+  EXPECT_FALSE(MakeEnvironment("mjcf:").ok());
+}
+
+}  // namespace
+}  // namespace vantage

@@ -1,0 +1,51 @@
+#include "tests/deploy/cli/run_vantage.h"
+
+#include <sys/wait.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+
+#include "absl/strings/str_cat.h"
+#include "gtest/gtest.h"
+
+namespace vantage {
+
+std::string ReadFile(const std::string& path) {
+  std::ifstream file(path);
+  std::stringstream contents;
+  contents << file.rdbuf();
+  return contents.str();
+}
+
+std::string TempPath(const std::string& name) {
+  static int counter = 0;
+  return absl::StrCat(
+      ::testing::TempDir(), "/vantage_",
+      ::testing::UnitTest::GetInstance()->current_test_info()->name(), "_",
+      counter++, "_", name);
+}
+
+std::string WriteTemp(const std::string& name, const std::string& text) {
+  const std::string path = TempPath(name);
+  std::ofstream(path) << text;
+  return path;
+}
+
+Outcome RunVantage(const std::string& args) {
+  const std::string out = TempPath("stdout.txt");
+  const std::string err = TempPath("stderr.txt");
+  const std::string command =
+      absl::StrCat(VANTAGE_BINARY, " ", args, " >", out, " 2>", err);
+  const int status = std::system(command.c_str());
+  Outcome outcome;
+  outcome.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  outcome.out = ReadFile(out);
+  outcome.err = ReadFile(err);
+  std::remove(out.c_str());
+  std::remove(err.c_str());
+  return outcome;
+}
+
+}  // namespace vantage

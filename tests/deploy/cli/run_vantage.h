@@ -1,0 +1,29 @@
+#ifndef VANTAGE_TESTS_DEPLOY_CLI_RUN_VANTAGE_H_
+#define VANTAGE_TESTS_DEPLOY_CLI_RUN_VANTAGE_H_
+
+// Runs the real `vantage` binary (path compiled in as VANTAGE_BINARY), as a
+// user would.
+
+#include <string>
+
+namespace vantage {
+
+struct Outcome {
+  int exit_code = -1;
+  std::string out;
+  std::string err;
+};
+
+// `vantage <args>` through the shell; stdout and stderr captured.
+Outcome RunVantage(const std::string& args);
+
+std::string ReadFile(const std::string& path);
+
+// ctest runs tests as parallel processes: every path gets the running
+// test's name and a counter so that none share one.
+std::string TempPath(const std::string& name);
+std::string WriteTemp(const std::string& name, const std::string& text);
+
+}  // namespace vantage
+
+#endif  // VANTAGE_TESTS_DEPLOY_CLI_RUN_VANTAGE_H_
