@@ -12,36 +12,13 @@
 #include <vector>
 
 #include "absl/strings/str_cat.h"
+#include "bench/fastest.h"
 #include "common/advantage/advantage.h"
 #include "common/advantage/advantage_config.h"
 #include "common/advantage/estimator_kernels_isa.h"
 
 namespace vantage {
 namespace {
-
-// Records the fastest repetition per benchmark while printing as usual: on
-// a shared machine interference only ever adds time, so the minimum is the
-// most repeatable estimate of the code's own cost.
-class FastestCollector : public benchmark::ConsoleReporter {
- public:
-  void ReportRuns(const std::vector<Run>& runs) override {
-    for (const Run& run : runs) {
-      if (run.run_type == Run::RT_Aggregate && run.aggregate_name == "min") {
-        seconds_[run.run_name.function_name] =
-            run.GetAdjustedRealTime() /
-            benchmark::GetTimeUnitMultiplier(run.time_unit);
-      }
-    }
-    ConsoleReporter::ReportRuns(runs);
-  }
-  double Seconds(const std::string& name) const {
-    auto it = seconds_.find(name);
-    return it == seconds_.end() ? -1.0 : it->second;
-  }
-
- private:
-  std::map<std::string, double> seconds_;
-};
 
 // A float32 rollout like the learner's: Gaussian rewards and values, about
 // one termination per 500 steps and one truncation per 1000.
@@ -72,18 +49,7 @@ int RunAdvantageBenchmark(int64_t steps, int64_t streams) {
   const double gamma = 0.99;
   const double lambda = 0.95;
 
-  const auto configure = [](benchmark::internal::Benchmark* b) {
-    // Many short repetitions: the fastest lands in a quiet moment.
-    b->MinTime(0.05)
-        ->Repetitions(30)
-        ->ReportAggregatesOnly(true)
-        ->ComputeStatistics("min",
-                            [](const std::vector<double>& times) {
-                              return *std::min_element(times.begin(),
-                                                       times.end());
-                            })
-        ->Unit(benchmark::kMicrosecond);
-  };
+  const auto configure = UseFastestOfRepetitions;
   configure(benchmark::RegisterBenchmark("gae", [&](benchmark::State& state) {
     for (auto _ : state) {
       benchmark::DoNotOptimize(ComputeGae(inputs, gamma, lambda));

@@ -21,6 +21,8 @@ class TimeLimit : public Environment {
                                   absl::Span<double> observation) override;
 
   int64_t elapsed_steps() const { return elapsed_steps_; }
+  // The wrapped environment (benchmarks reach the physics through it).
+  const Environment& inner() const { return *inner_; }
 
  private:
   std::unique_ptr<Environment> inner_;

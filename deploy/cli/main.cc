@@ -13,6 +13,7 @@
 #include "absl/flags/usage.h"
 #include "absl/strings/str_join.h"
 #include "bench/advantage_bench.h"
+#include "bench/env_bench.h"
 #include "deploy/cli/advantages_command.h"
 #include "deploy/cli/env_commands.h"
 
@@ -21,7 +22,8 @@ ABSL_FLAG(std::string, input, "",
 ABSL_FLAG(bool, example, false,
           "advantages: print every estimator on a built-in rollout");
 ABSL_FLAG(std::string, env, "",
-          "rollout: environment name (see `vantage envs`) or mjcf:PATH");
+          "rollout, bench env: environment name (see `vantage envs`) or "
+          "mjcf:PATH");
 ABSL_FLAG(int64_t, episodes, 10, "rollout: number of episodes");
 ABSL_FLAG(uint64_t, seed, 0, "rollout: random seed");
 ABSL_FLAG(int64_t, bench_steps, 2048, "bench advantages: rollout length T");
@@ -79,6 +81,7 @@ int RunBench(const std::vector<std::string>& args) {
          }
          return RunAdvantageBenchmark(steps, streams);
        }},
+      {"env", [] { return RunEnvBenchmark(absl::GetFlag(FLAGS_env)); }},
   };
   std::vector<std::string> names;
   for (const auto& entry : benchmarks) names.push_back(entry.first);
@@ -127,7 +130,8 @@ int main(int argc, char** argv) {
       "  advantages --example           every estimator on a built-in rollout\n"
       "  envs                           registered environments\n"
       "  rollout --env=NAME --episodes=N --seed=S   random-policy episodes\n"
-      "  bench advantages               path ensemble vs GAE benchmark\n");
+      "  bench advantages               path ensemble vs GAE benchmark\n"
+      "  bench env --env=NAME           env layer vs raw physics benchmark\n");
   const std::vector<char*> positional = absl::ParseCommandLine(argc, argv);
   if (positional.size() < 2) {
     std::fprintf(stderr, "%s", absl::ProgramUsageMessage().data());

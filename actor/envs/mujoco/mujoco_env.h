@@ -21,6 +21,8 @@ class MujocoEnv : public Environment {
 
   const mjModel* model() const { return model_.get(); }
   const mjData* data() const { return data_.get(); }
+  // Physics steps per environment step.
+  int frame_skip() const { return frame_skip_; }
 
  protected:
   // `spec` needs name, observation_size and max_episode_steps; the action
@@ -37,7 +39,6 @@ class MujocoEnv : public Environment {
   virtual void Observe(double* observation) const = 0;
 
   mjData* mutable_data() { return data_.get(); }
-  int frame_skip() const { return frame_skip_; }
 
   // qpos/qvel noise helpers used by most tasks' ResetState.
   void AddUniformNoise(std::mt19937_64& rng, double scale, double* values,

@@ -1,0 +1,18 @@
+#ifndef VANTAGE_BENCH_ENV_BENCH_H_
+#define VANTAGE_BENCH_ENV_BENCH_H_
+
+#include <string>
+
+namespace vantage {
+
+// `vantage bench env --env=NAME`: on one core, env steps per second of
+// bare mj_step on the same model (frame skip included, fixed actions), of
+// the environment through the interface (time limit and resets included)
+// and of a 16-env VectorEnv; ends with `RESULT env name=NAME
+// raw_steps_per_s=<x> env_steps_per_s=<y> vec16_steps_per_s=<z>
+// ratio=<vec16/raw>`. Returns the exit code.
+int RunEnvBenchmark(const std::string& env_name);
+
+}  // namespace vantage
+
+#endif  // VANTAGE_BENCH_ENV_BENCH_H_

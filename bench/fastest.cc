@@ -1,0 +1,35 @@
+#include "bench/fastest.h"
+
+#include <algorithm>
+
+namespace vantage {
+
+void UseFastestOfRepetitions(benchmark::internal::Benchmark* benchmark) {
+  benchmark->MinTime(0.05)
+      ->Repetitions(30)
+      ->ReportAggregatesOnly(true)
+      ->ComputeStatistics("min",
+                          [](const std::vector<double>& times) {
+                            return *std::min_element(times.begin(),
+                                                     times.end());
+                          })
+      ->Unit(benchmark::kMicrosecond);
+}
+
+void FastestCollector::ReportRuns(const std::vector<Run>& runs) {
+  for (const Run& run : runs) {
+    if (run.run_type == Run::RT_Aggregate && run.aggregate_name == "min") {
+      seconds_[run.run_name.function_name] =
+          run.GetAdjustedRealTime() /
+          benchmark::GetTimeUnitMultiplier(run.time_unit);
+    }
+  }
+  ConsoleReporter::ReportRuns(runs);
+}
+
+double FastestCollector::Seconds(const std::string& name) const {
+  auto it = seconds_.find(name);
+  return it == seconds_.end() ? -1.0 : it->second;
+}
+
+}  // namespace vantage

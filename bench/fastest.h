@@ -1,0 +1,35 @@
+#ifndef VANTAGE_BENCH_FASTEST_H_
+#define VANTAGE_BENCH_FASTEST_H_
+
+// How every vantage benchmark measures on a shared, noisy machine: many
+// short repetitions, interleaved across benchmarks (the default the
+// `vantage` tool sets), and the fastest one kept, since interference only
+// ever adds time.
+
+#include <benchmark/benchmark.h>
+
+#include <map>
+#include <string>
+#include <vector>
+
+namespace vantage {
+
+// 30 repetitions of at least 0.05 s each, reported as aggregates with a
+// "min" statistic.
+void UseFastestOfRepetitions(benchmark::internal::Benchmark* benchmark);
+
+// Prints as the console reporter does and records each benchmark's fastest
+// repetition (seconds per iteration).
+class FastestCollector : public benchmark::ConsoleReporter {
+ public:
+  void ReportRuns(const std::vector<Run>& runs) override;
+  // -1 if the benchmark did not run.
+  double Seconds(const std::string& name) const;
+
+ private:
+  std::map<std::string, double> seconds_;
+};
+
+}  // namespace vantage
+
+#endif  // VANTAGE_BENCH_FASTEST_H_
