@@ -9,7 +9,9 @@
 #include "absl/strings/str_join.h"
 #include "absl/strings/strip.h"
 #include "actor/envs/mujoco/gym_tasks.h"
+#include "actor/envs/mujoco/humanoid_env.h"
 #include "actor/envs/mujoco/pendulum_envs.h"
+#include "actor/envs/mujoco/point_maze_env.h"
 #include "common/env/time_limit.h"
 
 namespace vantage {
@@ -22,8 +24,10 @@ const std::map<std::string, Factory>& Factories() {
       {"Ant", MakeAnt},
       {"HalfCheetah", MakeHalfCheetah},
       {"Hopper", MakeHopper},
+      {"Humanoid", MakeHumanoid},
       {"InvertedDoublePendulum", MakeInvertedDoublePendulum},
       {"InvertedPendulum", MakeInvertedPendulum},
+      {"PointMaze", MakePointMaze},
       {"SparseHalfCheetah", MakeSparseHalfCheetah},
       {"Walker2d", MakeWalker2d},
   };

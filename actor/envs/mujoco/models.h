@@ -13,6 +13,8 @@ extern const char kHalfCheetahXml[];
 extern const char kHopperXml[];
 extern const char kWalker2dXml[];
 extern const char kAntXml[];
+extern const char kHumanoidXml[];
+extern const char kPointMazeXml[];
 
 }  // namespace vantage
 

@@ -53,16 +53,18 @@ std::vector<std::vector<double>> Episode(Environment& env, uint64_t seed,
 
 TEST(EnvRegistryTest, SpecsMatchTheGymnasiumTasks) {
   const std::map<std::string, std::pair<int, int>> expected = {
-      {"HalfCheetah", {17, 6}},      {"Hopper", {11, 3}},
-      {"Walker2d", {17, 6}},         {"Ant", {27, 8}},
-      {"InvertedPendulum", {4, 1}},  {"InvertedDoublePendulum", {11, 1}},
-      {"SparseHalfCheetah", {17, 6}}};
+      {"HalfCheetah", {17, 6}},       {"Hopper", {11, 3}},
+      {"Walker2d", {17, 6}},          {"Ant", {27, 8}},
+      {"InvertedPendulum", {4, 1}},   {"InvertedDoublePendulum", {11, 1}},
+      {"SparseHalfCheetah", {17, 6}}, {"Humanoid", {376, 17}},
+      {"PointMaze", {4, 2}}};
   for (const auto& [name, sizes] : expected) {
     const auto env = Make(name);
     ASSERT_NE(env, nullptr);
     EXPECT_EQ(env->spec().observation_size, sizes.first) << name;
     EXPECT_EQ(env->spec().action_size, sizes.second) << name;
-    EXPECT_EQ(env->spec().max_episode_steps, 1000) << name;
+    EXPECT_EQ(env->spec().max_episode_steps, name == "PointMaze" ? 500 : 1000)
+        << name;
   }
 }
 
@@ -133,6 +135,51 @@ TEST(EnvRegistryTest, FallingBodiesTerminate) {
     EXPECT_TRUE(result.terminated) << name;
     EXPECT_FALSE(result.truncated) << name;
     EXPECT_LT(steps, 1000) << name;
+  }
+}
+
+// Sparse tasks: a random policy earns nothing, a purposeful one does.
+TEST(EnvRegistryTest, PointMazeRewardsOnlyTheGoal) {
+  const auto env = Make("PointMaze");
+  std::vector<double> observation(4);
+  int random_successes = 0;
+  for (uint64_t episode = 0; episode < 50; ++episode) {
+    StepResult last;
+    Episode(*env, episode, 600, &last);
+    random_successes += last.terminated;
+  }
+  EXPECT_EQ(random_successes, 0);
+  // Steering through the waypoints round the wall reaches the goal.
+  ASSERT_TRUE(env->Reset(0, absl::MakeSpan(observation)).ok());
+  const double waypoints[3][2] = {{1.5, -1.5}, {1.5, 1.5}, {-1.5, 1.5}};
+  int target = 0;
+  double total = 0.0;
+  StepResult result;
+  for (int t = 0; t < 500; ++t) {
+    const double dx = waypoints[target][0] - observation[0];
+    const double dy = waypoints[target][1] - observation[1];
+    if (target < 2 && std::hypot(dx, dy) < 0.3) ++target;
+    const std::vector<double> action = {3 * dx - observation[2],
+                                        3 * dy - observation[3]};
+    result = *env->Step(action, absl::MakeSpan(observation));
+    total += result.reward;
+    if (result.terminated || result.truncated) break;
+  }
+  EXPECT_TRUE(result.terminated);
+  EXPECT_EQ(total, 1.0);
+}
+
+TEST(EnvRegistryTest, SparseHalfCheetahIsSilentNearTheStart) {
+  const auto env = Make("SparseHalfCheetah");
+  StepResult last;
+  std::mt19937_64 rng(1);
+  std::vector<double> observation(17);
+  ASSERT_TRUE(env->Reset(1, absl::MakeSpan(observation)).ok());
+  for (int t = 0; t < 200; ++t) {
+    absl::StatusOr<StepResult> result =
+        env->Step(RandomAction(env->spec(), rng), absl::MakeSpan(observation));
+    ASSERT_TRUE(result.ok());
+    EXPECT_EQ(result->reward, 0.0);
   }
 }
 
