@@ -138,6 +138,22 @@ TEST(EnvRegistryTest, FallingBodiesTerminate) {
   }
 }
 
+// The Ant's height rule: random flailing bounces the torso out of (0.2, 1)
+// within a few hundred steps.
+TEST(EnvRegistryTest, AntLeavingItsHeightRangeTerminates) {
+  const auto env = Make("Ant");
+  int terminated = 0;
+  for (uint64_t seed = 0; seed < 5; ++seed) {
+    StepResult last;
+    const auto seen = Episode(*env, seed, 1000, &last);
+    if (last.terminated) {
+      ++terminated;
+      EXPECT_LT(seen.size(), 1001u);
+    }
+  }
+  EXPECT_GE(terminated, 3);
+}
+
 // Sparse tasks: a random policy earns nothing, a purposeful one does.
 TEST(EnvRegistryTest, PointMazeRewardsOnlyTheGoal) {
   const auto env = Make("PointMaze");
