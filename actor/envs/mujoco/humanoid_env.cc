@@ -65,19 +65,17 @@ class Humanoid : public MujocoEnv {
 }  // namespace
 
 absl::StatusOr<std::unique_ptr<Environment>> MakeHumanoid() {
-  absl::StatusOr<MjModelPtr> model =
-      LoadModelFromString("Humanoid", kHumanoidXml);
-  if (!model.ok()) return model.status();
-  absl::StatusOr<MjDataPtr> data = MakeData(model->get());
-  if (!data.ok()) return data.status();
-  const mjModel* m = model->get();
+  absl::StatusOr<LoadedModel> loaded =
+      LoadModelAndData("Humanoid", kHumanoidXml);
+  if (!loaded.ok()) return loaded.status();
+  const mjModel* m = loaded->model.get();
   EnvSpec spec;
   spec.name = "Humanoid";
   spec.observation_size =
       (m->nq - 2) + m->nv + 10 * m->nbody + 6 * m->nbody + m->nv + 6 * m->nbody;
   spec.max_episode_steps = 1000;
-  return std::unique_ptr<Environment>(
-      new Humanoid(std::move(spec), std::move(*model), std::move(*data)));
+  return std::unique_ptr<Environment>(new Humanoid(
+      std::move(spec), std::move(loaded->model), std::move(loaded->data)));
 }
 
 }  // namespace vantage

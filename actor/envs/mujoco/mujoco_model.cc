@@ -4,6 +4,7 @@
 #include <mutex>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 #include "absl/strings/str_cat.h"
 
@@ -90,6 +91,15 @@ absl::StatusOr<MjDataPtr> MakeData(const mjModel* model) {
   if (data == nullptr)
     return absl::ResourceExhaustedError("mj_makeData failed");
   return MjDataPtr(data);
+}
+
+absl::StatusOr<LoadedModel> LoadModelAndData(absl::string_view name,
+                                             absl::string_view xml) {
+  absl::StatusOr<MjModelPtr> model = LoadModelFromString(name, xml);
+  if (!model.ok()) return model.status();
+  absl::StatusOr<MjDataPtr> data = MakeData(model->get());
+  if (!data.ok()) return data.status();
+  return LoadedModel{std::move(*model), std::move(*data)};
 }
 
 }  // namespace vantage

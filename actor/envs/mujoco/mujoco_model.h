@@ -35,6 +35,14 @@ absl::StatusOr<MjModelPtr> LoadModelFromFile(const std::string& path);
 
 absl::StatusOr<MjDataPtr> MakeData(const mjModel* model);
 
+// A compiled built-in model with its data, ready for an environment.
+struct LoadedModel {
+  MjModelPtr model;
+  MjDataPtr data;
+};
+absl::StatusOr<LoadedModel> LoadModelAndData(absl::string_view name,
+                                             absl::string_view xml);
+
 // Runs `fn` with mju_user_error turned into an Internal error instead of
 // MuJoCo's default exit(); MuJoCo warnings are recorded, not printed.
 absl::Status GuardMujoco(absl::FunctionRef<void()> fn);

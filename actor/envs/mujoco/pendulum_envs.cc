@@ -85,16 +85,15 @@ absl::StatusOr<std::unique_ptr<Environment>> Build(const char* name,
                                                    const char* xml,
                                                    int64_t observation_size,
                                                    Args... args) {
-  absl::StatusOr<MjModelPtr> model = LoadModelFromString(name, xml);
-  if (!model.ok()) return model.status();
-  absl::StatusOr<MjDataPtr> data = MakeData(model->get());
-  if (!data.ok()) return data.status();
+  absl::StatusOr<LoadedModel> loaded = LoadModelAndData(name, xml);
+  if (!loaded.ok()) return loaded.status();
   EnvSpec spec;
   spec.name = name;
   spec.observation_size = observation_size;
   spec.max_episode_steps = 1000;
   return std::unique_ptr<Environment>(
-      new Env(std::move(spec), std::move(*model), std::move(*data), args...));
+      new Env(std::move(spec), std::move(loaded->model),
+              std::move(loaded->data), args...));
 }
 
 }  // namespace

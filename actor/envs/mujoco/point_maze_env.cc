@@ -49,18 +49,17 @@ class PointMaze : public MujocoEnv {
 }  // namespace
 
 absl::StatusOr<std::unique_ptr<Environment>> MakePointMaze() {
-  absl::StatusOr<MjModelPtr> model =
-      LoadModelFromString("PointMaze", kPointMazeXml);
-  if (!model.ok()) return model.status();
-  absl::StatusOr<MjDataPtr> data = MakeData(model->get());
-  if (!data.ok()) return data.status();
-  const int point = mj_name2id(model->get(), mjOBJ_BODY, "point");
+  absl::StatusOr<LoadedModel> loaded =
+      LoadModelAndData("PointMaze", kPointMazeXml);
+  if (!loaded.ok()) return loaded.status();
+  const int point = mj_name2id(loaded->model.get(), mjOBJ_BODY, "point");
   EnvSpec spec;
   spec.name = "PointMaze";
   spec.observation_size = 4;
   spec.max_episode_steps = 500;
-  return std::unique_ptr<Environment>(new PointMaze(
-      std::move(spec), std::move(*model), std::move(*data), point));
+  return std::unique_ptr<Environment>(
+      new PointMaze(std::move(spec), std::move(loaded->model),
+                    std::move(loaded->data), point));
 }
 
 }  // namespace vantage
