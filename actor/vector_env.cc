@@ -70,6 +70,9 @@ absl::Status VectorEnv::Step(absl::Span<const double> actions) {
     absl::StatusOr<StepResult> result = envs_[i]->Step(
         actions.subspan(i * action_width_, action_width_), observation);
     if (!result.ok()) {
+      // Nothing stale may pass for this step's outcome.
+      rewards_[i] = 0.0;
+      terminated_[i] = truncated_[i] = 0;
       if (first_error.ok()) {
         first_error = absl::Status(
             result.status().code(),

@@ -37,8 +37,10 @@ class VectorEnv {
   int size() const { return static_cast<int>(envs_.size()); }
 
   absl::Status Reset();
-  // actions: [size, action values]. An error names the environment; the
-  // others have stepped and kept their results.
+  // actions: [size, action values]. An error names the (first) failing
+  // environment, whose reward and flags read 0 and whose episode goes on
+  // (or needs the reset the error asks for); the others have stepped and
+  // kept their results.
   absl::Status Step(absl::Span<const double> actions);
 
   absl::Span<const double> observations() const { return observations_; }
