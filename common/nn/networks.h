@@ -1,0 +1,80 @@
+#ifndef VANTAGE_COMMON_NN_NETWORKS_H_
+#define VANTAGE_COMMON_NN_NETWORKS_H_
+
+// The policy and value networks: tanh MLPs with orthogonal initialisation
+// (gain sqrt(2) for hidden layers, 0.01 for the policy's output, 1 for the
+// value's, zero biases), as in the baselines the paper builds on. A
+// continuous policy is a Gaussian with a state-independent log-std
+// (initially 0); a discrete one is categorical over logits.
+
+#include <torch/nn/module.h>
+#include <torch/nn/modules/container/modulelist.h>
+#include <torch/nn/modules/linear.h>
+
+#include <cstdint>
+#include <vector>
+
+#include "common/env/environment.h"
+
+namespace vantage {
+
+struct NetworkConfig {
+  std::vector<int64_t> hidden = {64, 64};
+};
+
+// Linear layers with tanh between them (none after the last).
+class TanhMlpImpl : public torch::nn::Module {
+ public:
+  TanhMlpImpl(int64_t inputs, const std::vector<int64_t>& hidden,
+              int64_t outputs, double output_gain);
+  at::Tensor forward(const at::Tensor& x);
+
+ private:
+  torch::nn::ModuleList layers_;
+};
+TORCH_MODULE(TanhMlp);
+
+class PolicyNetworkImpl : public torch::nn::Module {
+ public:
+  PolicyNetworkImpl(const EnvSpec& spec, const NetworkConfig& config);
+
+  // Means [B, k] (continuous) or logits [B, n] (discrete).
+  at::Tensor forward(const at::Tensor& observations);
+
+  // From forward()'s output: per-sample log-probabilities and entropies
+  // [B]. Discrete actions are indices stored as floats [B, 1] or [B].
+  at::Tensor LogProb(const at::Tensor& output, const at::Tensor& actions);
+  at::Tensor Entropy(const at::Tensor& output);
+  // KL(old || this) per sample from both policies' outputs.
+  at::Tensor Kl(const at::Tensor& old_output, const at::Tensor& old_log_std,
+                const at::Tensor& output);
+  // A sampled action [B, k] ([B, 1] indices as floats when discrete), or
+  // the mode when `deterministic`.
+  at::Tensor Act(const at::Tensor& output, bool deterministic,
+                 at::Generator generator);
+
+  bool discrete() const { return discrete_; }
+  // Undefined for discrete policies.
+  const at::Tensor& log_std() const { return log_std_; }
+
+ private:
+  bool discrete_;
+  TanhMlp body_{nullptr};
+  at::Tensor log_std_;
+};
+TORCH_MODULE(PolicyNetwork);
+
+class ValueNetworkImpl : public torch::nn::Module {
+ public:
+  ValueNetworkImpl(int64_t observation_size, const NetworkConfig& config);
+  // V(s) [B].
+  at::Tensor forward(const at::Tensor& observations);
+
+ private:
+  TanhMlp body_{nullptr};
+};
+TORCH_MODULE(ValueNetwork);
+
+}  // namespace vantage
+
+#endif  // VANTAGE_COMMON_NN_NETWORKS_H_
