@@ -17,8 +17,7 @@ class Humanoid : public MujocoEnv {
 
  protected:
   void ResetState(std::mt19937_64& rng) override {
-    AddUniformNoise(rng, 1e-2, mutable_data()->qpos, model()->nq);
-    AddUniformNoise(rng, 1e-2, mutable_data()->qvel, model()->nv);
+    PerturbState(rng, 1e-2, /*normal_qvel=*/false);
   }
 
   void BeforeStep() override { x_before_ = MassCenterX(); }

@@ -20,13 +20,7 @@ class LocomotionEnv : public MujocoEnv {
 
  protected:
   void ResetState(std::mt19937_64& rng) override {
-    mjData* d = mutable_data();
-    AddUniformNoise(rng, task_.reset_noise, d->qpos, model()->nq);
-    if (task_.normal_qvel_noise) {
-      AddNormalNoise(rng, task_.reset_noise, d->qvel, model()->nv);
-    } else {
-      AddUniformNoise(rng, task_.reset_noise, d->qvel, model()->nv);
-    }
+    PerturbState(rng, task_.reset_noise, task_.normal_qvel_noise);
   }
 
   void BeforeStep() override { x_before_ = ForwardX(); }

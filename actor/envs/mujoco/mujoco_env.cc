@@ -100,16 +100,15 @@ absl::StatusOr<StepResult> MujocoEnv::Step(absl::Span<const double> action,
   return result;
 }
 
-void MujocoEnv::AddUniformNoise(std::mt19937_64& rng, double scale,
-                                double* values, int count) {
-  std::uniform_real_distribution<double> noise(-scale, scale);
-  for (int i = 0; i < count; ++i) values[i] += noise(rng);
-}
-
-void MujocoEnv::AddNormalNoise(std::mt19937_64& rng, double scale,
-                               double* values, int count) {
-  std::normal_distribution<double> noise(0.0, 1.0);
-  for (int i = 0; i < count; ++i) values[i] += scale * noise(rng);
+void MujocoEnv::PerturbState(std::mt19937_64& rng, double scale,
+                             bool normal_qvel) {
+  mjData* d = data_.get();
+  std::uniform_real_distribution<double> uniform(-scale, scale);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  for (int i = 0; i < model_->nq; ++i) d->qpos[i] += uniform(rng);
+  for (int i = 0; i < model_->nv; ++i) {
+    d->qvel[i] += normal_qvel ? scale * normal(rng) : uniform(rng);
+  }
 }
 
 }  // namespace vantage

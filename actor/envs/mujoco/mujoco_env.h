@@ -40,11 +40,9 @@ class MujocoEnv : public Environment {
 
   mjData* mutable_data() { return data_.get(); }
 
-  // qpos/qvel noise helpers used by most tasks' ResetState.
-  void AddUniformNoise(std::mt19937_64& rng, double scale, double* values,
-                       int count);
-  void AddNormalNoise(std::mt19937_64& rng, double scale, double* values,
-                      int count);
+  // The usual ResetState: qpos += U(-scale, scale) and qvel +=
+  // U(-scale, scale) or, with normal_qvel, scale * N(0, 1).
+  void PerturbState(std::mt19937_64& rng, double scale, bool normal_qvel);
 
  private:
   EnvSpec spec_;

@@ -18,8 +18,7 @@ class InvertedPendulum : public MujocoEnv {
 
  protected:
   void ResetState(std::mt19937_64& rng) override {
-    AddUniformNoise(rng, 0.01, mutable_data()->qpos, model()->nq);
-    AddUniformNoise(rng, 0.01, mutable_data()->qvel, model()->nv);
+    PerturbState(rng, 0.01, /*normal_qvel=*/false);
   }
   StepResult Evaluate(absl::Span<const double>) override {
     StepResult result;
@@ -49,8 +48,7 @@ class InvertedDoublePendulum : public MujocoEnv {
 
  protected:
   void ResetState(std::mt19937_64& rng) override {
-    AddUniformNoise(rng, 0.1, mutable_data()->qpos, model()->nq);
-    AddNormalNoise(rng, 0.1, mutable_data()->qvel, model()->nv);
+    PerturbState(rng, 0.1, /*normal_qvel=*/true);
   }
   StepResult Evaluate(absl::Span<const double>) override {
     const mjData* d = data();

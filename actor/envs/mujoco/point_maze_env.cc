@@ -22,8 +22,7 @@ class PointMaze : public MujocoEnv {
 
  protected:
   void ResetState(std::mt19937_64& rng) override {
-    AddUniformNoise(rng, 0.1, mutable_data()->qpos, model()->nq);
-    AddUniformNoise(rng, 0.1, mutable_data()->qvel, model()->nv);
+    PerturbState(rng, 0.1, /*normal_qvel=*/false);
   }
 
   StepResult Evaluate(absl::Span<const double>) override {
