@@ -1,0 +1,71 @@
+#ifndef VANTAGE_ACTOR_ACTOR_CORE_H_
+#define VANTAGE_ACTOR_ACTOR_CORE_H_
+
+#include <ATen/core/Generator.h>
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "absl/status/status.h"
+#include "absl/status/statusor.h"
+#include "actor/vector_env.h"
+#include "common/nn/networks.h"
+#include "common/nn/policy_weights.h"
+#include "common/nn/running_mean_std.h"
+#include "common/rollout/segment_queue.h"
+
+namespace vantage {
+
+struct ActorConfig {
+  std::string env;
+  int num_envs = 1;
+  int64_t segment_length = 128;
+  uint64_t seed = 0;
+  int64_t actor_id = 0;
+  NetworkConfig network;
+  double observation_clip = 10.0;
+
+  absl::Status Validate() const;
+};
+
+// Runs the policy only: vectorised environments, batched inference with the
+// latest weights (the learner recomputes values itself), segments out.
+class ActorCore {
+ public:
+  static absl::StatusOr<std::unique_ptr<ActorCore>> Create(
+      const ActorConfig& config);
+
+  const EnvSpec& spec() const { return envs_->spec(); }
+  int64_t policy_version() const { return version_; }
+  int64_t env_steps() const { return env_steps_; }
+
+  // Takes effect from the next segment on.
+  absl::Status SetWeights(const PolicyWeights& weights);
+
+  // Steps every environment segment_length times and sends one segment per
+  // environment slot to `sink`. Acting needs weights from the learner
+  // first (FailedPrecondition otherwise), so every action comes from a
+  // published, reproducible policy version.
+  absl::Status CollectSegments(SegmentSink& sink);
+
+ private:
+  ActorCore(const ActorConfig& config, std::unique_ptr<VectorEnv> envs);
+  at::Tensor CurrentObservations() const;
+
+  const ActorConfig config_;
+  std::unique_ptr<VectorEnv> envs_;
+  PolicyNetwork policy_;
+  RunningMeanStd normalizer_;
+  at::Generator generator_;
+  int64_t version_ = 0;
+  bool has_weights_ = false;
+  int64_t env_steps_ = 0;
+  std::vector<int64_t> next_sequence_;
+  std::vector<double> actions_;
+};
+
+}  // namespace vantage
+
+#endif  // VANTAGE_ACTOR_ACTOR_CORE_H_

@@ -1,0 +1,124 @@
+#include "actor/actor_core.h"
+
+#include <ATen/ATen.h>
+
+#include "common/rollout/segment.h"
+#include "gmock/gmock.h"
+#include "gtest/gtest.h"
+
+namespace vantage {
+namespace {
+
+ActorConfig Config() {
+  ActorConfig config;
+  config.env = "InvertedPendulum";
+  config.num_envs = 3;
+  config.segment_length = 40;
+  config.seed = 5;
+  config.actor_id = 2;
+  config.network.hidden = {16};
+  return config;
+}
+
+// The weights of a learner's freshly initialised policy.
+PolicyWeights InitialWeights(const EnvSpec& spec, int64_t version) {
+  at::manual_seed(11);
+  PolicyNetwork policy(spec, Config().network);
+  return ExportPolicyWeights(*policy, RunningMeanStd(spec.observation_size),
+                             version);
+}
+
+std::unique_ptr<ActorCore> MakeActor() {
+  auto actor = std::move(*ActorCore::Create(Config()));
+  EXPECT_TRUE(actor->SetWeights(InitialWeights(actor->spec(), 0)).ok());
+  return actor;
+}
+
+std::vector<Segment> Collect(ActorCore& actor) {
+  SegmentQueue queue(16);
+  EXPECT_TRUE(actor.CollectSegments(queue).ok());
+  queue.Close();
+  std::vector<Segment> segments;
+  while (true) {
+    absl::StatusOr<Segment> s = queue.Receive();
+    if (!s.ok()) break;
+    segments.push_back(std::move(*s));
+  }
+  return segments;
+}
+
+TEST(ActorCoreTest, SegmentsAreValidAndNumberedPerSlot) {
+  auto actor = MakeActor();
+  for (int round = 0; round < 2; ++round) {
+    const std::vector<Segment> segments = Collect(*actor);
+    ASSERT_EQ(segments.size(), 3u);
+    for (int64_t i = 0; i < 3; ++i) {
+      const Segment& s = segments[i];
+      EXPECT_TRUE(ValidateSegment(s, actor->spec(), 40).ok());
+      EXPECT_EQ(s.actor_id, 2);
+      EXPECT_EQ(s.env_slot, i);
+      EXPECT_EQ(s.sequence, round);
+      EXPECT_EQ(s.steps(), 40);
+      // InvertedPendulum rewards 1 per step; its episodes end quickly.
+      EXPECT_TRUE(at::equal(s.rewards, at::ones({40})));
+      EXPECT_GT(s.terminated.sum().item<int64_t>(), 0);
+      EXPECT_EQ(s.episode_returns.size(),
+                static_cast<size_t>(s.terminated.sum().item<int64_t>()));
+    }
+  }
+  EXPECT_EQ(actor->env_steps(), 2 * 3 * 40);
+}
+
+TEST(ActorCoreTest, BehaviourLogProbsAreThoseOfTheActingWeights) {
+  auto actor = MakeActor();
+  // Publish weights (version 7) with a shifted normaliser.
+  PolicyNetwork reference(actor->spec(), Config().network);
+  RunningMeanStd normalizer(4);
+  ASSERT_TRUE(normalizer.Update(at::randn({50, 4}) * 0.1 + 0.3).ok());
+  const PolicyWeights weights = ExportPolicyWeights(*reference, normalizer, 7);
+  ASSERT_TRUE(actor->SetWeights(weights).ok());
+  const std::vector<Segment> segments = Collect(*actor);
+  for (const Segment& s : segments) {
+    EXPECT_EQ(s.policy_version, 7);
+    const at::Tensor observations = s.observations.slice(0, 0, 40);
+    const at::Tensor output =
+        reference->forward(normalizer.Normalize(observations, 10.0));
+    EXPECT_TRUE(at::allclose(reference->LogProb(output, s.actions),
+                             s.behaviour_log_probs, 1e-5, 1e-5));
+  }
+}
+
+TEST(ActorCoreTest, SameSeedSameSegments) {
+  auto a = MakeActor();
+  auto b = MakeActor();
+  const std::vector<Segment> first = Collect(*a);
+  const std::vector<Segment> second = Collect(*b);
+  for (size_t i = 0; i < first.size(); ++i) {
+    EXPECT_TRUE(at::equal(first[i].observations, second[i].observations));
+    EXPECT_TRUE(at::equal(first[i].actions, second[i].actions));
+  }
+}
+
+TEST(ActorCoreTest, BadConfigAndWeightsAreRefused) {
+  ActorConfig config = Config();
+  config.num_envs = 0;
+  EXPECT_FALSE(ActorCore::Create(config).ok());
+  config = Config();
+  config.env = "Nope";
+  EXPECT_FALSE(ActorCore::Create(config).ok());
+  auto actor = std::move(*ActorCore::Create(Config()));
+  SegmentQueue queue(4);
+  EXPECT_EQ(actor->CollectSegments(queue).code(),
+            absl::StatusCode::kFailedPrecondition);
+  PolicyNetwork other(actor->spec(), NetworkConfig{{8, 8}});
+  RunningMeanStd normalizer(4);
+  EXPECT_FALSE(
+      actor->SetWeights(ExportPolicyWeights(*other, normalizer, 1)).ok());
+  EXPECT_EQ(actor->policy_version(), 0);
+  PolicyWeights nan_weights = InitialWeights(actor->spec(), 3);
+  nan_weights.parameters.back().view({-1})[0] = NAN;
+  EXPECT_FALSE(actor->SetWeights(nan_weights).ok());
+}
+
+}  // namespace
+}  // namespace vantage
