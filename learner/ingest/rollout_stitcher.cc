@@ -1,0 +1,101 @@
+#include "learner/ingest/rollout_stitcher.h"
+
+#include <ATen/ATen.h>
+
+#include <memory>
+
+#include "absl/strings/str_cat.h"
+
+namespace vantage {
+
+RolloutStitcher::RolloutStitcher(int64_t horizon)
+    : horizon_(horizon < 1 ? 1 : horizon) {}
+
+absl::Status RolloutStitcher::Add(Segment segment) {
+  const int64_t actor_id = segment.actor_id;
+  const int64_t env_slot = segment.env_slot;
+  Stream& stream = streams_[{actor_id, env_slot}];
+  if (stream.started && segment.sequence < stream.next_sequence) {
+    ++stats_.stale_segments;
+    return absl::FailedPreconditionError(absl::StrCat(
+        "segment ", segment.sequence, " of actor ", segment.actor_id, " slot ",
+        segment.env_slot, " arrived after ", stream.next_sequence - 1));
+  }
+  if (stream.started && segment.sequence > stream.next_sequence) {
+    ++stats_.gaps;
+    stats_.dropped_steps += stream.steps;
+    stream.pieces.clear();
+    stream.steps = 0;
+  }
+  stream.started = true;
+  stream.next_sequence = segment.sequence + 1;
+  ++stats_.segments;
+  const int64_t steps = segment.steps();
+  stream.pieces.push_back(
+      {std::make_shared<const Segment>(std::move(segment)), 0, steps});
+  stream.steps += steps;
+  while (stream.steps >= horizon_) {
+    ready_.push_back(Cut(actor_id, env_slot, stream));
+    ++stats_.rollouts;
+  }
+  return absl::OkStatus();
+}
+
+Rollout RolloutStitcher::Cut(int64_t actor_id, int64_t env_slot,
+                             Stream& stream) {
+  std::vector<at::Tensor> observations, actions, rewards, terminated, truncated,
+      finals, log_probs, versions;
+  int64_t needed = horizon_;
+  at::Tensor next_observation;  // s_T: the observation after the last step
+  while (needed > 0) {
+    Piece& piece = stream.pieces.front();
+    const Segment& s = *piece.segment;
+    const int64_t take = std::min(needed, piece.end - piece.begin);
+    const int64_t b = piece.begin;
+    const int64_t e = b + take;
+    observations.push_back(s.observations.slice(0, b, e));
+    actions.push_back(s.actions.slice(0, b, e));
+    rewards.push_back(s.rewards.slice(0, b, e));
+    terminated.push_back(s.terminated.slice(0, b, e));
+    truncated.push_back(s.truncated.slice(0, b, e));
+    log_probs.push_back(s.behaviour_log_probs.slice(0, b, e));
+    versions.push_back(at::full({take}, s.policy_version, at::kLong));
+    // The final observations of the truncated steps in [b, e).
+    const int64_t before = s.truncated.slice(0, 0, b).sum().item<int64_t>();
+    const int64_t count = s.truncated.slice(0, b, e).sum().item<int64_t>();
+    finals.push_back(s.final_observations.slice(0, before, before + count));
+    // A slice shares the segment's storage, which outlives the piece.
+    next_observation = s.observations.slice(0, e, e + 1);
+    needed -= take;
+    stream.steps -= take;
+    piece.begin = e;
+    if (piece.begin == piece.end) stream.pieces.pop_front();
+  }
+  observations.push_back(next_observation);
+  Rollout rollout;
+  rollout.actor_id = actor_id;
+  rollout.env_slot = env_slot;
+  rollout.observations = at::cat(observations);
+  rollout.actions = at::cat(actions);
+  rollout.rewards = at::cat(rewards);
+  rollout.terminated = at::cat(terminated);
+  rollout.truncated = at::cat(truncated);
+  rollout.final_observations = at::cat(finals);
+  rollout.behaviour_log_probs = at::cat(log_probs);
+  rollout.policy_versions = at::cat(versions);
+  return rollout;
+}
+
+std::vector<Rollout> RolloutStitcher::TakeReady() {
+  std::vector<Rollout> ready = std::move(ready_);
+  ready_.clear();
+  return ready;
+}
+
+int64_t RolloutStitcher::buffered_steps() const {
+  int64_t steps = 0;
+  for (const auto& entry : streams_) steps += entry.second.steps;
+  return steps;
+}
+
+}  // namespace vantage

@@ -1,0 +1,83 @@
+#ifndef VANTAGE_LEARNER_INGEST_ROLLOUT_STITCHER_H_
+#define VANTAGE_LEARNER_INGEST_ROLLOUT_STITCHER_H_
+
+#include <ATen/core/Tensor.h>
+
+#include <cstdint>
+#include <deque>
+#include <map>
+#include <utility>
+#include <vector>
+
+#include "absl/status/status.h"
+#include "common/env/environment.h"
+#include "common/rollout/segment.h"
+
+namespace vantage {
+
+// `horizon` consecutive steps of one (actor, env slot) stream, stitched
+// across segment boundaries; episodes may end anywhere inside.
+struct Rollout {
+  int64_t actor_id = 0;
+  int64_t env_slot = 0;
+  at::Tensor observations;         // [T + 1, obs]; the last is s_T
+  at::Tensor actions;              // [T, act]
+  at::Tensor rewards;              // [T]
+  at::Tensor terminated;           // [T] bool
+  at::Tensor truncated;            // [T] bool
+  at::Tensor final_observations;   // [K, obs] for the K truncated steps
+  at::Tensor behaviour_log_probs;  // [T]
+  at::Tensor policy_versions;      // [T] int64: the version that acted
+};
+
+struct StitcherStats {
+  int64_t segments = 0;
+  int64_t rollouts = 0;
+  int64_t gaps = 0;            // a stream restarted (sequence jumped)
+  int64_t dropped_steps = 0;   // buffered steps discarded at gaps
+  int64_t stale_segments = 0;  // sequence at or below one already used
+};
+
+// Joins each stream's segments, in sequence order, into rollouts of exactly
+// `horizon` steps. Nothing is stitched across a sequence gap: the buffered
+// steps of the old stream are dropped and counted. Segments must have
+// passed ValidateSegment.
+class RolloutStitcher {
+ public:
+  explicit RolloutStitcher(int64_t horizon);
+
+  // FailedPrecondition (counted) for a segment whose sequence was already
+  // seen; the stream is unchanged.
+  absl::Status Add(Segment segment);
+
+  // The rollouts completed so far, oldest first.
+  std::vector<Rollout> TakeReady();
+
+  // Steps waiting in partial rollouts, over all streams.
+  int64_t buffered_steps() const;
+  const StitcherStats& stats() const { return stats_; }
+
+ private:
+  struct Piece {
+    std::shared_ptr<const Segment> segment;
+    int64_t begin = 0;
+    int64_t end = 0;
+  };
+  struct Stream {
+    int64_t next_sequence = 0;
+    bool started = false;
+    std::deque<Piece> pieces;
+    int64_t steps = 0;
+  };
+
+  Rollout Cut(int64_t actor_id, int64_t env_slot, Stream& stream);
+
+  const int64_t horizon_;
+  std::map<std::pair<int64_t, int64_t>, Stream> streams_;
+  std::vector<Rollout> ready_;
+  StitcherStats stats_;
+};
+
+}  // namespace vantage
+
+#endif  // VANTAGE_LEARNER_INGEST_ROLLOUT_STITCHER_H_
