@@ -1,0 +1,70 @@
+#include "learner/ingest/training_batch.h"
+
+#include <ATen/ATen.h>
+
+#include "absl/strings/str_cat.h"
+
+namespace vantage {
+
+absl::StatusOr<TrainingBatch> AssembleBatch(
+    const std::vector<Rollout>& rollouts,
+    absl::FunctionRef<at::Tensor(const at::Tensor&)> values_of) {
+  if (rollouts.empty()) {
+    return absl::InvalidArgumentError("a batch needs at least one rollout");
+  }
+  const int64_t steps = rollouts[0].rewards.size(0);
+  const int64_t n = static_cast<int64_t>(rollouts.size());
+  std::vector<at::Tensor> observations, finals;
+  for (const Rollout& rollout : rollouts) {
+    if (rollout.rewards.size(0) != steps) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("rollouts of ", rollout.rewards.size(0), " and ", steps,
+                       " steps cannot share a batch"));
+    }
+    observations.push_back(rollout.observations);
+    finals.push_back(rollout.final_observations);
+  }
+  // One critic pass: every rollout's T + 1 observations, then the finals.
+  const at::Tensor all_observations = at::cat(observations);
+  const at::Tensor all_finals = at::cat(finals);
+  const at::Tensor values =
+      values_of(at::cat({all_observations, all_finals})).to(at::kFloat);
+  const at::Tensor stream_values =
+      values.slice(0, 0, n * (steps + 1)).reshape({n, steps + 1}).t();
+  const at::Tensor final_values = values.slice(0, n * (steps + 1));
+
+  TrainingBatch batch;
+  AdvantageInputs& in = batch.advantage_inputs;
+  const auto stack = [&](auto field) {
+    std::vector<at::Tensor> columns;
+    for (const Rollout& rollout : rollouts) columns.push_back(field(rollout));
+    return at::stack(columns, 1);
+  };
+  in.rewards = stack([](const Rollout& r) { return r.rewards; });
+  in.terminated = stack([](const Rollout& r) { return r.terminated; });
+  in.truncated = stack([](const Rollout& r) { return r.truncated; });
+  in.values = stream_values.slice(0, 0, steps).contiguous();
+  in.last_values = stream_values[steps].contiguous();
+  // Scatter V(final observation) to the truncated steps, rollout by rollout
+  // in the order the finals were concatenated.
+  in.truncation_values = at::zeros({steps, n}, at::kFloat);
+  int64_t next_final = 0;
+  for (int64_t column = 0; column < n; ++column) {
+    const at::Tensor rows =
+        at::nonzero(rollouts[column].truncated).reshape({-1});
+    const int64_t k = rows.size(0);
+    in.truncation_values.select(1, column).index_put_(
+        {rows}, final_values.slice(0, next_final, next_final + k));
+    next_final += k;
+  }
+  batch.observations = stack(
+      [&](const Rollout& r) { return r.observations.slice(0, 0, steps); });
+  batch.actions = stack([](const Rollout& r) { return r.actions; });
+  batch.behaviour_log_probs =
+      stack([](const Rollout& r) { return r.behaviour_log_probs; });
+  batch.policy_versions =
+      stack([](const Rollout& r) { return r.policy_versions; });
+  return batch;
+}
+
+}  // namespace vantage

@@ -1,0 +1,36 @@
+#ifndef VANTAGE_LEARNER_INGEST_TRAINING_BATCH_H_
+#define VANTAGE_LEARNER_INGEST_TRAINING_BATCH_H_
+
+#include <ATen/core/Tensor.h>
+
+#include <vector>
+
+#include "absl/functional/function_ref.h"
+#include "absl/status/statusor.h"
+#include "common/advantage/advantage.h"
+#include "learner/ingest/rollout_stitcher.h"
+
+namespace vantage {
+
+// N rollouts of T steps side by side, ready for the advantage estimators
+// (columns = env streams) and the update.
+struct TrainingBatch {
+  AdvantageInputs advantage_inputs;  // [T, N]; values from the current critic
+  at::Tensor observations;           // [T, N, obs], as the actors saw them
+  at::Tensor actions;                // [T, N, act]
+  at::Tensor behaviour_log_probs;    // [T, N]
+  at::Tensor policy_versions;        // [T, N] int64
+};
+
+// Evaluates the learner's critic once over every observation the
+// estimators need: V(s_t), V(s_T) after each rollout's last step, and V of
+// the final observation at each truncated step (the others are 0 and never
+// read). `values_of` maps raw observations [M, obs] to values [M]. All
+// rollouts must have the same length.
+absl::StatusOr<TrainingBatch> AssembleBatch(
+    const std::vector<Rollout>& rollouts,
+    absl::FunctionRef<at::Tensor(const at::Tensor&)> values_of);
+
+}  // namespace vantage
+
+#endif  // VANTAGE_LEARNER_INGEST_TRAINING_BATCH_H_
