@@ -1,0 +1,83 @@
+#ifndef VANTAGE_LEARNER_LEARNER_CORE_H_
+#define VANTAGE_LEARNER_LEARNER_CORE_H_
+
+#include <cstdint>
+#include <deque>
+#include <random>
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "common/advantage/advantage_config.h"
+#include "common/env/environment.h"
+#include "common/nn/networks.h"
+#include "common/nn/policy_weights.h"
+#include "common/nn/running_mean_std.h"
+#include "common/rollout/segment_queue.h"
+#include "learner/algorithms/ppo.h"
+#include "learner/ingest/rollout_stitcher.h"
+
+namespace vantage {
+
+struct LearnerConfig {
+  EnvSpec spec;
+  int64_t horizon = 2048;          // steps per rollout and env stream
+  int64_t rollouts_per_batch = 1;  // env streams per update
+  int64_t max_segment_steps = 4096;
+  int64_t total_env_steps = 1000000;  // the learning rate decays to 0 there
+  uint64_t seed = 0;
+  double observation_clip = 10.0;
+  AdvantageConfig advantage;
+  PpoConfig ppo;
+  NetworkConfig network;
+
+  absl::Status Validate() const;
+};
+
+struct UpdateStats {
+  int64_t policy_version = 0;  // published after this update
+  int64_t env_steps = 0;       // consumed so far
+  PpoStats ppo;
+  double biased_fraction = 0.0;  // share of samples using the bias
+  double mean_abs_bias = 0.0;    // mean |biased - GAE|
+  double explained_variance = 0.0;
+  int64_t rejected_segments = 0;  // so far, any reason
+};
+
+// Consumes segments, stitches rollouts, evaluates the critic, estimates
+// advantages (GAE + the biased path ensemble, rho-mixed), runs PPO and
+// versions the weights. Knows nothing of how segments travel.
+class LearnerCore {
+ public:
+  // Seeds LibTorch's global generator with config.seed, so the initial
+  // networks are reproducible.
+  static absl::StatusOr<std::unique_ptr<LearnerCore>> Create(
+      const LearnerConfig& config);
+
+  PolicyWeights CurrentWeights();
+  // Blocks on `source` until a batch is complete, then updates.
+  absl::StatusOr<UpdateStats> RunUpdate(SegmentSource& source);
+
+  // Returns of the episodes reported by consumed segments, newest last
+  // (at most 100 kept).
+  const std::deque<double>& recent_returns() const { return recent_returns_; }
+
+ private:
+  explicit LearnerCore(const LearnerConfig& config);
+
+  const LearnerConfig config_;
+  PolicyNetwork policy_;
+  ValueNetwork value_;
+  RunningMeanStd normalizer_;
+  PpoUpdater ppo_;
+  RolloutStitcher stitcher_;
+  std::vector<Rollout> pending_;
+  std::mt19937_64 rng_;
+  int64_t version_ = 0;
+  int64_t env_steps_ = 0;
+  int64_t rejected_ = 0;
+  std::deque<double> recent_returns_;
+};
+
+}  // namespace vantage
+
+#endif  // VANTAGE_LEARNER_LEARNER_CORE_H_
