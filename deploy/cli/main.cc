@@ -11,21 +11,34 @@
 #include "absl/flags/flag.h"
 #include "absl/flags/parse.h"
 #include "absl/flags/usage.h"
+#include "absl/strings/numbers.h"
 #include "absl/strings/str_join.h"
 #include "bench/advantage_bench.h"
 #include "bench/env_bench.h"
 #include "deploy/cli/advantages_command.h"
 #include "deploy/cli/env_commands.h"
+#include "deploy/cli/train_command.h"
 
 ABSL_FLAG(std::string, input, "",
           "advantages: JSON file with one rollout and the estimator settings");
 ABSL_FLAG(bool, example, false,
           "advantages: print every estimator on a built-in rollout");
 ABSL_FLAG(std::string, env, "",
-          "rollout, bench env: environment name (see `vantage envs`) or "
-          "mjcf:PATH");
+          "rollout, bench env, train: environment name (see `vantage envs`) "
+          "or mjcf:PATH; train defaults to InvertedPendulum");
+ABSL_FLAG(std::string, mode, "local", "train: local (one process)");
+ABSL_FLAG(std::string, algo, "ppo", "train: learning algorithm (ppo)");
+ABSL_FLAG(std::string, estimator, "maxabs",
+          "train: gae | max | min | maxabs | order:D");
+ABSL_FLAG(double, rho, 0.4, "train: probability of the biased estimate");
+ABSL_FLAG(std::vector<std::string>, ensemble,
+          std::vector<std::string>({"1", "16", "64", "2048"}),
+          "train: the path ensemble's k-step lengths");
+ABSL_FLAG(int64_t, steps, 150000, "train: environment steps");
+ABSL_FLAG(int, envs, 1, "train: environments (one rollout each per update)");
+ABSL_FLAG(int64_t, horizon, 2048, "train: rollout length per environment");
 ABSL_FLAG(int64_t, episodes, 10, "rollout: number of episodes");
-ABSL_FLAG(uint64_t, seed, 0, "rollout: random seed");
+ABSL_FLAG(uint64_t, seed, 0, "rollout, train: random seed");
 ABSL_FLAG(int64_t, bench_steps, 2048, "bench advantages: rollout length T");
 ABSL_FLAG(int64_t, bench_streams, 16,
           "bench advantages: number of env streams");
@@ -67,6 +80,33 @@ int RunRollout(const std::vector<std::string>& args) {
                            absl::GetFlag(FLAGS_seed));
 }
 
+int RunTrain(const std::vector<std::string>& args) {
+  if (int code = NoArguments("train", args); code != 0) return code;
+  TrainFlags flags;
+  flags.mode = absl::GetFlag(FLAGS_mode);
+  if (!absl::GetFlag(FLAGS_env).empty()) flags.env = absl::GetFlag(FLAGS_env);
+  flags.algo = absl::GetFlag(FLAGS_algo);
+  flags.estimator = absl::GetFlag(FLAGS_estimator);
+  flags.rho = absl::GetFlag(FLAGS_rho);
+  flags.ensemble.clear();
+  for (const std::string& k : absl::GetFlag(FLAGS_ensemble)) {
+    int64_t value = 0;
+    if (!absl::SimpleAtoi(k, &value)) {
+      std::fprintf(stderr,
+                   "vantage train: --ensemble entry '%s' is not an "
+                   "integer\n",
+                   k.c_str());
+      return kUsageExitCode;
+    }
+    flags.ensemble.push_back(value);
+  }
+  flags.steps = absl::GetFlag(FLAGS_steps);
+  flags.seed = absl::GetFlag(FLAGS_seed);
+  flags.envs = absl::GetFlag(FLAGS_envs);
+  flags.horizon = absl::GetFlag(FLAGS_horizon);
+  return RunTrainCommand(flags);
+}
+
 int RunBench(const std::vector<std::string>& args) {
   const std::map<std::string, std::function<int()>> benchmarks = {
       {"advantages",
@@ -95,10 +135,8 @@ int RunBench(const std::vector<std::string>& args) {
 
 const std::map<std::string, Command>& Commands() {
   static const auto* commands = new std::map<std::string, Command>{
-      {"advantages", RunAdvantages},
-      {"bench", RunBench},
-      {"envs", RunEnvs},
-      {"rollout", RunRollout},
+      {"advantages", RunAdvantages}, {"bench", RunBench}, {"envs", RunEnvs},
+      {"rollout", RunRollout},       {"train", RunTrain},
   };
   return *commands;
 }
@@ -128,6 +166,7 @@ int main(int argc, char** argv) {
       "vantage <command> [flags]\n"
       "  advantages --input=FILE.json   estimates of one rollout as JSON\n"
       "  advantages --example           every estimator on a built-in rollout\n"
+      "  train [--env --estimator --rho --steps --seed ...]   local PPO\n"
       "  envs                           registered environments\n"
       "  rollout --env=NAME --episodes=N --seed=S   random-policy episodes\n"
       "  bench advantages               path ensemble vs GAE benchmark\n"
