@@ -95,10 +95,14 @@ absl::Status ActorCore::CollectSegments(SegmentSink& sink) {
     if (absl::Status status = envs_->Step(actions_); !status.ok()) {
       return status;
     }
+    // Plain stores: a tensor op per element would cost more than a step.
+    float* reward_row = rewards.data_ptr<float>() + t * m;
+    bool* terminated_row = terminated.data_ptr<bool>() + t * m;
+    bool* truncated_row = truncated.data_ptr<bool>() + t * m;
     for (int64_t i = 0; i < m; ++i) {
-      rewards[t][i] = envs_->rewards()[i];
-      terminated[t][i] = static_cast<bool>(envs_->terminated()[i]);
-      truncated[t][i] = static_cast<bool>(envs_->truncated()[i]);
+      reward_row[i] = static_cast<float>(envs_->rewards()[i]);
+      terminated_row[i] = envs_->terminated()[i] != 0;
+      truncated_row[i] = envs_->truncated()[i] != 0;
     }
     for (const FinishedEpisode& episode : envs_->finished()) {
       Segment& segment = segments[episode.env_index];
