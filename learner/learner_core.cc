@@ -71,14 +71,9 @@ absl::StatusOr<UpdateStats> LearnerCore::RunUpdate(SegmentSource& source) {
   pending_.erase(pending_.begin(),
                  pending_.begin() + config_.rollouts_per_batch);
 
-  // The normaliser sees the new observations before they are used.
-  for (const Rollout& rollout : rollouts) {
-    if (absl::Status status = normalizer_.Update(
-            rollout.observations.slice(0, 0, config_.horizon));
-        !status.ok()) {
-      return status;
-    }
-  }
+  // The batch is normalised with the statistics the acting policy used
+  // (shipped with its weights), so that in sync mode the first epoch's
+  // ratios start at 1; the statistics absorb the batch after the update.
   const double clip = config_.observation_clip;
   absl::StatusOr<TrainingBatch> batch =
       AssembleBatch(rollouts, [&](const at::Tensor& observations) {
@@ -103,6 +98,13 @@ absl::StatusOr<UpdateStats> LearnerCore::RunUpdate(SegmentSource& source) {
                   batch->behaviour_log_probs.reshape({samples}),
                   advantages->mixed.reshape({samples}),
                   advantages->returns.reshape({samples}), learning_rate, rng_);
+  for (const Rollout& rollout : rollouts) {
+    if (absl::Status status = normalizer_.Update(
+            rollout.observations.slice(0, 0, config_.horizon));
+        !status.ok()) {
+      return status;
+    }
+  }
   env_steps_ += samples;
   ++version_;
   stats.policy_version = version_;
