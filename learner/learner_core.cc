@@ -54,13 +54,16 @@ absl::StatusOr<UpdateStats> LearnerCore::RunUpdate(SegmentSource& source) {
       ++rejected_;
       continue;
     }
-    for (double r : segment->episode_returns) {
-      recent_returns_.push_back(r);
-      if (recent_returns_.size() > 100) recent_returns_.pop_front();
-    }
+    // Returns count only for segments the stitcher accepts (a duplicate
+    // must not count twice).
+    const std::vector<double> returns = segment->episode_returns;
     if (!stitcher_.Add(std::move(*segment)).ok()) {
       ++rejected_;
       continue;
+    }
+    for (double r : returns) {
+      recent_returns_.push_back(r);
+      if (recent_returns_.size() > 100) recent_returns_.pop_front();
     }
     for (Rollout& rollout : stitcher_.TakeReady()) {
       pending_.push_back(std::move(rollout));
