@@ -3,12 +3,32 @@
 #include <ATen/ATen.h>
 #include <ATen/CPUGeneratorImpl.h>
 #include <ATen/core/grad_mode.h>
+#include <c10/util/Exception.h>
 
+#include <algorithm>
+#include <cstring>
+#include <mutex>
 #include <utility>
 
 #include "absl/strings/str_cat.h"
+#include "common/util/state_bytes.h"
 
 namespace vantage {
+namespace {
+
+constexpr char kStateKind[] = "actor_core";
+constexpr uint32_t kStateVersion = 1;
+
+// The generator's own serialisation (mt19937 state and the cached normal
+// samples), as bytes.
+std::string GeneratorState(at::Generator generator) {
+  std::lock_guard<std::mutex> lock(generator.mutex());
+  const at::Tensor state = generator.get_state().contiguous();
+  return std::string(reinterpret_cast<const char*>(state.data_ptr<uint8_t>()),
+                     state.numel());
+}
+
+}  // namespace
 
 absl::Status ActorConfig::Validate() const {
   if (env.empty()) return absl::InvalidArgumentError("actor needs an env");
@@ -140,6 +160,74 @@ absl::Status ActorCore::CollectSegments(SegmentSink& sink) {
       return status;
     }
   }
+  return absl::OkStatus();
+}
+
+absl::StatusOr<std::string> ActorCore::SaveState() const {
+  absl::StatusOr<std::string> envs = envs_->SaveState();
+  if (!envs.ok()) return envs.status();
+  StateWriter writer(kStateKind, kStateVersion);
+  writer.PutBytes(config_.env);
+  writer.PutI64(config_.num_envs);
+  writer.PutI64(config_.actor_id);
+  writer.PutI64(env_steps_);
+  writer.PutI64s(next_sequence_);
+  writer.PutBytes(GeneratorState(generator_));
+  writer.PutBytes(*envs);
+  return std::move(writer).Finish();
+}
+
+absl::Status ActorCore::RestoreState(absl::string_view state) {
+  const std::string context =
+      absl::StrCat("actor ", config_.actor_id, " (", config_.env, "): state");
+  StateReader reader(state, kStateKind, kStateVersion, context);
+  reader.ExpectEqual("the environment", reader.GetBytes("env"), config_.env);
+  reader.ExpectEqual("num_envs", reader.GetI64("num_envs"), config_.num_envs);
+  reader.ExpectEqual("actor_id", reader.GetI64("actor_id"), config_.actor_id);
+  const int64_t env_steps = reader.GetI64("env_steps");
+  std::vector<int64_t> next_sequence =
+      reader.GetI64s("next_sequence", next_sequence_.size());
+  const absl::string_view generator = reader.GetBytes("sampling generator");
+  const absl::string_view envs = reader.GetBytes("environments");
+  reader.Check(env_steps >= 0, absl::StrCat("env_steps is ", env_steps));
+  reader.Check(std::all_of(next_sequence.begin(), next_sequence.end(),
+                           [](int64_t sequence) { return sequence >= 0; }),
+               "a negative sequence number");
+  const size_t generator_size = GeneratorState(generator_).size();
+  reader.Check(
+      generator.size() == generator_size,
+      absl::StrCat("the sampling generator state holds ", generator.size(),
+                   " bytes, expected ", generator_size));
+  if (absl::Status status = reader.Finish(); !status.ok()) return status;
+
+  // Try the generator state on a copy first: LibTorch refuses a bad one
+  // only by throwing, and nothing may change before the environments have
+  // accepted theirs.
+  at::Tensor generator_state = at::empty(
+      {static_cast<int64_t>(generator.size())}, at::TensorOptions(at::kByte));
+  std::memcpy(generator_state.data_ptr<uint8_t>(), generator.data(),
+              generator.size());
+  at::Generator trial = generator_.clone();
+  try {
+    trial.set_state(generator_state);
+  } catch (const c10::Error& error) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        context,
+        ": bad sampling generator state: ", error.what_without_backtrace()));
+  }
+  if (!trial.get<at::CPUGeneratorImpl>()->engine().is_valid()) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(context, ": bad sampling generator state"));
+  }
+  if (absl::Status status = envs_->RestoreState(envs); !status.ok()) {
+    return status;
+  }
+  {
+    std::lock_guard<std::mutex> lock(generator_.mutex());
+    generator_.set_state(generator_state);
+  }
+  env_steps_ = env_steps;
+  next_sequence_ = std::move(next_sequence);
   return absl::OkStatus();
 }
 

@@ -10,6 +10,7 @@
 
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
+#include "absl/strings/string_view.h"
 #include "actor/vector_env.h"
 #include "common/nn/networks.h"
 #include "common/nn/policy_weights.h"
@@ -49,6 +50,19 @@ class ActorCore {
   // first (FailedPrecondition otherwise), so every action comes from a
   // published, reproducible policy version.
   absl::Status CollectSegments(SegmentSink& sink);
+
+  // Everything but the weights that decides the next segments: the
+  // environments (VectorEnv::SaveState), the action-sampling generator,
+  // env_steps() and each slot's next sequence number, so that an actor
+  // restored from it continues bit for bit. The policy weights, normaliser
+  // and policy_version() are not in it: after RestoreState the learner
+  // sends its weights again with SetWeights (acting still needs them).
+  // Call between CollectSegments calls.
+  absl::StatusOr<std::string> SaveState() const;
+  // Needs a state saved by an actor with the same env, num_envs and
+  // actor_id. All or nothing: on any error (InvalidArgument for a bad blob)
+  // the actor is left as it was.
+  absl::Status RestoreState(absl::string_view state);
 
  private:
   ActorCore(const ActorConfig& config, std::unique_ptr<VectorEnv> envs);

@@ -5,8 +5,20 @@
 
 #include "absl/strings/str_cat.h"
 #include "actor/envs/env_registry.h"
+#include "common/util/state_bytes.h"
 
 namespace vantage {
+namespace {
+
+constexpr char kStateKind[] = "vector_env";
+constexpr uint32_t kStateVersion = 1;
+
+absl::string_view AsBytes(const std::vector<uint8_t>& flags) {
+  return absl::string_view(reinterpret_cast<const char*>(flags.data()),
+                           flags.size());
+}
+
+}  // namespace
 
 absl::StatusOr<std::unique_ptr<VectorEnv>> VectorEnv::Create(
     absl::string_view name, int count, uint64_t seed) {
@@ -96,6 +108,124 @@ absl::Status VectorEnv::Step(absl::Span<const double> actions) {
     }
   }
   return first_error;
+}
+
+absl::StatusOr<std::string> VectorEnv::SaveState() const {
+  StateWriter writer(kStateKind, kStateVersion);
+  writer.PutBytes(spec().name);
+  writer.PutI64(size());
+  writer.PutI64(observation_size_);
+  writer.PutI64(action_width_);
+  writer.PutEngine(seeds_);
+  writer.PutDoubles(observations_);
+  writer.PutDoubles(final_observations_);
+  writer.PutDoubles(rewards_);
+  writer.PutBytes(AsBytes(terminated_));
+  writer.PutBytes(AsBytes(truncated_));
+  writer.PutDoubles(episode_returns_);
+  writer.PutI64s(episode_lengths_);
+  writer.PutI64(static_cast<int64_t>(finished_.size()));
+  for (const FinishedEpisode& episode : finished_) {
+    writer.PutI64(episode.env_index);
+    writer.PutDouble(episode.episode_return);
+    writer.PutI64(episode.length);
+    writer.PutBool(episode.truncated);
+  }
+  // The environments' states come last, one field each.
+  for (const std::unique_ptr<Environment>& env : envs_) {
+    absl::StatusOr<std::string> state = env->SaveState();
+    if (!state.ok()) return state.status();
+    writer.PutBytes(*state);
+  }
+  return std::move(writer).Finish();
+}
+
+absl::Status VectorEnv::RestoreState(absl::string_view state) {
+  const size_t m = envs_.size();
+  StateReader reader(state, kStateKind, kStateVersion,
+                     absl::StrCat("vector of ", spec().name, ": state"));
+  reader.ExpectEqual("the environment", reader.GetBytes("name"), spec().name);
+  reader.ExpectEqual("the number of environments", reader.GetI64("size"),
+                     size());
+  reader.ExpectEqual("observation_size", reader.GetI64("observation_size"),
+                     observation_size_);
+  reader.ExpectEqual("the action width", reader.GetI64("action_width"),
+                     action_width_);
+  const std::mt19937_64 seeds = reader.GetEngine("episode seeds");
+  const size_t values = m * observation_size_;
+  std::vector<double> observations = reader.GetDoubles("observations", values);
+  std::vector<double> final_observations =
+      reader.GetDoubles("final_observations", values);
+  std::vector<double> rewards = reader.GetDoubles("rewards", m);
+  const absl::string_view terminated = reader.GetBytes("terminated");
+  const absl::string_view truncated = reader.GetBytes("truncated");
+  std::vector<double> returns = reader.GetDoubles("episode_returns", m);
+  std::vector<int64_t> lengths = reader.GetI64s("episode_lengths", m);
+  const int64_t finished_count = reader.GetI64("finished episodes");
+  reader.Check(
+      finished_count >= 0 && finished_count <= size(),
+      absl::StrCat(finished_count, " episodes finished in one step of ", m,
+                   " environments"));
+  std::vector<FinishedEpisode> finished;
+  for (int64_t i = 0; reader.status().ok() && i < finished_count; ++i) {
+    const int64_t index = reader.GetI64("finished env_index");
+    FinishedEpisode episode;
+    episode.episode_return = reader.GetDouble("finished episode_return");
+    episode.length = reader.GetI64("finished length");
+    episode.truncated = reader.GetBool("finished truncated");
+    reader.Check(index >= 0 && index < size() && episode.length >= 1,
+                 absl::StrCat("finished episode ", i, " is impossible (env ",
+                              index, ", length ", episode.length, ")"));
+    episode.env_index = static_cast<int>(index);
+    finished.push_back(episode);
+  }
+  std::vector<absl::string_view> env_states;
+  for (size_t i = 0; i < m; ++i) {
+    env_states.push_back(reader.GetBytes(absl::StrCat("env ", i, " state")));
+  }
+  const auto flags_ok = [m](absl::string_view flags) {
+    return flags.size() == m &&
+           std::all_of(flags.begin(), flags.end(),
+                       [](char flag) { return flag == 0 || flag == 1; });
+  };
+  reader.Check(flags_ok(terminated) && flags_ok(truncated),
+               absl::StrCat("the step flags are not ", m, " bools each"));
+  reader.Check(std::all_of(lengths.begin(), lengths.end(),
+                           [](int64_t length) { return length >= 0; }),
+               "a negative episode length");
+  if (absl::Status status = reader.Finish(); !status.ok()) return status;
+
+  // Each environment restores all or nothing, but one may refuse after
+  // others took their new state: keep what they had to roll them back.
+  std::vector<std::string> backups;
+  for (const std::unique_ptr<Environment>& env : envs_) {
+    absl::StatusOr<std::string> backup = env->SaveState();
+    if (!backup.ok()) return backup.status();
+    backups.push_back(std::move(*backup));
+  }
+  for (size_t i = 0; i < m; ++i) {
+    absl::Status status = envs_[i]->RestoreState(env_states[i]);
+    if (status.ok()) continue;
+    for (size_t j = 0; j < i; ++j) {
+      if (absl::Status undo = envs_[j]->RestoreState(backups[j]); !undo.ok()) {
+        return absl::InternalError(absl::StrCat(
+            "env ", i, " refused its state (", status.message(),
+            ") and rolling back env ", j, " failed: ", undo.message()));
+      }
+    }
+    return absl::Status(status.code(),
+                        absl::StrCat("env ", i, ": ", status.message()));
+  }
+  seeds_ = seeds;
+  observations_ = std::move(observations);
+  final_observations_ = std::move(final_observations);
+  rewards_ = std::move(rewards);
+  terminated_.assign(terminated.begin(), terminated.end());
+  truncated_.assign(truncated.begin(), truncated.end());
+  episode_returns_ = std::move(returns);
+  episode_lengths_ = std::move(lengths);
+  finished_ = std::move(finished);
+  return absl::OkStatus();
 }
 
 }  // namespace vantage

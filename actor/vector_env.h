@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <memory>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "absl/status/status.h"
@@ -52,6 +53,14 @@ class VectorEnv {
   const std::vector<uint8_t>& truncated() const { return truncated_; }
   // Episodes that ended during the last Step.
   const std::vector<FinishedEpisode>& finished() const { return finished_; }
+
+  // Every environment's state, the episode-seed generator, the running
+  // episode returns and lengths, and what the accessors above return, so
+  // that a restored vector steps and resets exactly like the saved one.
+  absl::StatusOr<std::string> SaveState() const;
+  // Needs a state of the same environment and size. All or nothing: on any
+  // error (InvalidArgument for a bad blob) the vector is left as it was.
+  absl::Status RestoreState(absl::string_view state);
 
  private:
   VectorEnv(std::vector<std::unique_ptr<Environment>> envs, uint64_t seed);

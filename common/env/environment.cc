@@ -10,6 +10,16 @@ std::string EnvSpec::ActionString() const {
   return absl::StrCat(discrete ? "discrete:" : "continuous:", action_size);
 }
 
+absl::StatusOr<std::string> Environment::SaveState() const {
+  return absl::UnimplementedError(
+      absl::StrCat(spec().name, ": this environment cannot save its state"));
+}
+
+absl::Status Environment::RestoreState(absl::string_view) {
+  return absl::UnimplementedError(absl::StrCat(
+      spec().name, ": this environment cannot restore a saved state"));
+}
+
 absl::Status CheckAction(const EnvSpec& spec, absl::Span<const double> action) {
   const size_t expected = spec.discrete ? 1 : spec.action_size;
   if (action.size() != expected) {

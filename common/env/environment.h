@@ -10,6 +10,7 @@
 
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
+#include "absl/strings/string_view.h"
 #include "absl/types/span.h"
 
 namespace vantage {
@@ -59,6 +60,17 @@ class Environment {
   // writes the next observation. Never resets by itself.
   virtual absl::StatusOr<StepResult> Step(absl::Span<const double> action,
                                           absl::Span<double> observation) = 0;
+
+  // Everything that decides what later Reset and Step calls produce, as an
+  // opaque blob (see common/util/state_bytes.h) for checkpoints; valid at
+  // any point between calls, including before the first Reset and after an
+  // episode ended. The defaults say the environment cannot.
+  virtual absl::StatusOr<std::string> SaveState() const;
+  // Puts the environment into exactly the saved state: the same actions
+  // then give bit-identical observations, rewards and flags. The blob must
+  // come from an environment of the same name and model; anything else is
+  // InvalidArgument and leaves this environment as it was.
+  virtual absl::Status RestoreState(absl::string_view state);
 };
 
 // Checks an action's size and finiteness against the spec (and, if

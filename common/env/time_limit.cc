@@ -3,8 +3,15 @@
 #include <utility>
 
 #include "absl/strings/str_cat.h"
+#include "common/util/state_bytes.h"
 
 namespace vantage {
+namespace {
+
+constexpr char kStateKind[] = "time_limit";
+constexpr uint32_t kStateVersion = 1;
+
+}  // namespace
 
 TimeLimit::TimeLimit(std::unique_ptr<Environment> inner)
     : inner_(std::move(inner)) {}
@@ -36,6 +43,44 @@ absl::StatusOr<StepResult> TimeLimit::Step(absl::Span<const double> action,
   }
   if (result->terminated || result->truncated) running_ = false;
   return result;
+}
+
+absl::StatusOr<std::string> TimeLimit::SaveState() const {
+  absl::StatusOr<std::string> inner = inner_->SaveState();
+  if (!inner.ok()) return inner.status();
+  StateWriter writer(kStateKind, kStateVersion);
+  writer.PutBytes(spec().name);
+  writer.PutI64(spec().max_episode_steps);
+  writer.PutI64(elapsed_steps_);
+  writer.PutBool(running_);
+  writer.PutBytes(*inner);
+  return std::move(writer).Finish();
+}
+
+absl::Status TimeLimit::RestoreState(absl::string_view state) {
+  StateReader reader(state, kStateKind, kStateVersion,
+                     absl::StrCat(spec().name, ": time limit state"));
+  reader.ExpectEqual("the environment", reader.GetBytes("name"), spec().name);
+  const int64_t limit = spec().max_episode_steps;
+  reader.ExpectEqual("max_episode_steps", reader.GetI64("max_episode_steps"),
+                     limit);
+  const int64_t elapsed = reader.GetI64("elapsed_steps");
+  const bool running = reader.GetBool("running");
+  const absl::string_view inner = reader.GetBytes("inner state");
+  // A running episode has not reached the limit yet; an ended one may have.
+  reader.Check(elapsed >= 0 && (limit <= 0 ||
+                                (running ? elapsed < limit : elapsed <= limit)),
+               absl::StrCat("elapsed_steps ", elapsed,
+                            " is impossible with the limit ", limit));
+  if (absl::Status status = reader.Finish(); !status.ok()) return status;
+  // The inner environment restores all or nothing, so nothing has changed
+  // if it fails.
+  if (absl::Status status = inner_->RestoreState(inner); !status.ok()) {
+    return status;
+  }
+  elapsed_steps_ = elapsed;
+  running_ = running;
+  return absl::OkStatus();
 }
 
 }  // namespace vantage

@@ -3,6 +3,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <string>
 
 #include "common/env/environment.h"
 
@@ -19,6 +20,9 @@ class TimeLimit : public Environment {
   absl::Status Reset(uint64_t seed, absl::Span<double> observation) override;
   absl::StatusOr<StepResult> Step(absl::Span<const double> action,
                                   absl::Span<double> observation) override;
+  // The step count and whether an episode runs, around the inner state.
+  absl::StatusOr<std::string> SaveState() const override;
+  absl::Status RestoreState(absl::string_view state) override;
 
   int64_t elapsed_steps() const { return elapsed_steps_; }
   // The wrapped environment (benchmarks reach the physics through it).

@@ -1,13 +1,46 @@
 #include "actor/envs/mujoco/mujoco_env.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstring>
 #include <limits>
+#include <string>
 #include <utility>
 
 #include "absl/strings/str_cat.h"
+#include "common/util/state_bytes.h"
 
 namespace vantage {
+namespace {
+
+constexpr char kStateKind[] = "mujoco_env";
+constexpr uint32_t kStateVersion = 1;
+
+struct NamedSize {
+  const char* name;
+  int64_t value;
+};
+
+// What the buffer's layout depends on; a blob from a model that differs in
+// any of them (another task, another MJCF file under the same path) is
+// refused.
+std::array<NamedSize, 12> LayoutSizes(const mjModel* m, const mjData* d) {
+  return {{{"MuJoCo version", mj_version()},
+           {"nq", m->nq},
+           {"nv", m->nv},
+           {"na", m->na},
+           {"nu", m->nu},
+           {"nbody", m->nbody},
+           {"nmocap", m->nmocap},
+           {"nuserdata", m->nuserdata},
+           {"nsensordata", m->nsensordata},
+           {"nconmax", m->nconmax},
+           {"njmax", m->njmax},
+           {"nbuffer", d->nbuffer}}};
+}
+
+}  // namespace
 
 MujocoEnv::MujocoEnv(EnvSpec spec, MjModelPtr model, MjDataPtr data,
                      int frame_skip)
@@ -28,6 +61,9 @@ MujocoEnv::MujocoEnv(EnvSpec spec, MjModelPtr model, MjDataPtr data,
   }
   spec_.control_dt = m->opt.timestep * frame_skip_;
   clipped_.resize(m->nu);
+  std::string mjb(mj_sizeModel(m), '\0');
+  mj_saveModel(m, nullptr, mjb.data(), static_cast<int>(mjb.size()));
+  model_fingerprint_ = Fingerprint(mjb);
 }
 
 absl::Status MujocoEnv::Reset(uint64_t seed, absl::Span<double> observation) {
@@ -98,6 +134,111 @@ absl::StatusOr<StepResult> MujocoEnv::Step(absl::Span<const double> action,
   const StepResult result = Evaluate(clipped_);
   Observe(observation.data());
   return result;
+}
+
+absl::StatusOr<std::string> MujocoEnv::SaveState() const {
+  const mjData* d = data_.get();
+  StateWriter writer(kStateKind, kStateVersion);
+  writer.PutBytes(spec_.name);
+  for (const NamedSize& size : LayoutSizes(model_.get(), d)) {
+    writer.PutI64(size.value);
+  }
+  writer.PutU64(model_fingerprint_);
+  writer.PutDouble(d->time);
+  writer.PutDoubles(d->energy);
+  writer.PutI64s({d->ne, d->nf, d->nefc, d->ncon});
+  writer.PutI64s({d->solver_iter, d->solver_nnz});
+  writer.PutDoubles(d->solver_fwdinv);
+  // Step reads the warning counters; the timers and per-iteration solver
+  // statistics are diagnostics that the next step overwrites.
+  std::vector<int64_t> warnings;
+  for (const mjWarningStat& warning : d->warning) {
+    warnings.push_back(warning.lastinfo);
+    warnings.push_back(warning.number);
+  }
+  writer.PutI64s(warnings);
+  writer.PutPacked(absl::string_view(static_cast<const char*>(d->buffer),
+                                     static_cast<size_t>(d->nbuffer)));
+  writer.PutEngine(rng_);
+  writer.PutBool(needs_reset_);
+  writer.PutBytes(SaveTaskState());
+  return std::move(writer).Finish();
+}
+
+absl::Status MujocoEnv::RestoreState(absl::string_view state) {
+  const mjModel* m = model_.get();
+  mjData* d = data_.get();
+  StateReader reader(state, kStateKind, kStateVersion,
+                     absl::StrCat(spec_.name, ": MuJoCo state"));
+  reader.ExpectEqual("the environment", reader.GetBytes("name"), spec_.name);
+  for (const NamedSize& size : LayoutSizes(m, d)) {
+    reader.ExpectEqual(size.name, reader.GetI64(size.name), size.value);
+  }
+  const uint64_t fingerprint = reader.GetU64("model fingerprint");
+  reader.Check(fingerprint == model_fingerprint_,
+               "the state was saved with another MuJoCo model (the "
+               "fingerprints differ)");
+  const double time = reader.GetDouble("time");
+  const std::vector<double> energy = reader.GetDoubles("energy", 2);
+  const std::vector<int64_t> counts = reader.GetI64s("constraint counts", 4);
+  const std::vector<int64_t> solver = reader.GetI64s("solver counts", 2);
+  const std::vector<double> fwdinv = reader.GetDoubles("solver_fwdinv", 2);
+  const std::vector<int64_t> warnings =
+      reader.GetI64s("warnings", 2 * mjNWARNING);
+  const std::string buffer =
+      reader.GetPacked("buffer", static_cast<size_t>(d->nbuffer));
+  const std::mt19937_64 rng = reader.GetEngine("reset generator");
+  const bool needs_reset = reader.GetBool("needs_reset");
+  const absl::string_view task = reader.GetBytes("task state");
+  reader.Check(std::isfinite(time), "time is not finite");
+  // Counts out of range would make later reads of the contact and
+  // constraint arrays overrun the buffer.
+  const int64_t ne = counts[0];
+  const int64_t nf = counts[1];
+  const int64_t nefc = counts[2];
+  const int64_t ncon = counts[3];
+  reader.Check(ne >= 0 && nf >= 0 && ne + nf <= nefc && nefc <= m->njmax &&
+                   ncon >= 0 && ncon <= m->nconmax,
+               absl::StrCat("impossible constraint counts ne=", ne, " nf=", nf,
+                            " nefc=", nefc, " ncon=", ncon));
+  reader.Check(solver[0] >= 0 && solver[0] <= mjNSOLVER && solver[1] >= 0 &&
+                   solver[1] <= std::numeric_limits<int>::max(),
+               "impossible solver counts");
+  bool warnings_fit = true;
+  for (int64_t value : warnings) {
+    warnings_fit &= value >= std::numeric_limits<int>::min() &&
+                    value <= std::numeric_limits<int>::max();
+  }
+  reader.Check(warnings_fit, "warning counters out of range");
+  if (absl::Status status = reader.Finish(); !status.ok()) return status;
+  if (absl::Status status = RestoreTaskState(task); !status.ok()) {
+    return status;
+  }
+
+  d->time = time;
+  std::copy(energy.begin(), energy.end(), d->energy);
+  d->ne = static_cast<int>(ne);
+  d->nf = static_cast<int>(nf);
+  d->nefc = static_cast<int>(nefc);
+  d->ncon = static_cast<int>(ncon);
+  d->solver_iter = static_cast<int>(solver[0]);
+  d->solver_nnz = static_cast<int>(solver[1]);
+  std::copy(fwdinv.begin(), fwdinv.end(), d->solver_fwdinv);
+  for (int i = 0; i < mjNWARNING; ++i) {
+    d->warning[i].lastinfo = static_cast<int>(warnings[2 * i]);
+    d->warning[i].number = static_cast<int>(warnings[2 * i + 1]);
+  }
+  std::memcpy(d->buffer, buffer.data(), buffer.size());
+  rng_ = rng;
+  needs_reset_ = needs_reset;
+  return absl::OkStatus();
+}
+
+absl::Status MujocoEnv::RestoreTaskState(absl::string_view state) {
+  if (state.empty()) return absl::OkStatus();
+  return absl::InvalidArgumentError(
+      absl::StrCat(spec_.name, ": MuJoCo state: carries ", state.size(),
+                   " bytes of task state, but this task keeps none"));
 }
 
 void MujocoEnv::PerturbState(std::mt19937_64& rng, double scale,

@@ -2,6 +2,8 @@
 #define VANTAGE_ACTOR_ENVS_MUJOCO_MUJOCO_ENV_H_
 
 #include <random>
+#include <string>
+#include <vector>
 
 #include "actor/envs/mujoco/mujoco_model.h"
 #include "common/env/environment.h"
@@ -18,6 +20,16 @@ class MujocoEnv : public Environment {
   absl::Status Reset(uint64_t seed, absl::Span<double> observation) override;
   absl::StatusOr<StepResult> Step(absl::Span<const double> action,
                                   absl::Span<double> observation) override;
+  // MuJoCo 2.2.2 has no mj_getState: the blob holds mjData's scalars that
+  // outlive a step (time, constraint counts, warnings) and its whole buffer
+  // (qpos, qvel, act, ctrl, the solver's warm start, contacts and the
+  // derived quantities observations read; packed, as it is mostly unused
+  // constraint rows), the reset generator, whether a reset is due, and the
+  // task's own state (SaveTaskState). The buffer is only meaningful for the
+  // same compiled model and MuJoCo version, so restoring checks both: the
+  // version, the model's sizes and a fingerprint of the model.
+  absl::StatusOr<std::string> SaveState() const override;
+  absl::Status RestoreState(absl::string_view state) override;
 
   const mjModel* model() const { return model_.get(); }
   const mjData* data() const { return data_.get(); }
@@ -38,6 +50,14 @@ class MujocoEnv : public Environment {
   virtual StepResult Evaluate(absl::Span<const double> action) = 0;
   virtual void Observe(double* observation) const = 0;
 
+  // State a task keeps outside mjData that outlives a Step, as a blob of
+  // its own; the default has none.
+  virtual std::string SaveTaskState() const { return {}; }
+  // Restores what SaveTaskState wrote, all or nothing: it runs once the
+  // rest of the environment's blob has been checked, and the rest is
+  // applied only if it succeeds.
+  virtual absl::Status RestoreTaskState(absl::string_view state);
+
   mjData* mutable_data() { return data_.get(); }
 
   // The usual ResetState: qpos += U(-scale, scale) and qvel +=
@@ -49,7 +69,11 @@ class MujocoEnv : public Environment {
   MjModelPtr model_;
   MjDataPtr data_;
   int frame_skip_;
+  // Of the compiled model (its MJB bytes): a state is refused by a model
+  // that differs in anything, not just in the sizes of mjData's buffer.
+  uint64_t model_fingerprint_ = 0;
   std::mt19937_64 rng_;
+  // Scratch of one Step, not state.
   std::vector<double> clipped_;
   // Set after an error left the simulation in an unknown state.
   bool needs_reset_ = true;
