@@ -7,6 +7,7 @@
 
 #include "absl/status/status.h"
 #include "actor/actor_core.h"
+#include "deploy/run_directory.h"
 #include "learner/learner_core.h"
 
 namespace vantage {
@@ -17,16 +18,33 @@ struct LocalTrainingConfig {
   int64_t total_env_steps = 300000;
   uint64_t seed = 0;
   LearnerConfig learner;  // spec, rollouts_per_batch and total steps filled in
+
+  // Optional run directory (see deploy/run_directory.h): config.json with
+  // `config_json`, progress.csv, and a checkpoint every `checkpoint_every`
+  // updates and at the end, keeping the newest `keep_checkpoints`.
+  std::string run_dir;
+  std::string config_json;
+  int checkpoint_every = 10;
+  int keep_checkpoints = 3;
+  // Continue the run in run_dir from its newest readable checkpoint (an
+  // unreadable one is reported and the one before it used); the continued
+  // run's progress equals an uninterrupted run's.
+  bool resume = false;
 };
+
+// The learner's config for `config` and the environment's spec.
+LearnerConfig MakeLearnerConfig(const LocalTrainingConfig& config,
+                                const EnvSpec& spec);
 
 // `--mode=local`: one actor core and one learner core in this process,
 // connected by an in-process queue, strictly on-policy: the actor collects
 // one horizon per environment with the latest weights, the learner updates
-// and publishes the next version. `on_update` sees every update with the
-// mean return of the last 100 episodes (NaN before the first one ends).
+// and publishes the next version. `on_update` sees every update (after its
+// progress row and checkpoint are written) and returns false to stop the
+// run there, as an interruption would (a later resume continues it).
 absl::Status RunLocalTraining(
     const LocalTrainingConfig& config,
-    const std::function<void(const UpdateStats&, double)>& on_update);
+    const std::function<bool(const ProgressRow&)>& on_update);
 
 }  // namespace vantage
 

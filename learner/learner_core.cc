@@ -2,11 +2,16 @@
 
 #include <ATen/ATen.h>
 #include <ATen/core/grad_mode.h>
+#include <torch/serialize/archive.h>
 
+#include <limits>
+#include <numeric>
+#include <sstream>
 #include <utility>
 
 #include "absl/strings/str_cat.h"
 #include "common/advantage/advantage.h"
+#include "learner/archive_io.h"
 #include "learner/ingest/training_batch.h"
 
 namespace vantage {
@@ -20,8 +25,19 @@ absl::Status LearnerConfig::Validate() const {
         "learner horizon, rollouts_per_batch and total_env_steps must be "
         ">= 1");
   }
+  if (!(observation_clip > 0) || !(reward_clip > 0)) {
+    return absl::InvalidArgumentError(
+        "observation_clip and reward_clip must be > 0");
+  }
   if (absl::Status status = advantage.Validate(); !status.ok()) return status;
-  return ppo.Validate();
+  if (absl::Status status = algorithm.Validate(); !status.ok()) return status;
+  if (algorithm.name == "a2c" &&
+      horizon % algorithm.a2c.steps_per_minibatch != 0) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "a2c needs a horizon that is a multiple of its ",
+        algorithm.a2c.steps_per_minibatch, "-step minibatches; got ", horizon));
+  }
+  return absl::OkStatus();
 }
 
 absl::StatusOr<std::unique_ptr<LearnerCore>> LearnerCore::Create(
@@ -37,12 +53,20 @@ LearnerCore::LearnerCore(const LearnerConfig& config)
       policy_(config.spec, config.network),
       value_(config.spec.observation_size, config.network),
       normalizer_(config.spec.observation_size),
-      ppo_(policy_, value_, config.ppo),
+      reward_scaler_(config.advantage.gamma, config.reward_clip),
+      // Validated by Create, so the algorithm exists.
+      updater_(MakePolicyUpdater(config.algorithm, policy_, value_).value()),
       stitcher_(config.horizon),
       rng_(config.seed) {}
 
 PolicyWeights LearnerCore::CurrentWeights() {
   return ExportPolicyWeights(*policy_, normalizer_, version_);
+}
+
+double LearnerCore::MeanRecentReturn() const {
+  if (recent_returns_.empty()) return std::numeric_limits<double>::quiet_NaN();
+  return std::accumulate(recent_returns_.begin(), recent_returns_.end(), 0.0) /
+         recent_returns_.size();
 }
 
 absl::StatusOr<UpdateStats> LearnerCore::RunUpdate(SegmentSource& source) {
@@ -65,6 +89,7 @@ absl::StatusOr<UpdateStats> LearnerCore::RunUpdate(SegmentSource& source) {
       recent_returns_.push_back(r);
       if (recent_returns_.size() > 100) recent_returns_.pop_front();
     }
+    episodes_ += static_cast<int64_t>(returns.size());
     for (Rollout& rollout : stitcher_.TakeReady()) {
       pending_.push_back(std::move(rollout));
     }
@@ -84,23 +109,25 @@ absl::StatusOr<UpdateStats> LearnerCore::RunUpdate(SegmentSource& source) {
         return value_->forward(normalizer_.Normalize(observations, clip));
       });
   if (!batch.ok()) return batch.status();
+  if (config_.scale_rewards) {
+    if (absl::Status status = reward_scaler_.Observe(rollouts); !status.ok()) {
+      return status;
+    }
+    batch->advantage_inputs.rewards =
+        reward_scaler_.Scale(batch->advantage_inputs.rewards);
+  }
   absl::StatusOr<Advantages> advantages =
       ComputeAdvantages(batch->advantage_inputs, config_.advantage, rng_);
   if (!advantages.ok()) return advantages.status();
 
-  const int64_t samples = config_.horizon * config_.rollouts_per_batch;
-  const at::Tensor observations =
-      normalizer_.Normalize(batch->observations.reshape({samples, -1}), clip);
+  const UpdateBatch update = MakeUpdateBatch(
+      *batch, *advantages,
+      [&](const at::Tensor& raw) { return normalizer_.Normalize(raw, clip); });
+  const int64_t samples = update.horizon * update.streams;
   const double progress =
       static_cast<double>(env_steps_) / config_.total_env_steps;
-  const double learning_rate =
-      config_.ppo.learning_rate * std::max(0.0, 1.0 - progress);
   UpdateStats stats;
-  stats.ppo =
-      ppo_.Update(observations, batch->actions.reshape({samples, -1}),
-                  batch->behaviour_log_probs.reshape({samples}),
-                  advantages->mixed.reshape({samples}),
-                  advantages->returns.reshape({samples}), learning_rate, rng_);
+  stats.algorithm = updater_->Update(update, progress, rng_);
   for (const Rollout& rollout : rollouts) {
     if (absl::Status status = normalizer_.Update(
             rollout.observations.slice(0, 0, config_.horizon));
@@ -112,6 +139,7 @@ absl::StatusOr<UpdateStats> LearnerCore::RunUpdate(SegmentSource& source) {
   ++version_;
   stats.policy_version = version_;
   stats.env_steps = env_steps_;
+  stats.episodes = episodes_;
   stats.biased_fraction = advantages->mask.to(at::kFloat).mean().item<double>();
   stats.mean_abs_bias =
       (advantages->biased - advantages->gae).abs().mean().item<double>();
@@ -121,6 +149,113 @@ absl::StatusOr<UpdateStats> LearnerCore::RunUpdate(SegmentSource& source) {
       1.0 - (residual.var() / (targets.var() + 1e-8)).item<double>();
   stats.rejected_segments = rejected_;
   return stats;
+}
+
+namespace {
+
+// The spec's shape, which a checkpoint must match.
+at::Tensor SpecShape(const EnvSpec& spec) {
+  return at::tensor({spec.observation_size, spec.action_size,
+                     static_cast<int64_t>(spec.discrete)},
+                    at::kLong);
+}
+
+}  // namespace
+
+void LearnerCore::Save(torch::serialize::OutputArchive& archive) const {
+  WriteBytes(archive, "spec.name", config_.spec.name);
+  archive.write("spec.shape", SpecShape(config_.spec));
+  WriteBytes(archive, "algorithm", config_.algorithm.name);
+  WriteModule(archive, "policy", *policy_);
+  WriteModule(archive, "value", *value_);
+  torch::serialize::OutputArchive updater, scaler;
+  updater_->Save(updater);
+  reward_scaler_.Save(scaler);
+  archive.write("updater", updater);
+  archive.write("reward_scaler", scaler);
+  WriteRunningMeanStd(archive, "normalizer", normalizer_);
+  std::ostringstream rng;
+  rng << rng_;
+  WriteBytes(archive, "rng", rng.str());
+  archive.write(
+      "counters",
+      at::tensor({version_, env_steps_, rejected_, episodes_}, at::kLong));
+  archive.write("recent_returns",
+                at::tensor(std::vector<double>(recent_returns_.begin(),
+                                               recent_returns_.end()),
+                           at::kDouble));
+}
+
+absl::StatusOr<std::unique_ptr<LearnerCore>> LearnerCore::Load(
+    const LearnerConfig& config, torch::serialize::InputArchive& archive) {
+  absl::StatusOr<std::unique_ptr<LearnerCore>> created = Create(config);
+  if (!created.ok()) return created.status();
+  LearnerCore& core = **created;
+  absl::StatusOr<std::string> name = ReadBytes(archive, "spec.name");
+  if (!name.ok()) return name.status();
+  at::Tensor shape;
+  if (absl::Status status = ReadTensor(archive, "spec.shape", shape);
+      !status.ok()) {
+    return status;
+  }
+  if (*name != config.spec.name || !shape.equal(SpecShape(config.spec))) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "checkpoint is for environment '", *name,
+        "' with a different spec "
+        "than the configured '",
+        config.spec.name, "' (observation ", config.spec.observation_size,
+        ", action ", config.spec.ActionString(), ")"));
+  }
+  absl::StatusOr<std::string> algorithm = ReadBytes(archive, "algorithm");
+  if (!algorithm.ok()) return algorithm.status();
+  if (*algorithm != config.algorithm.name) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("checkpoint was trained with ", *algorithm, ", not ",
+                     config.algorithm.name));
+  }
+  torch::serialize::InputArchive updater, scaler;
+  if (absl::Status status = CatchTorchErrors(
+          "checkpoint entries 'updater' or 'reward_scaler' are missing",
+          [&] {
+            archive.read("updater", updater);
+            archive.read("reward_scaler", scaler);
+          });
+      !status.ok()) {
+    return status;
+  }
+  for (absl::Status status :
+       {ReadModule(archive, "policy", *core.policy_),
+        ReadModule(archive, "value", *core.value_),
+        core.updater_->Load(updater), core.reward_scaler_.Load(scaler),
+        ReadRunningMeanStd(archive, "normalizer", core.normalizer_)}) {
+    if (!status.ok()) return status;
+  }
+  absl::StatusOr<std::string> rng = ReadBytes(archive, "rng");
+  if (!rng.ok()) return rng.status();
+  std::istringstream rng_text(*rng);
+  rng_text >> core.rng_;
+  if (rng_text.fail()) {
+    return absl::InvalidArgumentError("checkpoint entry 'rng' is malformed");
+  }
+  at::Tensor counters, returns;
+  for (absl::Status status : {ReadTensor(archive, "counters", counters),
+                              ReadTensor(archive, "recent_returns", returns)}) {
+    if (!status.ok()) return status;
+  }
+  if (counters.scalar_type() != at::kLong || counters.numel() != 4 ||
+      returns.scalar_type() != at::kDouble || returns.dim() != 1 ||
+      returns.numel() > 100) {
+    return absl::InvalidArgumentError(
+        "checkpoint entries 'counters' or 'recent_returns' are malformed");
+  }
+  core.version_ = counters[0].item<int64_t>();
+  core.env_steps_ = counters[1].item<int64_t>();
+  core.rejected_ = counters[2].item<int64_t>();
+  core.episodes_ = counters[3].item<int64_t>();
+  for (int64_t i = 0; i < returns.numel(); ++i) {
+    core.recent_returns_.push_back(returns[i].item<double>());
+  }
+  return created;
 }
 
 }  // namespace vantage

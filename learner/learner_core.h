@@ -3,6 +3,7 @@
 
 #include <cstdint>
 #include <deque>
+#include <memory>
 #include <random>
 #include <vector>
 
@@ -13,7 +14,8 @@
 #include "common/nn/policy_weights.h"
 #include "common/nn/running_mean_std.h"
 #include "common/rollout/segment_queue.h"
-#include "learner/algorithms/ppo.h"
+#include "learner/algorithms/algorithm.h"
+#include "learner/ingest/reward_scaler.h"
 #include "learner/ingest/rollout_stitcher.h"
 
 namespace vantage {
@@ -26,8 +28,11 @@ struct LearnerConfig {
   int64_t total_env_steps = 1000000;  // the learning rate decays to 0 there
   uint64_t seed = 0;
   double observation_clip = 10.0;
+  // Divide rewards by the running std of discounted returns (then clip).
+  bool scale_rewards = false;
+  double reward_clip = 10.0;
   AdvantageConfig advantage;
-  PpoConfig ppo;
+  AlgorithmConfig algorithm;
   NetworkConfig network;
 
   absl::Status Validate() const;
@@ -36,7 +41,8 @@ struct LearnerConfig {
 struct UpdateStats {
   int64_t policy_version = 0;  // published after this update
   int64_t env_steps = 0;       // consumed so far
-  PpoStats ppo;
+  int64_t episodes = 0;        // finished, reported by consumed segments
+  AlgorithmStats algorithm;
   double biased_fraction = 0.0;  // share of samples using the bias
   double mean_abs_bias = 0.0;    // mean |biased - GAE|
   double explained_variance = 0.0;
@@ -44,8 +50,9 @@ struct UpdateStats {
 };
 
 // Consumes segments, stitches rollouts, evaluates the critic, estimates
-// advantages (GAE + the biased path ensemble, rho-mixed), runs PPO and
-// versions the weights. Knows nothing of how segments travel.
+// advantages (GAE + the biased path ensemble, rho-mixed), runs the
+// configured algorithm (PPO, A2C or TRPO) and versions the weights. Knows
+// nothing of how segments travel.
 class LearnerCore {
  public:
   // Seeds LibTorch's global generator with config.seed, so the initial
@@ -60,6 +67,22 @@ class LearnerCore {
   // Returns of the episodes reported by consumed segments, newest last
   // (at most 100 kept).
   const std::deque<double>& recent_returns() const { return recent_returns_; }
+  // Mean of recent_returns(); NaN before the first episode ends.
+  double MeanRecentReturn() const;
+  int64_t policy_version() const { return version_; }
+  int64_t env_steps() const { return env_steps_; }
+  const LearnerConfig& config() const { return config_; }
+
+  // Everything later updates depend on: both networks, the optimiser
+  // state, the observation normaliser, the reward scaler, the random
+  // generator, the version and counters, the recent returns and the
+  // environment spec. Rollouts still being stitched are not included (a
+  // resumed learner starts every stream afresh).
+  void Save(torch::serialize::OutputArchive& archive) const;
+  // Creates a learner from `config` and the state `archive` holds; any
+  // missing or mismatching entry is an InvalidArgument error naming it.
+  static absl::StatusOr<std::unique_ptr<LearnerCore>> Load(
+      const LearnerConfig& config, torch::serialize::InputArchive& archive);
 
  private:
   explicit LearnerCore(const LearnerConfig& config);
@@ -68,13 +91,15 @@ class LearnerCore {
   PolicyNetwork policy_;
   ValueNetwork value_;
   RunningMeanStd normalizer_;
-  PpoUpdater ppo_;
+  RewardScaler reward_scaler_;
+  std::unique_ptr<PolicyUpdater> updater_;
   RolloutStitcher stitcher_;
   std::vector<Rollout> pending_;
   std::mt19937_64 rng_;
   int64_t version_ = 0;
   int64_t env_steps_ = 0;
   int64_t rejected_ = 0;
+  int64_t episodes_ = 0;
   std::deque<double> recent_returns_;
 };
 

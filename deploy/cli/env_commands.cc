@@ -1,13 +1,18 @@
 #include "deploy/cli/env_commands.h"
 
+#include <ATen/CPUGeneratorImpl.h>
+
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <optional>
 #include <random>
 #include <vector>
 
+#include "absl/strings/str_cat.h"
 #include "absl/strings/str_replace.h"
 #include "actor/envs/env_registry.h"
+#include "deploy/trained_policy.h"
 
 namespace vantage {
 namespace {
@@ -49,8 +54,28 @@ int RunEnvsCommand() {
   return 0;
 }
 
-int RunRolloutCommand(const std::string& env_name, int64_t episodes,
-                      uint64_t seed) {
+int RunRolloutCommand(const RolloutRequest& request) {
+  const int64_t episodes = request.episodes;
+  const uint64_t seed = request.seed;
+  std::string env_name = request.env;
+  std::optional<TrainedPolicy> trained;
+  if (!request.checkpoint.empty()) {
+    absl::StatusOr<TrainedPolicy> loaded =
+        LoadTrainedPolicy(request.checkpoint);
+    if (!loaded.ok()) return Fail("rollout", loaded.status());
+    trained = *std::move(loaded);
+    if (env_name.empty()) env_name = trained->config.env();
+    if (env_name != trained->config.env()) {
+      return Fail("rollout", absl::InvalidArgumentError(absl::StrCat(
+                                 "the checkpoint's policy was trained on ",
+                                 trained->config.env(), ", not ", env_name)));
+    }
+    std::printf("policy: %s (version %ld, %s actions)\n",
+                trained->checkpoint_path.c_str(),
+                static_cast<long>(trained->version),
+                request.stochastic ? "sampled" : "deterministic");
+  }
+  at::Generator generator = at::detail::createCPUGenerator(seed);
   if (env_name.empty()) {
     return Fail("rollout", absl::InvalidArgumentError(
                                "--env=NAME is required (see `vantage envs`)"));
@@ -79,7 +104,9 @@ int RunRolloutCommand(const std::string& env_name, int64_t episodes,
     double episode_return = 0.0;
     int64_t length = 0;
     while (true) {
-      if (spec.discrete) {
+      if (trained.has_value()) {
+        action = trained->Act(observation, !request.stochastic, generator);
+      } else if (spec.discrete) {
         action[0] = static_cast<double>(std::uniform_int_distribution<int64_t>(
             0, spec.action_size - 1)(rng));
       } else {

@@ -5,16 +5,20 @@
 #include <cstdio>
 #include <functional>
 #include <map>
+#include <set>
 #include <string>
 #include <vector>
 
 #include "absl/flags/flag.h"
 #include "absl/flags/parse.h"
 #include "absl/flags/usage.h"
+#include "absl/strings/match.h"
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_join.h"
+#include "absl/strings/strip.h"
 #include "bench/advantage_bench.h"
 #include "bench/env_bench.h"
+#include "bench/learner_bench.h"
 #include "deploy/cli/advantages_command.h"
 #include "deploy/cli/env_commands.h"
 #include "deploy/cli/train_command.h"
@@ -27,16 +31,51 @@ ABSL_FLAG(std::string, env, "",
           "rollout, bench env, train: environment name (see `vantage envs`) "
           "or mjcf:PATH; train defaults to InvertedPendulum");
 ABSL_FLAG(std::string, mode, "local", "train: local (one process)");
-ABSL_FLAG(std::string, algo, "ppo", "train: learning algorithm (ppo)");
+ABSL_FLAG(std::string, algo, "ppo", "train: ppo | a2c | trpo");
 ABSL_FLAG(std::string, estimator, "maxabs",
           "train: gae | max | min | maxabs | order:D");
 ABSL_FLAG(double, rho, 0.4, "train: probability of the biased estimate");
 ABSL_FLAG(std::vector<std::string>, ensemble,
           std::vector<std::string>({"1", "16", "64", "2048"}),
           "train: the path ensemble's k-step lengths");
-ABSL_FLAG(int64_t, steps, 150000, "train: environment steps");
+ABSL_FLAG(int64_t, steps, 150000, "train: environment steps of the run");
 ABSL_FLAG(int, envs, 1, "train: environments (one rollout each per update)");
-ABSL_FLAG(int64_t, horizon, 2048, "train: rollout length per environment");
+ABSL_FLAG(int64_t, horizon, 2048,
+          "train: rollout length per environment (default: ppo 2048, trpo "
+          "1024, a2c 5 x --minibatches)");
+ABSL_FLAG(int, minibatches, 32,
+          "train: ppo minibatches per epoch (32); a2c: n of the paper's 5n "
+          "trick, 5n-step rollouts updated as n 5-step minibatches (4)");
+ABSL_FLAG(int, epochs, 10, "train: ppo epochs per update");
+ABSL_FLAG(double, learning_rate, 3e-4,
+          "train: ppo 3e-4 (Adam), a2c 7e-4 (RMSProp), both decayed "
+          "linearly; trpo: the value function's Adam, 1e-3");
+ABSL_FLAG(double, gamma, 0.99, "train: discount");
+ABSL_FLAG(double, gae_lambda, 0.95,
+          "train: GAE lambda (default: ppo 0.95, trpo 0.98, a2c 1)");
+ABSL_FLAG(double, entropy_coef, 0.0,
+          "train: entropy bonus (default: a2c 0.01, else 0)");
+ABSL_FLAG(std::vector<std::string>, hidden,
+          std::vector<std::string>({"64", "64"}),
+          "train: hidden layer sizes of the policy and value networks");
+ABSL_FLAG(bool, scale_rewards, false,
+          "train: divide rewards by the running std of discounted returns");
+ABSL_FLAG(double, max_kl, 0.01, "train: trpo's trust region");
+ABSL_FLAG(int, checkpoint_every, 10,
+          "train: updates between checkpoints (with --run_dir)");
+ABSL_FLAG(int, keep_checkpoints, 3, "train: newest checkpoints kept");
+ABSL_FLAG(std::string, config, "",
+          "train: JSON run config (as a run directory's config.json); flags "
+          "given on the command line override it");
+ABSL_FLAG(std::string, run_dir, "",
+          "train: directory for config.json, progress.csv, checkpoints/");
+ABSL_FLAG(std::string, resume, "",
+          "train: continue the run in this directory from its last "
+          "checkpoint");
+ABSL_FLAG(std::string, checkpoint, "",
+          "rollout: a run directory or checkpoint file whose policy acts");
+ABSL_FLAG(bool, stochastic, false,
+          "rollout --checkpoint: sample actions instead of the mean/mode");
 ABSL_FLAG(int64_t, episodes, 10, "rollout: number of episodes");
 ABSL_FLAG(uint64_t, seed, 0, "rollout, train: random seed");
 ABSL_FLAG(int64_t, bench_steps, 2048, "bench advantages: rollout length T");
@@ -75,36 +114,104 @@ int RunEnvs(const std::vector<std::string>& args) {
 
 int RunRollout(const std::vector<std::string>& args) {
   if (int code = NoArguments("rollout", args); code != 0) return code;
-  return RunRolloutCommand(absl::GetFlag(FLAGS_env),
-                           absl::GetFlag(FLAGS_episodes),
-                           absl::GetFlag(FLAGS_seed));
+  RolloutRequest request;
+  request.env = absl::GetFlag(FLAGS_env);
+  request.episodes = absl::GetFlag(FLAGS_episodes);
+  request.seed = absl::GetFlag(FLAGS_seed);
+  request.checkpoint = absl::GetFlag(FLAGS_checkpoint);
+  request.stochastic = absl::GetFlag(FLAGS_stochastic);
+  return RunRolloutCommand(request);
+}
+
+// The names of the flags given on the command line (this absl version
+// keeps CommandLineFlag::IsSpecifiedOnCommandLine private).
+std::set<std::string>& GivenFlags() {
+  static auto* given = new std::set<std::string>;
+  return *given;
+}
+
+void RecordGivenFlags(int argc, char** argv) {
+  for (int i = 1; i < argc; ++i) {
+    absl::string_view arg = argv[i];
+    if (arg == "--") break;
+    if (!absl::ConsumePrefix(&arg, "--") && !absl::ConsumePrefix(&arg, "-")) {
+      continue;
+    }
+    const std::string name(arg.substr(0, arg.find('=')));
+    GivenFlags().insert(name);
+    // --noflag sets a bool flag to false.
+    if (absl::StartsWith(name, "no")) GivenFlags().insert(name.substr(2));
+  }
+}
+
+// Whether a flag was set on the command line, as opposed to holding its
+// default (a config file fills those).
+bool Given(absl::string_view name) {
+  return GivenFlags().count(std::string(name)) > 0;
+}
+
+// Appends the integers of a list flag; false (after a message) if one is not.
+template <typename Repeated>
+bool ParseIntegers(const char* name, const std::vector<std::string>& values,
+                   Repeated& out) {
+  for (const std::string& text : values) {
+    int64_t value = 0;
+    if (!absl::SimpleAtoi(text, &value)) {
+      std::fprintf(stderr, "vantage train: --%s entry '%s' is not an integer\n",
+                   name, text.c_str());
+      return false;
+    }
+    out.Add(value);
+  }
+  return true;
 }
 
 int RunTrain(const std::vector<std::string>& args) {
   if (int code = NoArguments("train", args); code != 0) return code;
-  TrainFlags flags;
-  flags.mode = absl::GetFlag(FLAGS_mode);
-  if (!absl::GetFlag(FLAGS_env).empty()) flags.env = absl::GetFlag(FLAGS_env);
-  flags.algo = absl::GetFlag(FLAGS_algo);
-  flags.estimator = absl::GetFlag(FLAGS_estimator);
-  flags.rho = absl::GetFlag(FLAGS_rho);
-  flags.ensemble.clear();
-  for (const std::string& k : absl::GetFlag(FLAGS_ensemble)) {
-    int64_t value = 0;
-    if (!absl::SimpleAtoi(k, &value)) {
-      std::fprintf(stderr,
-                   "vantage train: --ensemble entry '%s' is not an "
-                   "integer\n",
-                   k.c_str());
-      return kUsageExitCode;
-    }
-    flags.ensemble.push_back(value);
+  TrainRequest request;
+  pb::RunConfig& c = request.flags;
+  if (Given("mode")) c.set_mode(absl::GetFlag(FLAGS_mode));
+  if (Given("env")) c.set_env(absl::GetFlag(FLAGS_env));
+  if (Given("algo")) c.set_algo(absl::GetFlag(FLAGS_algo));
+  if (Given("estimator")) c.set_estimator(absl::GetFlag(FLAGS_estimator));
+  if (Given("rho")) c.set_rho(absl::GetFlag(FLAGS_rho));
+  if (Given("ensemble") &&
+      !ParseIntegers("ensemble", absl::GetFlag(FLAGS_ensemble),
+                     *c.mutable_ensemble())) {
+    return kUsageExitCode;
   }
-  flags.steps = absl::GetFlag(FLAGS_steps);
-  flags.seed = absl::GetFlag(FLAGS_seed);
-  flags.envs = absl::GetFlag(FLAGS_envs);
-  flags.horizon = absl::GetFlag(FLAGS_horizon);
-  return RunTrainCommand(flags);
+  if (Given("steps")) c.set_steps(absl::GetFlag(FLAGS_steps));
+  if (Given("seed")) c.set_seed(absl::GetFlag(FLAGS_seed));
+  if (Given("envs")) c.set_envs(absl::GetFlag(FLAGS_envs));
+  if (Given("horizon")) c.set_horizon(absl::GetFlag(FLAGS_horizon));
+  if (Given("minibatches")) c.set_minibatches(absl::GetFlag(FLAGS_minibatches));
+  if (Given("epochs")) c.set_epochs(absl::GetFlag(FLAGS_epochs));
+  if (Given("learning_rate")) {
+    c.set_learning_rate(absl::GetFlag(FLAGS_learning_rate));
+  }
+  if (Given("gamma")) c.set_gamma(absl::GetFlag(FLAGS_gamma));
+  if (Given("gae_lambda")) c.set_gae_lambda(absl::GetFlag(FLAGS_gae_lambda));
+  if (Given("entropy_coef")) {
+    c.set_entropy_coef(absl::GetFlag(FLAGS_entropy_coef));
+  }
+  if (Given("hidden") && !ParseIntegers("hidden", absl::GetFlag(FLAGS_hidden),
+                                        *c.mutable_hidden())) {
+    return kUsageExitCode;
+  }
+  if (Given("scale_rewards")) {
+    c.set_scale_rewards(absl::GetFlag(FLAGS_scale_rewards));
+  }
+  if (Given("max_kl")) c.set_max_kl(absl::GetFlag(FLAGS_max_kl));
+  if (Given("checkpoint_every")) {
+    c.set_checkpoint_every(absl::GetFlag(FLAGS_checkpoint_every));
+  }
+  if (Given("keep_checkpoints")) {
+    c.set_keep_checkpoints(absl::GetFlag(FLAGS_keep_checkpoints));
+  }
+  request.config_file = absl::GetFlag(FLAGS_config);
+  request.run_dir = absl::GetFlag(FLAGS_run_dir);
+  request.resume = absl::GetFlag(FLAGS_resume);
+  return RunTrainCommand(request);
 }
 
 int RunBench(const std::vector<std::string>& args) {
@@ -122,6 +229,7 @@ int RunBench(const std::vector<std::string>& args) {
          return RunAdvantageBenchmark(steps, streams);
        }},
       {"env", [] { return RunEnvBenchmark(absl::GetFlag(FLAGS_env)); }},
+      {"learner", [] { return RunLearnerBenchmark(); }},
   };
   std::vector<std::string> names;
   for (const auto& entry : benchmarks) names.push_back(entry.first);
@@ -166,11 +274,18 @@ int main(int argc, char** argv) {
       "vantage <command> [flags]\n"
       "  advantages --input=FILE.json   estimates of one rollout as JSON\n"
       "  advantages --example           every estimator on a built-in rollout\n"
-      "  train [--env --estimator --rho --steps --seed ...]   local PPO\n"
+      "  train [--env --algo --estimator --rho --steps --seed --run_dir ...]\n"
+      "                                 local PPO / A2C / TRPO training\n"
+      "  train --config=FILE.json       flags from a run config file\n"
+      "  train --resume=RUN_DIR         continue from the last checkpoint\n"
       "  envs                           registered environments\n"
       "  rollout --env=NAME --episodes=N --seed=S   random-policy episodes\n"
+      "  rollout --checkpoint=RUN_DIR [--episodes=N] [--stochastic]\n"
+      "                                 the trained policy's episodes\n"
       "  bench advantages               path ensemble vs GAE benchmark\n"
-      "  bench env --env=NAME           env layer vs raw physics benchmark\n");
+      "  bench env --env=NAME           env layer vs raw physics benchmark\n"
+      "  bench learner                  PPO update vs a bare LibTorch loop\n");
+  vantage::RecordGivenFlags(argc, argv);
   const std::vector<char*> positional = absl::ParseCommandLine(argc, argv);
   if (positional.size() < 2) {
     std::fprintf(stderr, "%s", absl::ProgramUsageMessage().data());

@@ -1,87 +1,137 @@
 #include "deploy/cli/train_command.h"
 
 #include <ATen/Parallel.h>
+#include <unistd.h>
 
-#include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <vector>
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_join.h"
 #include "deploy/local_training.h"
+#include "deploy/run_config.h"
 
 namespace vantage {
 namespace {
 
-int Fail(const std::string& message) {
-  std::fprintf(stderr, "vantage train: %s\n", message.c_str());
+int Fail(absl::string_view message) {
+  std::fprintf(stderr, "vantage train: %s\n", std::string(message).c_str());
   return 2;
+}
+
+// The given config file (if any) with the command line's flags on top.
+absl::StatusOr<pb::RunConfig> MergeFlags(const TrainRequest& request) {
+  pb::RunConfig config;
+  if (!request.config_file.empty()) {
+    absl::StatusOr<pb::RunConfig> file = ReadRunConfigFile(request.config_file);
+    if (!file.ok()) return file.status();
+    config = *file;
+  }
+  // A repeated field given as a flag replaces the file's list.
+  if (request.flags.ensemble_size() > 0) config.clear_ensemble();
+  if (request.flags.hidden_size() > 0) config.clear_hidden();
+  config.MergeFrom(request.flags);
+  return config;
+}
+
+// Resuming continues the run exactly as configured; flags that would change
+// it are refused rather than silently ignored.
+absl::Status CheckNoOverrides(const pb::RunConfig& flags) {
+  std::vector<std::string> given;
+  const auto* descriptor = flags.GetDescriptor();
+  const auto* reflection = flags.GetReflection();
+  for (int i = 0; i < descriptor->field_count(); ++i) {
+    const auto* field = descriptor->field(i);
+    if (field->is_repeated() ? reflection->FieldSize(flags, field) > 0
+                             : reflection->HasField(flags, field)) {
+      given.push_back(absl::StrCat("--", field->name()));
+    }
+  }
+  if (given.empty()) return absl::OkStatus();
+  return absl::InvalidArgumentError(
+      absl::StrCat("--resume continues the run as its config.json says; drop ",
+                   absl::StrJoin(given, ", ")));
+}
+
+std::string Duration(double seconds) {
+  if (!std::isfinite(seconds) || seconds < 0) return "?";
+  const long s = std::lround(seconds);
+  return s >= 3600 ? absl::StrCat(s / 3600, "h", (s % 3600) / 60, "m")
+                   : absl::StrCat(s / 60, "m", s % 60, "s");
 }
 
 }  // namespace
 
-int RunTrainCommand(const TrainFlags& flags) {
-  if (flags.mode != "local") {
-    return Fail(
-        absl::StrCat("unknown --mode='", flags.mode, "'; available: local"));
+int RunTrainCommand(const TrainRequest& request) {
+  pb::RunConfig given;
+  LocalTrainingConfig local;
+  if (!request.resume.empty()) {
+    if (!request.config_file.empty() || !request.run_dir.empty()) {
+      return Fail(
+          "--resume takes the run directory's own config; drop "
+          "--config and --run_dir");
+    }
+    if (absl::Status status = CheckNoOverrides(request.flags); !status.ok()) {
+      return Fail(status.message());
+    }
+    absl::StatusOr<pb::RunConfig> saved =
+        ReadRunConfigFile(request.resume + "/config.json");
+    if (!saved.ok()) return Fail(saved.status().message());
+    given = *saved;
+  } else {
+    absl::StatusOr<pb::RunConfig> merged = MergeFlags(request);
+    if (!merged.ok()) return Fail(merged.status().message());
+    given = *merged;
   }
-  if (flags.algo != "ppo") {
-    return Fail(
-        absl::StrCat("unknown --algo='", flags.algo, "'; available: ppo"));
-  }
-  if (flags.steps < 1 || flags.envs < 1 || flags.horizon < 1) {
-    return Fail("--steps, --envs and --horizon must be >= 1");
-  }
-  absl::StatusOr<Statistic> statistic = ParseStatistic(flags.estimator);
-  if (!statistic.ok()) {
-    return Fail(absl::StrCat("--estimator: ", statistic.status().message()));
-  }
-  LocalTrainingConfig config;
-  config.env = flags.env;
-  config.num_envs = flags.envs;
-  config.total_env_steps = flags.steps;
-  config.seed = flags.seed;
-  config.learner.horizon = flags.horizon;
-  config.learner.advantage.statistic = *statistic;
-  config.learner.advantage.rho = flags.rho;
-  config.learner.advantage.ensemble = flags.ensemble;
-  if (absl::Status status = config.learner.advantage.Validate(); !status.ok()) {
-    return Fail(std::string(status.message()));
-  }
+  absl::StatusOr<pb::RunConfig> config = ResolveRunConfig(given);
+  if (!config.ok()) return Fail(config.status().message());
+  local = ToLocalTrainingConfig(*config);
+  local.config_json = RunConfigToJson(*config);
+  local.run_dir = request.resume.empty() ? request.run_dir : request.resume;
+  local.resume = !request.resume.empty();
+  local.checkpoint_every = config->checkpoint_every();
+  local.keep_checkpoints = config->keep_checkpoints();
+
   at::set_num_threads(1);
   std::printf(
-      "training %s with %s, estimator %s (rho %g, ensemble %s), "
-      "%ld steps, seed %lu\n",
-      flags.env.c_str(), flags.algo.c_str(), flags.estimator.c_str(), flags.rho,
-      absl::StrJoin(flags.ensemble, ",").c_str(),
-      static_cast<long>(flags.steps), static_cast<unsigned long>(flags.seed));
-  const auto start = std::chrono::steady_clock::now();
-  double last_mean = std::nan("");
-  int64_t last_steps = 0;
-  const absl::Status status = RunLocalTraining(
-      config, [&](const UpdateStats& stats, double mean_return) {
-        const double seconds = std::chrono::duration<double>(
-                                   std::chrono::steady_clock::now() - start)
-                                   .count();
-        last_mean = mean_return;
-        last_steps = stats.env_steps;
+      "%s %s with %s, estimator %s (rho %g, ensemble %s), %ld steps, seed "
+      "%lu%s%s\n",
+      local.resume ? "resuming" : "training", config->env().c_str(),
+      config->algo().c_str(), config->estimator().c_str(), config->rho(),
+      absl::StrJoin(config->ensemble(), ",").c_str(),
+      static_cast<long>(config->steps()),
+      static_cast<unsigned long>(config->seed()),
+      local.run_dir.empty() ? "" : ", run directory ", local.run_dir.c_str());
+  std::fflush(stdout);
+  const bool terminal = ::isatty(STDOUT_FILENO) == 1;
+  ProgressRow last;
+  last.mean_return = std::nan("");
+  const absl::Status status =
+      RunLocalTraining(local, [&](const ProgressRow& progress) {
+        last = progress;
+        if (!terminal) return true;
+        const double remaining = (config->steps() - progress.stats.env_steps) /
+                                 progress.steps_per_second;
         std::printf(
-            "update %3ld steps %7ld  return(last100) %8.1f  policy_loss %7.4f "
-            " value_loss %8.3f  entropy %6.3f  kl %.4f  clip %.3f  "
-            "biased %.2f  sps %.0f\n",
-            static_cast<long>(stats.policy_version),
-            static_cast<long>(stats.env_steps), mean_return,
-            stats.ppo.policy_loss, stats.ppo.value_loss, stats.ppo.entropy,
-            stats.ppo.approx_kl, stats.ppo.clip_fraction, stats.biased_fraction,
-            stats.env_steps / seconds);
+            "\r\033[Kupdate %ld  steps %ld/%ld  %.0f steps/s  "
+            "return(last100) %.1f  ETA %s",
+            static_cast<long>(progress.stats.policy_version),
+            static_cast<long>(progress.stats.env_steps),
+            static_cast<long>(config->steps()), progress.steps_per_second,
+            progress.mean_return, Duration(remaining).c_str());
         std::fflush(stdout);
+        return true;
       });
-  if (!status.ok()) return Fail(std::string(status.message()));
+  if (terminal) std::printf("\n");
+  if (!status.ok()) return Fail(status.message());
   std::printf(
       "RESULT train env=%s algo=%s estimator=%s rho=%g steps=%ld "
-      "mean_return=%.1f\n",
-      flags.env.c_str(), flags.algo.c_str(), flags.estimator.c_str(), flags.rho,
-      static_cast<long>(last_steps), last_mean);
+      "mean_return=%.1f elapsed_s=%.1f sps=%.0f\n",
+      config->env().c_str(), config->algo().c_str(),
+      config->estimator().c_str(), config->rho(),
+      static_cast<long>(last.stats.env_steps), last.mean_return,
+      last.elapsed_seconds, last.steps_per_second);
   return 0;
 }
 

@@ -1,29 +1,24 @@
 #ifndef VANTAGE_DEPLOY_CLI_TRAIN_COMMAND_H_
 #define VANTAGE_DEPLOY_CLI_TRAIN_COMMAND_H_
 
-#include <cstdint>
 #include <string>
-#include <vector>
+
+#include "proto/run_config.pb.h"
 
 namespace vantage {
 
-struct TrainFlags {
-  std::string mode = "local";
-  std::string env = "InvertedPendulum";
-  std::string algo = "ppo";
-  std::string estimator = "maxabs";
-  double rho = 0.4;
-  std::vector<int64_t> ensemble = {1, 16, 64, 2048};
-  int64_t steps = 150000;
-  uint64_t seed = 0;
-  int envs = 1;
-  int64_t horizon = 2048;
+struct TrainRequest {
+  // The fields set by flags given on the command line.
+  pb::RunConfig flags;
+  std::string config_file;  // --config: JSON RunConfig under the flags
+  std::string run_dir;      // --run_dir: where the run is recorded
+  std::string resume;       // --resume: a run directory to continue
 };
 
-// `vantage train`: one progress line per update and a final
-// `RESULT train ... mean_return=<last 100 episodes>` line. Bad flags: one
-// line on stderr, exit code 2.
-int RunTrainCommand(const TrainFlags& flags);
+// `vantage train`: a progress line while a terminal watches, a final
+// `RESULT train ... mean_return=<last 100 episodes>` line. Bad flags or
+// files: one line on stderr, exit code 2.
+int RunTrainCommand(const TrainRequest& request);
 
 }  // namespace vantage
 

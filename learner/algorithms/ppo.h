@@ -1,13 +1,16 @@
 #ifndef VANTAGE_LEARNER_ALGORITHMS_PPO_H_
 #define VANTAGE_LEARNER_ALGORITHMS_PPO_H_
 
-#include <torch/optim/adam.h>
-
 #include <memory>
-#include <random>
+#include <vector>
 
 #include "absl/status/status.h"
 #include "common/nn/networks.h"
+#include "learner/algorithms/policy_updater.h"
+
+namespace torch::optim {
+class Adam;
+}  // namespace torch::optim
 
 namespace vantage {
 
@@ -16,7 +19,7 @@ struct PpoConfig {
   int epochs = 10;
   int minibatches = 32;
   double clip = 0.2;
-  double learning_rate = 3e-4;
+  double learning_rate = 3e-4;  // decays linearly to 0 over the run
   double max_grad_norm = 0.5;
   double value_coef = 0.5;
   double entropy_coef = 0.0;
@@ -25,30 +28,18 @@ struct PpoConfig {
   absl::Status Validate() const;
 };
 
-struct PpoStats {
-  double policy_loss = 0.0;
-  double value_loss = 0.0;
-  double entropy = 0.0;
-  double approx_kl = 0.0;
-  double clip_fraction = 0.0;
-};
-
-// One PPO update over a batch: `epochs` passes of shuffled minibatches, a
-// single Adam over the policy and value parameters, the gradient clipped to
-// max_grad_norm. The policy loss takes the rho-mixed advantages, the value
-// loss the normal targets V + GAE.
-class PpoUpdater {
+// PPO: `epochs` passes of shuffled minibatches, one Adam (eps 1e-5) over
+// the policy and value parameters, the gradient norm clipped. The ratio's
+// denominator is the behaviour log-probability carried with the segment.
+class PpoUpdater : public PolicyUpdater {
  public:
   PpoUpdater(PolicyNetwork policy, ValueNetwork value, const PpoConfig& config);
+  ~PpoUpdater() override;
 
-  // observations [B, obs] (normalised), actions [B, act], the others [B].
-  // `learning_rate` overrides the configured one (linear decay).
-  PpoStats Update(const at::Tensor& observations, const at::Tensor& actions,
-                  const at::Tensor& behaviour_log_probs,
-                  const at::Tensor& advantages, const at::Tensor& returns,
-                  double learning_rate, std::mt19937_64& rng);
-
-  torch::optim::Adam& optimizer() { return *optimizer_; }
+  AlgorithmStats Update(const UpdateBatch& batch, double progress,
+                        std::mt19937_64& rng) override;
+  void Save(torch::serialize::OutputArchive& archive) const override;
+  absl::Status Load(torch::serialize::InputArchive& archive) override;
 
  private:
   PolicyNetwork policy_;

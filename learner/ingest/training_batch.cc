@@ -67,4 +67,19 @@ absl::StatusOr<TrainingBatch> AssembleBatch(
   return batch;
 }
 
+UpdateBatch MakeUpdateBatch(
+    const TrainingBatch& batch, const Advantages& advantages,
+    absl::FunctionRef<at::Tensor(const at::Tensor&)> normalize) {
+  UpdateBatch update;
+  update.horizon = batch.observations.size(0);
+  update.streams = batch.observations.size(1);
+  const int64_t samples = update.horizon * update.streams;
+  update.observations = normalize(batch.observations.reshape({samples, -1}));
+  update.actions = batch.actions.reshape({samples, -1});
+  update.behaviour_log_probs = batch.behaviour_log_probs.reshape({samples});
+  update.advantages = advantages.mixed.reshape({samples});
+  update.returns = advantages.returns.reshape({samples});
+  return update;
+}
+
 }  // namespace vantage

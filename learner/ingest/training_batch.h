@@ -8,6 +8,7 @@
 #include "absl/functional/function_ref.h"
 #include "absl/status/statusor.h"
 #include "common/advantage/advantage.h"
+#include "learner/algorithms/policy_updater.h"
 #include "learner/ingest/rollout_stitcher.h"
 
 namespace vantage {
@@ -30,6 +31,14 @@ struct TrainingBatch {
 absl::StatusOr<TrainingBatch> AssembleBatch(
     const std::vector<Rollout>& rollouts,
     absl::FunctionRef<at::Tensor(const at::Tensor&)> values_of);
+
+// What the algorithm trains on, flattened time-major: the policy gets the
+// rho-mixed advantages, the critic ALWAYS the normal targets V + GAE
+// (whatever rho is). `normalize` maps raw observations to the network's
+// inputs.
+UpdateBatch MakeUpdateBatch(
+    const TrainingBatch& batch, const Advantages& advantages,
+    absl::FunctionRef<at::Tensor(const at::Tensor&)> normalize);
 
 }  // namespace vantage
 

@@ -2,44 +2,157 @@
 
 #include <ATen/Parallel.h>
 
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
 #include <vector>
 
+#include "absl/strings/str_join.h"
+#include "absl/strings/str_split.h"
+#include "gmock/gmock.h"
 #include "gtest/gtest.h"
+#include "learner/checkpoint.h"
 
 namespace vantage {
 namespace {
 
-std::vector<double> Trace(uint64_t seed) {
-  LocalTrainingConfig config;
-  config.env = "Hopper";
-  config.num_envs = 2;
-  config.total_env_steps = 3 * 2 * 256;
-  config.seed = seed;
-  config.learner.horizon = 256;
-  config.learner.ppo.minibatches = 8;
-  config.learner.ppo.epochs = 2;
-  config.learner.advantage.statistic = *ParseStatistic("max");
-  config.learner.advantage.rho = 0.5;
-  std::vector<double> trace;
-  const absl::Status status =
-      RunLocalTraining(config, [&](const UpdateStats& stats, double mean) {
-        trace.insert(trace.end(),
-                     {stats.ppo.policy_loss, stats.ppo.value_loss,
-                      stats.ppo.entropy, stats.ppo.approx_kl,
-                      stats.biased_fraction, stats.mean_abs_bias, mean});
-      });
-  EXPECT_TRUE(status.ok()) << status;
-  return trace;
+constexpr int64_t kHorizon = 128;
+constexpr int kEnvs = 2;
+constexpr int kUpdates = 6;
+
+// A fresh, empty directory under the test's temporary directory.
+std::string FreshDirectory(const std::string& name) {
+  const std::string path = std::string(::testing::TempDir()) + "/" + name;
+  std::filesystem::remove_all(path);
+  return path;
 }
 
-// Local mode is deterministic: the same seed repeats every statistic
-// exactly, another seed does not.
-TEST(LocalTrainingTest, SameSeedSameRun) {
+LocalTrainingConfig SmallRun(const std::string& algorithm, uint64_t seed,
+                             const std::string& run_dir) {
+  // A2C's rollouts are 5n steps (n = 4 here).
+  const int64_t horizon = algorithm == "a2c" ? 20 : kHorizon;
+  LocalTrainingConfig config;
+  config.env = "Hopper";
+  config.num_envs = kEnvs;
+  config.total_env_steps = kUpdates * kEnvs * horizon;
+  config.seed = seed;
+  config.learner.horizon = horizon;
+  config.learner.algorithm.name = algorithm;
+  config.learner.algorithm.ppo.minibatches = 8;
+  config.learner.algorithm.ppo.epochs = 2;
+  config.learner.algorithm.a2c.minibatches = 4;
+  config.learner.advantage.statistic = *ParseStatistic("max");
+  config.learner.advantage.rho = 0.5;
+  // Reward scaling carries state across updates (per-stream returns), so
+  // the resume tests cover it.
+  config.learner.scale_rewards = true;
+  config.run_dir = run_dir;
+  config.config_json = "{}";
+  config.checkpoint_every = 2;
+  return config;
+}
+
+// progress.csv without the wall-clock columns (the last two).
+std::vector<std::string> DeterministicProgress(const std::string& run_dir) {
+  std::ifstream file(run_dir + "/progress.csv");
+  std::vector<std::string> rows;
+  std::string line;
+  while (std::getline(file, line)) {
+    std::vector<std::string> fields = absl::StrSplit(line, ',');
+    fields.resize(fields.size() - 2);
+    rows.push_back(absl::StrJoin(fields, ","));
+  }
+  return rows;
+}
+
+// Runs to the end, or stops after update `stop_after` like a killed run.
+void Train(const LocalTrainingConfig& config, int stop_after = kUpdates) {
+  const absl::Status status =
+      RunLocalTraining(config, [&](const ProgressRow& row) {
+        return row.stats.policy_version < stop_after;
+      });
+  ASSERT_TRUE(status.ok()) << status;
+}
+
+TEST(LocalTrainingTest, SameSeedSameProgressCsv) {
   at::set_num_threads(1);
-  const std::vector<double> first = Trace(4);
-  ASSERT_EQ(first.size(), 3u * 7);
-  EXPECT_EQ(first, Trace(4));
-  EXPECT_NE(first, Trace(5));
+  const std::string a = FreshDirectory("same_seed_a");
+  const std::string b = FreshDirectory("same_seed_b");
+  const std::string c = FreshDirectory("other_seed");
+  Train(SmallRun("ppo", 4, a));
+  Train(SmallRun("ppo", 4, b));
+  Train(SmallRun("ppo", 5, c));
+  const std::vector<std::string> first = DeterministicProgress(a);
+  ASSERT_EQ(first.size(), 1u + kUpdates);
+  EXPECT_EQ(first[0],
+            "env_steps,updates,policy_version,episodes,mean_return,"
+            "policy_loss,value_loss,entropy,approx_kl,clip_fraction,"
+            "explained_variance,biased_fraction,mean_abs_bias,"
+            "rejected_segments");
+  EXPECT_EQ(first, DeterministicProgress(b));
+  EXPECT_NE(first, DeterministicProgress(c));
+  // One row per update, steps counted exactly.
+  EXPECT_THAT(first[1], ::testing::StartsWith("256,1,1,"));
+  EXPECT_THAT(first[kUpdates], ::testing::StartsWith("1536,6,6,"));
+}
+
+TEST(LocalTrainingTest, RefusesADirectoryThatHoldsARun) {
+  const std::string dir = FreshDirectory("taken");
+  Train(SmallRun("ppo", 1, dir), /*stop_after=*/1);
+  const absl::Status status = RunLocalTraining(
+      SmallRun("ppo", 1, dir), [](const ProgressRow&) { return true; });
+  EXPECT_EQ(status.code(), absl::StatusCode::kAlreadyExists);
+  EXPECT_THAT(std::string(status.message()), ::testing::HasSubstr("--resume"));
+}
+
+class ResumeTest : public ::testing::TestWithParam<std::string> {};
+
+// A run killed after update 5 (its last checkpoint is from update 4, and
+// progress.csv already has row 5) and resumed gives the uninterrupted
+// run's progress.csv, row for row.
+TEST_P(ResumeTest, ResumedRunEqualsUninterruptedRun) {
+  at::set_num_threads(1);
+  const std::string whole = FreshDirectory("whole_" + GetParam());
+  const std::string broken = FreshDirectory("broken_" + GetParam());
+  Train(SmallRun(GetParam(), 7, whole));
+  Train(SmallRun(GetParam(), 7, broken), /*stop_after=*/5);
+  EXPECT_EQ(DeterministicProgress(broken).size(), 1u + 5);
+  LocalTrainingConfig resume = SmallRun(GetParam(), 7, broken);
+  resume.resume = true;
+  Train(resume);
+  EXPECT_EQ(DeterministicProgress(broken), DeterministicProgress(whole));
+  // Checkpoints at 2, 4 and 6 (the end); the newest 3 are kept.
+  EXPECT_EQ(ListCheckpoints(broken + "/checkpoints").size(), 3u);
+}
+
+INSTANTIATE_TEST_SUITE_P(Algorithms, ResumeTest,
+                         ::testing::Values("ppo", "a2c", "trpo"));
+
+// A damaged newest checkpoint is reported and skipped: the run continues
+// from the one before it and still ends where the uninterrupted run did.
+TEST(LocalTrainingTest, ResumeSkipsADamagedNewestCheckpoint) {
+  at::set_num_threads(1);
+  const std::string whole = FreshDirectory("whole_damaged");
+  const std::string broken = FreshDirectory("broken_damaged");
+  Train(SmallRun("ppo", 8, whole));
+  Train(SmallRun("ppo", 8, broken), /*stop_after=*/5);
+  const std::string newest = CheckpointPath(broken + "/checkpoints", 4);
+  ASSERT_TRUE(std::filesystem::exists(newest));
+  std::ofstream(newest, std::ios::trunc) << "not a checkpoint";
+  LocalTrainingConfig resume = SmallRun("ppo", 8, broken);
+  resume.resume = true;
+  Train(resume);
+  EXPECT_EQ(DeterministicProgress(broken), DeterministicProgress(whole));
+}
+
+TEST(LocalTrainingTest, ResumeWithoutCheckpointsIsAnError) {
+  const std::string dir = FreshDirectory("no_checkpoints");
+  LocalTrainingConfig config = SmallRun("ppo", 1, dir);
+  config.resume = true;
+  EXPECT_EQ(
+      RunLocalTraining(config, [](const ProgressRow&) { return true; }).code(),
+      absl::StatusCode::kNotFound);
 }
 
 }  // namespace

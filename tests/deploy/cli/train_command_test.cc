@@ -1,3 +1,4 @@
+#include <filesystem>
 #include <string>
 
 #include "gmock/gmock.h"
@@ -8,31 +9,109 @@ namespace vantage {
 namespace {
 
 using ::testing::HasSubstr;
+using ::testing::Not;
 
-TEST(TrainCommandTest, ShortRunPrintsProgressAndResult) {
-  const Outcome outcome =
-      RunVantage("train --steps=256 --horizon=128 --envs=2 --seed=3");
+std::string FreshDirectory(const std::string& name) {
+  const std::string path = TempPath(name);
+  std::filesystem::remove_all(path);
+  return path;
+}
+
+TEST(TrainCommandTest, ShortRunWritesARunDirectory) {
+  const std::string run = FreshDirectory("cli_run");
+  const Outcome outcome = RunVantage(
+      "train --steps=512 --horizon=128 --envs=2 --seed=3 --checkpoint_every=1 "
+      "--run_dir=" +
+      run);
   ASSERT_EQ(outcome.exit_code, 0) << outcome.err;
-  EXPECT_THAT(outcome.out, HasSubstr("update   1 steps     256"));
   EXPECT_THAT(outcome.out, HasSubstr("RESULT train env=InvertedPendulum "
                                      "algo=ppo estimator=maxabs rho=0.4 "
-                                     "steps=256"));
+                                     "steps=512"));
+  // Not a terminal: no progress line.
+  EXPECT_THAT(outcome.out, Not(HasSubstr("ETA")));
+  const std::string progress = ReadFile(run + "/progress.csv");
+  EXPECT_THAT(progress, HasSubstr("\n256,1,1,"));
+  EXPECT_THAT(progress, HasSubstr("\n512,2,2,"));
+  // The resolved config has every field.
+  const std::string config = ReadFile(run + "/config.json");
+  EXPECT_THAT(config, HasSubstr("\"minibatches\": 32"));
+  EXPECT_THAT(config, HasSubstr("\"gae_lambda\": 0.95"));
+  EXPECT_THAT(config, HasSubstr("\"horizon\": \"128\""));
+  EXPECT_TRUE(
+      std::filesystem::exists(run + "/checkpoints/checkpoint-00000002.pt"));
+
+  // The trained policy acts in `rollout`.
+  const Outcome rollout =
+      RunVantage("rollout --episodes=2 --checkpoint=" + run);
+  ASSERT_EQ(rollout.exit_code, 0) << rollout.err;
+  EXPECT_THAT(rollout.out, HasSubstr("version 2, deterministic actions"));
+  EXPECT_THAT(rollout.out,
+              HasSubstr("RESULT rollout env=InvertedPendulum obs_dim=4 "
+                        "act_dim=1 episodes=2"));
+  const Outcome wrong_env =
+      RunVantage("rollout --env=Hopper --checkpoint=" + run);
+  EXPECT_EQ(wrong_env.exit_code, 2);
+  EXPECT_THAT(wrong_env.err, HasSubstr("trained on InvertedPendulum"));
+
+  // The run's config.json is a valid --config; flags override it.
+  const std::string again = FreshDirectory("cli_again");
+  const Outcome rerun = RunVantage(
+      "train --config=" + run + "/config.json --steps=256 --run_dir=" + again);
+  ASSERT_EQ(rerun.exit_code, 0) << rerun.err;
+  EXPECT_THAT(rerun.out, HasSubstr("steps=256"));
+  EXPECT_THAT(ReadFile(again + "/config.json"), HasSubstr("\"seed\": \"3\""));
+}
+
+TEST(TrainCommandTest, ResumeContinuesTheRun) {
+  const std::string run = FreshDirectory("cli_resume");
+  const std::string config =
+      WriteTemp("resume.json",
+                R"({"steps": 768, "horizon": 128, "envs": 2, "algo": "trpo"})");
+  ASSERT_EQ(RunVantage("train --checkpoint_every=1 --config=" + config +
+                       " --run_dir=" + run)
+                .exit_code,
+            0);
+  // Changing a finished run's config on resume is refused...
+  const Outcome changed = RunVantage("train --rho=0.9 --resume=" + run);
+  EXPECT_EQ(changed.exit_code, 2);
+  EXPECT_THAT(changed.err, HasSubstr("drop --rho"));
+  // ... and resuming a finished run has nothing left to do.
+  const Outcome resumed = RunVantage("train --resume=" + run);
+  ASSERT_EQ(resumed.exit_code, 0) << resumed.err;
+  EXPECT_THAT(resumed.out, HasSubstr("resuming InvertedPendulum with trpo"));
 }
 
 TEST(TrainCommandTest, BadFlagsAreOneLineErrors) {
-  const std::pair<const char*, const char*> cases[] = {
-      {"train --algo=sac", "unknown --algo='sac'; available: ppo"},
-      {"train --mode=cluster", "unknown --mode='cluster'"},
+  const std::string taken = FreshDirectory("cli_taken");
+  ASSERT_EQ(
+      RunVantage("train --steps=10 --horizon=10 --run_dir=" + taken).exit_code,
+      0);
+  const std::pair<std::string, std::string> cases[] = {
+      {"train --algo=sac",
+       "--algo: unknown algorithm 'sac'; available: a2c, ppo, trpo"},
+      {"train --mode=cluster", "--mode: unknown mode 'cluster'"},
       {"train --estimator=median", "unknown statistic 'median'"},
       {"train --rho=1.5", "rho must be in [0, 1]"},
       {"train --ensemble=1,x", "--ensemble entry 'x'"},
-      {"train --steps=0", "must be >= 1"},
+      {"train --steps=0", "--steps must be >= 1"},
+      {"train --envs=0", "--envs must be in [1, 4096]"},
+      {"train --algo=a2c --horizon=12", "--horizon must be a multiple"},
+      {"train --hidden=64,0", "--hidden sizes must be >= 1"},
       {"train --env=Nope --steps=10", "unknown environment 'Nope'"},
+      {"train --config=/no/such.json", "cannot read config file /no/such.json"},
+      {"train --config=" + WriteTemp("bad.json", R"({"rhoo": 1})"), "rhoo"},
+      {"train --config=" + WriteTemp("typed.json", R"({"steps": "many"})"),
+       "steps"},
+      {"train --resume=/no/such/run", "/no/such/run/config.json"},
+      {"train --steps=10 --run_dir=" + taken, "already holds a run"},
+      {"rollout --checkpoint=/no/such/run", "no checkpoint file"},
   };
   for (const auto& [args, message] : cases) {
     const Outcome outcome = RunVantage(args);
     EXPECT_EQ(outcome.exit_code, 2) << args;
     EXPECT_THAT(outcome.err, HasSubstr(message)) << args;
+    EXPECT_EQ(std::count(outcome.err.begin(), outcome.err.end(), '\n'), 1)
+        << args << ": " << outcome.err;
   }
 }
 

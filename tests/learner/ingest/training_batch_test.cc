@@ -79,5 +79,44 @@ TEST(TrainingBatchTest, RefusesMixedLengthsAndEmptyBatches) {
               ::testing::HasSubstr("cannot share a batch"));
 }
 
+// With rho = 1 every policy sample uses the biased estimate, and still the
+// critic's targets are V + GAE, not V + biased.
+TEST(MakeUpdateBatchTest, CriticTargetsStayVPlusGaeAtRhoOne) {
+  constexpr int64_t T = 40, N = 3;
+  at::manual_seed(2);
+  TrainingBatch batch;
+  AdvantageInputs& in = batch.advantage_inputs;
+  in.rewards = at::randn({T, N});
+  in.values = at::randn({T, N});
+  in.terminated = at::rand({T, N}) < 0.05;
+  in.truncated =
+      at::logical_and(at::rand({T, N}) < 0.05, at::logical_not(in.terminated));
+  in.truncation_values = at::randn({T, N});
+  in.last_values = at::randn({N});
+  batch.observations = at::randn({T, N, 2});
+  batch.actions = at::randn({T, N, 1});
+  batch.behaviour_log_probs = at::randn({T, N});
+  AdvantageConfig config;
+  config.statistic = *ParseStatistic("max");
+  config.ensemble = {1, 4, 16};
+  config.rho = 1.0;
+  std::mt19937_64 rng(1);
+  const Advantages advantages = *ComputeAdvantages(in, config, rng);
+  const UpdateBatch update = MakeUpdateBatch(
+      batch, advantages, [](const at::Tensor& x) { return x * 2; });
+  EXPECT_EQ(update.horizon, T);
+  EXPECT_EQ(update.streams, N);
+  const at::Tensor gae = *ComputeGae(in, config.gamma, config.lambda);
+  const at::Tensor biased = *ComputeBiasedAdvantage(in, config);
+  EXPECT_TRUE(update.advantages.equal(biased.reshape({T * N})));
+  EXPECT_TRUE(update.returns.equal((in.values + gae).reshape({T * N})));
+  EXPECT_FALSE(update.returns.equal((in.values + biased).reshape({T * N})));
+  // Time-major rows: row t * N + n is step t of stream n.
+  EXPECT_TRUE(
+      update.observations[2 * N + 1].equal(batch.observations[2][1] * 2));
+  EXPECT_TRUE(update.behaviour_log_probs[2 * N + 1].equal(
+      batch.behaviour_log_probs[2][1]));
+}
+
 }  // namespace
 }  // namespace vantage

@@ -1,0 +1,133 @@
+#include "deploy/run_directory.h"
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <vector>
+
+#include "absl/strings/numbers.h"
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
+#include "absl/strings/str_join.h"
+#include "absl/strings/str_split.h"
+
+namespace vantage {
+namespace {
+
+std::string Number(double value) {
+  return std::isnan(value) ? "" : absl::StrFormat("%.9g", value);
+}
+
+absl::Status WriteFileAtomically(const std::string& path,
+                                 const std::string& text) {
+  const std::string temporary = path + ".tmp";
+  {
+    std::ofstream file(temporary, std::ios::trunc);
+    file << text;
+    file.flush();
+    if (!file) {
+      return absl::InternalError(absl::StrCat("cannot write ", temporary));
+    }
+  }
+  if (std::rename(temporary.c_str(), path.c_str()) != 0) {
+    return absl::InternalError(
+        absl::StrCat("cannot rename ", temporary, " to ", path));
+  }
+  return absl::OkStatus();
+}
+
+}  // namespace
+
+std::string FormatProgressRow(const ProgressRow& row) {
+  const UpdateStats& s = row.stats;
+  return absl::StrJoin(
+      {absl::StrCat(s.env_steps), absl::StrCat(s.policy_version),
+       absl::StrCat(s.policy_version), absl::StrCat(s.episodes),
+       Number(row.mean_return), Number(s.algorithm.policy_loss),
+       Number(s.algorithm.value_loss), Number(s.algorithm.entropy),
+       Number(s.algorithm.approx_kl), Number(s.algorithm.clip_fraction),
+       Number(s.explained_variance), Number(s.biased_fraction),
+       Number(s.mean_abs_bias), absl::StrCat(s.rejected_segments),
+       absl::StrFormat("%.3f", row.elapsed_seconds),
+       absl::StrFormat("%.1f", row.steps_per_second)},
+      ",");
+}
+
+absl::StatusOr<RunDirectory> RunDirectory::Create(
+    const std::string& path, const std::string& config_json) {
+  RunDirectory run(path);
+  std::error_code error;
+  std::filesystem::create_directories(run.checkpoint_directory(), error);
+  if (error) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "cannot create run directory ", path, ": ", error.message()));
+  }
+  if (std::filesystem::exists(run.config_path())) {
+    return absl::AlreadyExistsError(absl::StrCat(
+        path, " already holds a run; continue it with --resume=", path,
+        " or choose another --run_dir"));
+  }
+  if (absl::Status status = WriteFileAtomically(
+          run.progress_path(), absl::StrCat(kProgressColumns, "\n"));
+      !status.ok()) {
+    return status;
+  }
+  if (absl::Status status = WriteFileAtomically(run.config_path(), config_json);
+      !status.ok()) {
+    return status;
+  }
+  return run;
+}
+
+absl::StatusOr<RunDirectory> RunDirectory::Open(const std::string& path) {
+  RunDirectory run(path);
+  if (!std::filesystem::is_regular_file(run.config_path())) {
+    return absl::NotFoundError(
+        absl::StrCat(path, " is not a run directory (no config.json)"));
+  }
+  return run;
+}
+
+std::string RunDirectory::config_path() const { return path_ + "/config.json"; }
+std::string RunDirectory::progress_path() const {
+  return path_ + "/progress.csv";
+}
+std::string RunDirectory::checkpoint_directory() const {
+  return path_ + "/checkpoints";
+}
+
+absl::Status RunDirectory::TruncateProgress(int64_t updates) const {
+  std::ifstream file(progress_path());
+  std::string text = absl::StrCat(kProgressColumns, "\n");
+  std::string line;
+  bool header = true;
+  while (std::getline(file, line)) {
+    if (header) {
+      header = false;
+      continue;
+    }
+    const std::vector<absl::string_view> fields = absl::StrSplit(line, ',');
+    int64_t row_updates = 0;
+    if (fields.size() < 2 || !absl::SimpleAtoi(fields[1], &row_updates)) {
+      break;  // a torn last line from a crash
+    }
+    if (row_updates > updates) break;
+    absl::StrAppend(&text, line, "\n");
+  }
+  return WriteFileAtomically(progress_path(), text);
+}
+
+absl::Status RunDirectory::AppendProgress(const ProgressRow& row) const {
+  std::ofstream file(progress_path(), std::ios::app);
+  file << FormatProgressRow(row) << "\n";
+  file.flush();
+  if (!file) {
+    return absl::InternalError(
+        absl::StrCat("cannot append to ", progress_path()));
+  }
+  return absl::OkStatus();
+}
+
+}  // namespace vantage

@@ -1,0 +1,98 @@
+#include "learner/algorithms/a2c.h"
+
+#include <ATen/ATen.h>
+#include <torch/optim/rmsprop.h>
+
+#include <algorithm>
+#include <limits>
+
+#include "learner/algorithms/gradient_step.h"
+
+namespace vantage {
+
+absl::Status A2cConfig::Validate() const {
+  if (steps_per_minibatch < 1 || minibatches < 1) {
+    return absl::InvalidArgumentError(
+        "a2c steps_per_minibatch and minibatches must be >= 1");
+  }
+  if (!(learning_rate > 0) || !(max_grad_norm > 0)) {
+    return absl::InvalidArgumentError(
+        "a2c learning rate and max_grad_norm must be > 0");
+  }
+  if (!(rmsprop_alpha > 0 && rmsprop_alpha < 1) || !(rmsprop_eps > 0)) {
+    return absl::InvalidArgumentError(
+        "a2c rmsprop alpha must be in (0, 1) and eps > 0");
+  }
+  if (!(value_coef >= 0) || !(entropy_coef >= 0)) {
+    return absl::InvalidArgumentError(
+        "a2c value and entropy coefficients must be >= 0");
+  }
+  return absl::OkStatus();
+}
+
+A2cUpdater::A2cUpdater(PolicyNetwork policy, ValueNetwork value,
+                       const A2cConfig& config)
+    : policy_(std::move(policy)),
+      value_(std::move(value)),
+      config_(config),
+      parameters_(JointParameters(*policy_, *value_)),
+      optimizer_(std::make_unique<torch::optim::RMSprop>(
+          parameters_, torch::optim::RMSpropOptions(config.learning_rate)
+                           .alpha(config.rmsprop_alpha)
+                           .eps(config.rmsprop_eps))) {}
+
+A2cUpdater::~A2cUpdater() = default;
+
+AlgorithmStats A2cUpdater::Update(const UpdateBatch& batch, double progress,
+                                  std::mt19937_64& /*rng*/) {
+  SetLearningRate(*optimizer_,
+                  config_.learning_rate * std::max(0.0, 1.0 - progress));
+  const int64_t rows = config_.steps_per_minibatch * batch.streams;
+  const int64_t size = batch.observations.size(0);
+  AlgorithmStats stats;
+  stats.clip_fraction = std::numeric_limits<double>::quiet_NaN();
+  int64_t count = 0;
+  for (int64_t begin = 0; begin + rows <= size; begin += rows) {
+    const at::Tensor obs = batch.observations.slice(0, begin, begin + rows);
+    const at::Tensor adv = batch.advantages.slice(0, begin, begin + rows);
+    const at::Tensor old_log_prob =
+        batch.behaviour_log_probs.slice(0, begin, begin + rows);
+    const at::Tensor output = policy_->forward(obs);
+    const at::Tensor log_prob =
+        policy_->LogProb(output, batch.actions.slice(0, begin, begin + rows));
+    const at::Tensor policy_loss = -(log_prob * adv).mean();
+    const at::Tensor entropy = policy_->Entropy(output).mean();
+    const at::Tensor value_loss =
+        ValueLoss(*value_, obs, batch.returns.slice(0, begin, begin + rows));
+    GradientStep(*optimizer_, parameters_,
+                 policy_loss + config_.value_coef * value_loss -
+                     config_.entropy_coef * entropy,
+                 config_.max_grad_norm);
+    stats.policy_loss += policy_loss.item<double>();
+    stats.value_loss += value_loss.item<double>();
+    stats.entropy += entropy.item<double>();
+    // Later minibatches act on an already-updated policy; this is how far
+    // it has moved from the behaviour policy (the same estimator as PPO's).
+    const at::Tensor log_ratio = log_prob.detach() - old_log_prob;
+    stats.approx_kl +=
+        ((at::exp(log_ratio) - 1) - log_ratio).mean().item<double>();
+    ++count;
+  }
+  if (count > 0) {
+    stats.policy_loss /= count;
+    stats.value_loss /= count;
+    stats.entropy /= count;
+    stats.approx_kl /= count;
+  }
+  return stats;
+}
+
+void A2cUpdater::Save(torch::serialize::OutputArchive& archive) const {
+  SaveOptimizer(*optimizer_, "rmsprop", archive);
+}
+
+absl::Status A2cUpdater::Load(torch::serialize::InputArchive& archive) {
+  return LoadOptimizer(*optimizer_, "rmsprop", archive);
+}
+
+}  // namespace vantage

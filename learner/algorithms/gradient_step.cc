@@ -1,0 +1,60 @@
+#include "learner/algorithms/gradient_step.h"
+
+#include <torch/nn/utils/clip_grad.h>
+#include <torch/optim/optimizer.h>
+#include <torch/serialize/archive.h>
+
+#include "absl/strings/str_cat.h"
+#include "learner/archive_io.h"
+
+namespace vantage {
+
+at::Tensor ValueLoss(ValueNetworkImpl& value, const at::Tensor& observations,
+                     const at::Tensor& targets) {
+  const at::Tensor error = value.forward(observations) - targets;
+  return 0.5 * (error * error).mean();
+}
+
+void GradientStep(torch::optim::Optimizer& optimizer,
+                  const std::vector<at::Tensor>& parameters,
+                  const at::Tensor& loss, double max_grad_norm) {
+  optimizer.zero_grad();
+  loss.backward();
+  torch::nn::utils::clip_grad_norm_(parameters, max_grad_norm);
+  optimizer.step();
+}
+
+void SetLearningRate(torch::optim::Optimizer& optimizer, double learning_rate) {
+  for (auto& group : optimizer.param_groups()) {
+    group.options().set_lr(learning_rate);
+  }
+}
+
+std::vector<at::Tensor> JointParameters(PolicyNetworkImpl& policy,
+                                        ValueNetworkImpl& value) {
+  std::vector<at::Tensor> parameters = policy.parameters();
+  for (const at::Tensor& p : value.parameters()) parameters.push_back(p);
+  return parameters;
+}
+
+void SaveOptimizer(const torch::optim::Optimizer& optimizer,
+                   const std::string& key,
+                   torch::serialize::OutputArchive& archive) {
+  torch::serialize::OutputArchive state;
+  optimizer.save(state);
+  archive.write(key, state);
+}
+
+absl::Status LoadOptimizer(torch::optim::Optimizer& optimizer,
+                           const std::string& key,
+                           torch::serialize::InputArchive& archive) {
+  return CatchTorchErrors(
+      absl::StrCat("optimiser state '", key, "' is missing or does not fit"),
+      [&] {
+        torch::serialize::InputArchive state;
+        archive.read(key, state);
+        optimizer.load(state);
+      });
+}
+
+}  // namespace vantage

@@ -1,0 +1,52 @@
+#ifndef VANTAGE_LEARNER_ALGORITHMS_GRADIENT_STEP_H_
+#define VANTAGE_LEARNER_ALGORITHMS_GRADIENT_STEP_H_
+
+// Pieces the first-order actor-critic algorithms (PPO, A2C) share.
+
+#include <ATen/core/Tensor.h>
+
+#include <string>
+#include <vector>
+
+#include "absl/status/status.h"
+#include "common/nn/networks.h"
+
+namespace torch::optim {
+class Optimizer;
+}  // namespace torch::optim
+namespace torch::serialize {
+class InputArchive;
+class OutputArchive;
+}  // namespace torch::serialize
+
+namespace vantage {
+
+// 0.5 * mean((V(s) - target)^2).
+at::Tensor ValueLoss(ValueNetworkImpl& value, const at::Tensor& observations,
+                     const at::Tensor& targets);
+
+// Zeroes the gradients, backpropagates `loss`, clips the global gradient
+// norm of `parameters` to `max_grad_norm` and steps.
+void GradientStep(torch::optim::Optimizer& optimizer,
+                  const std::vector<at::Tensor>& parameters,
+                  const at::Tensor& loss, double max_grad_norm);
+
+// Sets every parameter group's learning rate.
+void SetLearningRate(torch::optim::Optimizer& optimizer, double learning_rate);
+
+// The parameters of both networks, policy first (one optimiser over both).
+std::vector<at::Tensor> JointParameters(PolicyNetworkImpl& policy,
+                                        ValueNetworkImpl& value);
+
+// Checkpoint helpers: an optimiser's state under `key`. Loading a state
+// that does not fit the optimiser is an InvalidArgument error.
+void SaveOptimizer(const torch::optim::Optimizer& optimizer,
+                   const std::string& key,
+                   torch::serialize::OutputArchive& archive);
+absl::Status LoadOptimizer(torch::optim::Optimizer& optimizer,
+                           const std::string& key,
+                           torch::serialize::InputArchive& archive);
+
+}  // namespace vantage
+
+#endif  // VANTAGE_LEARNER_ALGORITHMS_GRADIENT_STEP_H_

@@ -1,0 +1,208 @@
+#include "learner/algorithms/trpo.h"
+
+#include <ATen/ATen.h>
+#include <torch/csrc/autograd/autograd.h>
+#include <torch/nn/utils/convert_parameters.h>
+#include <torch/optim/adam.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numeric>
+
+#include "learner/algorithms/conjugate_gradient.h"
+#include "learner/algorithms/gradient_step.h"
+
+namespace vantage {
+namespace {
+
+// Gradients of `parameters` as one vector; an unused parameter's is zero.
+at::Tensor FlatGradient(const at::Tensor& output,
+                        const std::vector<at::Tensor>& parameters,
+                        bool create_graph) {
+  const std::vector<at::Tensor> gradients = torch::autograd::grad(
+      {output}, parameters, /*grad_outputs=*/{}, /*retain_graph=*/create_graph,
+      create_graph, /*allow_unused=*/true);
+  std::vector<at::Tensor> flat;
+  flat.reserve(gradients.size());
+  for (size_t i = 0; i < gradients.size(); ++i) {
+    flat.push_back(gradients[i].defined() ? gradients[i].reshape({-1})
+                                          : at::zeros({parameters[i].numel()},
+                                                      parameters[i].options()));
+  }
+  return at::cat(flat);
+}
+
+// Writes `flat` into the parameters in place (they stay the same tensors,
+// so the published weights and the module keep referring to them).
+void AssignParameters(const at::Tensor& flat,
+                      const std::vector<at::Tensor>& parameters) {
+  at::NoGradGuard no_grad;
+  int64_t offset = 0;
+  for (const at::Tensor& p : parameters) {
+    const int64_t n = p.numel();
+    p.copy_(flat.slice(0, offset, offset + n).view_as(p));
+    offset += n;
+  }
+}
+
+}  // namespace
+
+absl::Status TrpoConfig::Validate() const {
+  if (!(max_kl > 0) || !(cg_damping >= 0)) {
+    return absl::InvalidArgumentError(
+        "trpo max_kl must be > 0 and cg_damping >= 0");
+  }
+  if (cg_iterations < 1 || line_search_steps < 1) {
+    return absl::InvalidArgumentError(
+        "trpo cg_iterations and line_search_steps must be >= 1");
+  }
+  if (!(value_learning_rate > 0) || value_epochs < 1 ||
+      value_minibatch_size < 1) {
+    return absl::InvalidArgumentError(
+        "trpo value learning rate must be > 0, value epochs and minibatch "
+        "size >= 1");
+  }
+  if (!(entropy_coef >= 0)) {
+    return absl::InvalidArgumentError("trpo entropy_coef must be >= 0");
+  }
+  return absl::OkStatus();
+}
+
+TrpoUpdater::TrpoUpdater(PolicyNetwork policy, ValueNetwork value,
+                         const TrpoConfig& config)
+    : policy_(std::move(policy)),
+      value_(std::move(value)),
+      config_(config),
+      policy_parameters_(policy_->parameters()),
+      value_parameters_(value_->parameters()),
+      value_optimizer_(std::make_unique<torch::optim::Adam>(
+          value_parameters_,
+          torch::optim::AdamOptions(config.value_learning_rate))) {}
+
+TrpoUpdater::~TrpoUpdater() = default;
+
+AlgorithmStats TrpoUpdater::Update(const UpdateBatch& batch,
+                                   double /*progress*/, std::mt19937_64& rng) {
+  at::Tensor advantages = batch.advantages;
+  if (config_.normalize_advantages) {
+    advantages = (advantages - advantages.mean()) / (advantages.std() + 1e-8);
+  }
+  AlgorithmStats stats;
+  stats.clip_fraction = std::numeric_limits<double>::quiet_NaN();
+  {
+    at::NoGradGuard no_grad;
+    stats.entropy = policy_->Entropy(policy_->forward(batch.observations))
+                        .mean()
+                        .item<double>();
+  }
+  double surrogate = 0.0;
+  stats.approx_kl = PolicyStep(batch, advantages, surrogate);
+  stats.policy_loss = -surrogate;
+  stats.value_loss = FitValue(batch, rng);
+  return stats;
+}
+
+double TrpoUpdater::PolicyStep(const UpdateBatch& batch,
+                               const at::Tensor& advantages,
+                               double& surrogate_after) {
+  PolicyNetworkImpl& policy = *policy_;
+  at::Tensor old_output;
+  at::Tensor old_log_std;
+  {
+    at::NoGradGuard no_grad;
+    old_output = policy.forward(batch.observations);
+    if (!policy.discrete()) old_log_std = policy.log_std().clone();
+  }
+  // Importance-weighted against the policy that acted (the actors' version
+  // may lag the learner's).
+  auto surrogate = [&]() {
+    const at::Tensor output = policy.forward(batch.observations);
+    const at::Tensor ratio = at::exp(policy.LogProb(output, batch.actions) -
+                                     batch.behaviour_log_probs);
+    return (ratio * advantages).mean() +
+           config_.entropy_coef * policy.Entropy(output).mean();
+  };
+  auto mean_kl = [&]() {
+    return policy
+        .Kl(old_output, old_log_std, policy.forward(batch.observations))
+        .mean();
+  };
+
+  const at::Tensor objective = surrogate();
+  const double objective_before = objective.item<double>();
+  surrogate_after = objective_before;
+  const at::Tensor gradient =
+      FlatGradient(objective, policy_parameters_, /*create_graph=*/false);
+  auto fisher_product = [&](const at::Tensor& v) {
+    const at::Tensor kl = mean_kl();
+    const at::Tensor kl_gradient =
+        FlatGradient(kl, policy_parameters_, /*create_graph=*/true);
+    const at::Tensor product =
+        FlatGradient((kl_gradient * v.detach()).sum(), policy_parameters_,
+                     /*create_graph=*/false);
+    return product.detach() + config_.cg_damping * v;
+  };
+  const at::Tensor direction = ConjugateGradient(
+      fisher_product, gradient.detach(), config_.cg_iterations);
+  const double curvature =
+      0.5 * (direction * fisher_product(direction)).sum().item<double>();
+  if (!(curvature > 0) || !std::isfinite(curvature)) return 0.0;
+  const at::Tensor full_step =
+      direction * std::sqrt(config_.max_kl / curvature);
+
+  const at::Tensor start =
+      torch::nn::utils::parameters_to_vector(policy_parameters_)
+          .detach()
+          .clone();
+  at::NoGradGuard no_grad;
+  double fraction = 1.0;
+  for (int i = 0; i < config_.line_search_steps; ++i, fraction *= 0.5) {
+    AssignParameters(start + fraction * full_step, policy_parameters_);
+    const double value = surrogate().item<double>();
+    const double kl = mean_kl().item<double>();
+    if (std::isfinite(value) && std::isfinite(kl) && kl <= config_.max_kl &&
+        value > objective_before) {
+      surrogate_after = value;
+      return kl;
+    }
+  }
+  AssignParameters(start, policy_parameters_);
+  return 0.0;
+}
+
+double TrpoUpdater::FitValue(const UpdateBatch& batch, std::mt19937_64& rng) {
+  const int64_t size = batch.observations.size(0);
+  const int64_t minibatch =
+      std::min<int64_t>(config_.value_minibatch_size, size);
+  std::vector<int64_t> order(size);
+  double total = 0.0;
+  int64_t count = 0;
+  for (int epoch = 0; epoch < config_.value_epochs; ++epoch) {
+    std::iota(order.begin(), order.end(), 0);
+    std::shuffle(order.begin(), order.end(), rng);
+    const at::Tensor permutation = at::tensor(order, at::kLong);
+    for (int64_t begin = 0; begin + minibatch <= size; begin += minibatch) {
+      const at::Tensor index = permutation.slice(0, begin, begin + minibatch);
+      const at::Tensor loss =
+          ValueLoss(*value_, batch.observations.index_select(0, index),
+                    batch.returns.index_select(0, index));
+      value_optimizer_->zero_grad();
+      loss.backward();
+      value_optimizer_->step();
+      total += loss.item<double>();
+      ++count;
+    }
+  }
+  return count > 0 ? total / count : 0.0;
+}
+
+void TrpoUpdater::Save(torch::serialize::OutputArchive& archive) const {
+  SaveOptimizer(*value_optimizer_, "value_adam", archive);
+}
+
+absl::Status TrpoUpdater::Load(torch::serialize::InputArchive& archive) {
+  return LoadOptimizer(*value_optimizer_, "value_adam", archive);
+}
+
+}  // namespace vantage

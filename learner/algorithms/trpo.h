@@ -1,0 +1,65 @@
+#ifndef VANTAGE_LEARNER_ALGORITHMS_TRPO_H_
+#define VANTAGE_LEARNER_ALGORITHMS_TRPO_H_
+
+#include <memory>
+#include <vector>
+
+#include "absl/status/status.h"
+#include "common/nn/networks.h"
+#include "learner/algorithms/policy_updater.h"
+
+namespace torch::optim {
+class Adam;
+}  // namespace torch::optim
+
+namespace vantage {
+
+// Defaults of the baselines' TRPO for MuJoCo.
+struct TrpoConfig {
+  double max_kl = 0.01;
+  int cg_iterations = 10;
+  double cg_damping = 0.1;
+  int line_search_steps = 10;  // step fractions 1, 1/2, 1/4, ...
+  double entropy_coef = 0.0;
+  bool normalize_advantages = true;  // over the batch, after rho mixing
+  // The value function is fitted by Adam on the targets V + GAE.
+  double value_learning_rate = 1e-3;
+  int value_epochs = 5;
+  int value_minibatch_size = 64;
+
+  absl::Status Validate() const;
+};
+
+// TRPO: the natural-gradient direction by conjugate gradient on
+// Fisher-vector products (Hessian of the mean KL, damped), scaled to the
+// trust region's edge, then a backtracking line search that accepts the
+// first step with mean KL(old || new) <= max_kl and a positive improvement
+// of the surrogate; if none qualifies the policy stays as it was.
+class TrpoUpdater : public PolicyUpdater {
+ public:
+  TrpoUpdater(PolicyNetwork policy, ValueNetwork value,
+              const TrpoConfig& config);
+  ~TrpoUpdater() override;
+
+  AlgorithmStats Update(const UpdateBatch& batch, double progress,
+                        std::mt19937_64& rng) override;
+  void Save(torch::serialize::OutputArchive& archive) const override;
+  absl::Status Load(torch::serialize::InputArchive& archive) override;
+
+ private:
+  // Returns the accepted step's mean KL (0 if the policy did not move).
+  double PolicyStep(const UpdateBatch& batch, const at::Tensor& advantages,
+                    double& surrogate_after);
+  double FitValue(const UpdateBatch& batch, std::mt19937_64& rng);
+
+  PolicyNetwork policy_;
+  ValueNetwork value_;
+  TrpoConfig config_;
+  std::vector<at::Tensor> policy_parameters_;
+  std::vector<at::Tensor> value_parameters_;
+  std::unique_ptr<torch::optim::Adam> value_optimizer_;
+};
+
+}  // namespace vantage
+
+#endif  // VANTAGE_LEARNER_ALGORITHMS_TRPO_H_
