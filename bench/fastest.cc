@@ -4,16 +4,28 @@
 
 namespace vantage {
 
+namespace {
+
+void ReportFastest(benchmark::internal::Benchmark* benchmark) {
+  benchmark->ReportAggregatesOnly(true)->ComputeStatistics(
+      "min", [](const std::vector<double>& times) {
+        return *std::min_element(times.begin(), times.end());
+      });
+}
+
+}  // namespace
+
 void UseFastestOfRepetitions(benchmark::internal::Benchmark* benchmark) {
-  benchmark->MinTime(0.05)
-      ->Repetitions(30)
-      ->ReportAggregatesOnly(true)
-      ->ComputeStatistics("min",
-                          [](const std::vector<double>& times) {
-                            return *std::min_element(times.begin(),
-                                                     times.end());
-                          })
-      ->Unit(benchmark::kMicrosecond);
+  benchmark->MinTime(0.05)->Repetitions(30)->Unit(benchmark::kMicrosecond);
+  ReportFastest(benchmark);
+}
+
+void UseFastestOfSingleRuns(benchmark::internal::Benchmark* benchmark,
+                            int repetitions) {
+  benchmark->Iterations(1)
+      ->Repetitions(repetitions)
+      ->Unit(benchmark::kMillisecond);
+  ReportFastest(benchmark);
 }
 
 void FastestCollector::ReportRuns(const std::vector<Run>& runs) {

@@ -18,6 +18,11 @@ namespace vantage {
 // "min" statistic.
 void UseFastestOfRepetitions(benchmark::internal::Benchmark* benchmark);
 
+// For work that takes long per iteration (a whole learner update): single
+// iterations, `repetitions` of them, the fastest kept.
+void UseFastestOfSingleRuns(benchmark::internal::Benchmark* benchmark,
+                            int repetitions);
+
 // Prints as the console reporter does and records each benchmark's fastest
 // repetition (seconds per iteration).
 class FastestCollector : public benchmark::ConsoleReporter {
