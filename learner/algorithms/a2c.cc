@@ -49,9 +49,7 @@ AlgorithmStats A2cUpdater::Update(const UpdateBatch& batch, double progress,
                   config_.learning_rate * std::max(0.0, 1.0 - progress));
   const int64_t rows = config_.steps_per_minibatch * batch.streams;
   const int64_t size = batch.observations.size(0);
-  AlgorithmStats stats;
-  stats.clip_fraction = std::numeric_limits<double>::quiet_NaN();
-  int64_t count = 0;
+  MeanStats stats;
   for (int64_t begin = 0; begin + rows <= size; begin += rows) {
     const at::Tensor obs = batch.observations.slice(0, begin, begin + rows);
     const at::Tensor adv = batch.advantages.slice(0, begin, begin + rows);
@@ -68,23 +66,19 @@ AlgorithmStats A2cUpdater::Update(const UpdateBatch& batch, double progress,
                  policy_loss + config_.value_coef * value_loss -
                      config_.entropy_coef * entropy,
                  config_.max_grad_norm);
-    stats.policy_loss += policy_loss.item<double>();
-    stats.value_loss += value_loss.item<double>();
-    stats.entropy += entropy.item<double>();
+    AlgorithmStats step;
+    step.policy_loss = policy_loss.item<double>();
+    step.value_loss = value_loss.item<double>();
+    step.entropy = entropy.item<double>();
     // Later minibatches act on an already-updated policy; this is how far
     // it has moved from the behaviour policy (the same estimator as PPO's).
     const at::Tensor log_ratio = log_prob.detach() - old_log_prob;
-    stats.approx_kl +=
+    step.approx_kl =
         ((at::exp(log_ratio) - 1) - log_ratio).mean().item<double>();
-    ++count;
+    step.clip_fraction = std::numeric_limits<double>::quiet_NaN();
+    stats.Add(step);
   }
-  if (count > 0) {
-    stats.policy_loss /= count;
-    stats.value_loss /= count;
-    stats.entropy /= count;
-    stats.approx_kl /= count;
-  }
-  return stats;
+  return stats.Mean();
 }
 
 void A2cUpdater::Save(torch::serialize::OutputArchive& archive) const {

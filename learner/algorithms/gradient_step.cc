@@ -37,6 +37,25 @@ std::vector<at::Tensor> JointParameters(PolicyNetworkImpl& policy,
   return parameters;
 }
 
+void MeanStats::Add(const AlgorithmStats& stats) {
+  sum_.policy_loss += stats.policy_loss;
+  sum_.value_loss += stats.value_loss;
+  sum_.entropy += stats.entropy;
+  sum_.approx_kl += stats.approx_kl;
+  sum_.clip_fraction += stats.clip_fraction;
+  ++count_;
+}
+
+AlgorithmStats MeanStats::Mean() const {
+  if (count_ == 0) return AlgorithmStats();
+  AlgorithmStats mean = sum_;
+  for (double* field : {&mean.policy_loss, &mean.value_loss, &mean.entropy,
+                        &mean.approx_kl, &mean.clip_fraction}) {
+    *field /= count_;
+  }
+  return mean;
+}
+
 void SaveOptimizer(const torch::optim::Optimizer& optimizer,
                    const std::string& key,
                    torch::serialize::OutputArchive& archive) {

@@ -10,6 +10,7 @@
 
 #include "absl/status/status.h"
 #include "common/nn/networks.h"
+#include "learner/algorithms/policy_updater.h"
 
 namespace torch::optim {
 class Optimizer;
@@ -37,6 +38,17 @@ void SetLearningRate(torch::optim::Optimizer& optimizer, double learning_rate);
 // The parameters of both networks, policy first (one optimiser over both).
 std::vector<at::Tensor> JointParameters(PolicyNetworkImpl& policy,
                                         ValueNetworkImpl& value);
+
+// Averages per-minibatch statistics (a NaN field stays NaN).
+class MeanStats {
+ public:
+  void Add(const AlgorithmStats& stats);
+  AlgorithmStats Mean() const;
+
+ private:
+  AlgorithmStats sum_;
+  int64_t count_ = 0;
+};
 
 // Checkpoint helpers: an optimiser's state under `key`. Loading a state
 // that does not fit the optimiser is an InvalidArgument error.

@@ -52,8 +52,7 @@ AlgorithmStats PpoUpdater::Update(const UpdateBatch& batch, double progress,
   const int64_t size = batch.observations.size(0);
   const int64_t minibatch = std::max<int64_t>(1, size / config_.minibatches);
   std::vector<int64_t> order(size);
-  AlgorithmStats stats;
-  int64_t count = 0;
+  MeanStats stats;
   for (int epoch = 0; epoch < config_.epochs; ++epoch) {
     std::iota(order.begin(), order.end(), 0);
     std::shuffle(order.begin(), order.end(), rng);
@@ -78,22 +77,16 @@ AlgorithmStats PpoUpdater::Update(const UpdateBatch& batch, double progress,
                    policy_loss.loss + config_.value_coef * value_loss -
                        config_.entropy_coef * entropy,
                    config_.max_grad_norm);
-      stats.policy_loss += policy_loss.loss.item<double>();
-      stats.value_loss += value_loss.item<double>();
-      stats.entropy += entropy.item<double>();
-      stats.approx_kl += policy_loss.approx_kl.item<double>();
-      stats.clip_fraction += policy_loss.clip_fraction.item<double>();
-      ++count;
+      AlgorithmStats step;
+      step.policy_loss = policy_loss.loss.item<double>();
+      step.value_loss = value_loss.item<double>();
+      step.entropy = entropy.item<double>();
+      step.approx_kl = policy_loss.approx_kl.item<double>();
+      step.clip_fraction = policy_loss.clip_fraction.item<double>();
+      stats.Add(step);
     }
   }
-  if (count > 0) {
-    stats.policy_loss /= count;
-    stats.value_loss /= count;
-    stats.entropy /= count;
-    stats.approx_kl /= count;
-    stats.clip_fraction /= count;
-  }
-  return stats;
+  return stats.Mean();
 }
 
 void PpoUpdater::Save(torch::serialize::OutputArchive& archive) const {
