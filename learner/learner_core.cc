@@ -70,12 +70,33 @@ double LearnerCore::MeanRecentReturn() const {
 }
 
 absl::StatusOr<UpdateStats> LearnerCore::RunUpdate(SegmentSource& source) {
+  // In sync mode (lag 0) only the current version's steps train.
+  const int64_t min_version = config_.max_policy_lag < 0
+                                  ? std::numeric_limits<int64_t>::min()
+                                  : version_ - config_.max_policy_lag;
+  stale_steps_ += stitcher_.DropStepsOlderThan(min_version);
+  std::vector<Rollout> fresh;
+  for (Rollout& rollout : pending_) {
+    if (rollout.policy_versions.min().item<int64_t>() >= min_version) {
+      fresh.push_back(std::move(rollout));
+    } else {
+      stale_steps_ += rollout.policy_versions.size(0);
+    }
+  }
+  pending_ = std::move(fresh);
   while (static_cast<int64_t>(pending_.size()) < config_.rollouts_per_batch) {
     absl::StatusOr<Segment> segment = source.Receive();
     if (!segment.ok()) return segment.status();
     if (!ValidateSegment(*segment, config_.spec, config_.max_segment_steps)
-             .ok()) {
+             .ok() ||
+        segment->policy_version > version_) {
       ++rejected_;
+      continue;
+    }
+    if (segment->policy_version < min_version) {
+      ++rejected_;
+      ++stale_segments_;
+      stale_steps_ += segment->steps();
       continue;
     }
     // Returns count only for segments the stitcher accepts (a duplicate
@@ -148,6 +169,8 @@ absl::StatusOr<UpdateStats> LearnerCore::RunUpdate(SegmentSource& source) {
   stats.explained_variance =
       1.0 - (residual.var() / (targets.var() + 1e-8)).item<double>();
   stats.rejected_segments = rejected_;
+  stats.stale_segments = stale_segments_;
+  stats.stale_steps = stale_steps_;
   return stats;
 }
 
@@ -177,9 +200,10 @@ void LearnerCore::Save(torch::serialize::OutputArchive& archive) const {
   std::ostringstream rng;
   rng << rng_;
   WriteBytes(archive, "rng", rng.str());
-  archive.write(
-      "counters",
-      at::tensor({version_, env_steps_, rejected_, episodes_}, at::kLong));
+  archive.write("counters",
+                at::tensor({version_, env_steps_, rejected_, episodes_,
+                            stale_segments_, stale_steps_},
+                           at::kLong));
   archive.write("recent_returns",
                 at::tensor(std::vector<double>(recent_returns_.begin(),
                                                recent_returns_.end()),
@@ -242,7 +266,7 @@ absl::StatusOr<std::unique_ptr<LearnerCore>> LearnerCore::Load(
                               ReadTensor(archive, "recent_returns", returns)}) {
     if (!status.ok()) return status;
   }
-  if (counters.scalar_type() != at::kLong || counters.numel() != 4 ||
+  if (counters.scalar_type() != at::kLong || counters.numel() != 6 ||
       returns.scalar_type() != at::kDouble || returns.dim() != 1 ||
       returns.numel() > 100) {
     return absl::InvalidArgumentError(
@@ -252,6 +276,8 @@ absl::StatusOr<std::unique_ptr<LearnerCore>> LearnerCore::Load(
   core.env_steps_ = counters[1].item<int64_t>();
   core.rejected_ = counters[2].item<int64_t>();
   core.episodes_ = counters[3].item<int64_t>();
+  core.stale_segments_ = counters[4].item<int64_t>();
+  core.stale_steps_ = counters[5].item<int64_t>();
   for (int64_t i = 0; i < returns.numel(); ++i) {
     core.recent_returns_.push_back(returns[i].item<double>());
   }

@@ -25,6 +25,9 @@ struct LearnerConfig {
   int64_t horizon = 2048;          // steps per rollout and env stream
   int64_t rollouts_per_batch = 1;  // env streams per update
   int64_t max_segment_steps = 4096;
+  // Steps acted by a policy older than version - max_policy_lag are
+  // dropped and counted (0: strictly on-policy, the sync mode); -1: any.
+  int64_t max_policy_lag = 0;
   int64_t total_env_steps = 1000000;  // the learning rate decays to 0 there
   uint64_t seed = 0;
   double observation_clip = 10.0;
@@ -46,7 +49,9 @@ struct UpdateStats {
   double biased_fraction = 0.0;  // share of samples using the bias
   double mean_abs_bias = 0.0;    // mean |biased - GAE|
   double explained_variance = 0.0;
-  int64_t rejected_segments = 0;  // so far, any reason
+  int64_t rejected_segments = 0;  // so far, any reason (stale included)
+  int64_t stale_segments = 0;     // so far, too old a policy version
+  int64_t stale_steps = 0;        // so far, dropped for their version
 };
 
 // Consumes segments, stitches rollouts, evaluates the critic, estimates
@@ -99,6 +104,8 @@ class LearnerCore {
   int64_t version_ = 0;
   int64_t env_steps_ = 0;
   int64_t rejected_ = 0;
+  int64_t stale_segments_ = 0;
+  int64_t stale_steps_ = 0;
   int64_t episodes_ = 0;
   std::deque<double> recent_returns_;
 };

@@ -92,6 +92,23 @@ std::vector<Rollout> RolloutStitcher::TakeReady() {
   return ready;
 }
 
+int64_t RolloutStitcher::DropStepsOlderThan(int64_t min_version) {
+  int64_t dropped = 0;
+  for (auto& entry : streams_) {
+    Stream& stream = entry.second;
+    // Versions never decrease along a stream, so the stale steps lead.
+    while (!stream.pieces.empty() &&
+           stream.pieces.front().segment->policy_version < min_version) {
+      const Piece& piece = stream.pieces.front();
+      dropped += piece.end - piece.begin;
+      stream.steps -= piece.end - piece.begin;
+      stream.pieces.pop_front();
+    }
+  }
+  stats_.stale_steps += dropped;
+  return dropped;
+}
+
 int64_t RolloutStitcher::buffered_steps() const {
   int64_t steps = 0;
   for (const auto& entry : streams_) steps += entry.second.steps;

@@ -36,6 +36,7 @@ struct StitcherStats {
   int64_t gaps = 0;            // a stream restarted (sequence jumped)
   int64_t dropped_steps = 0;   // buffered steps discarded at gaps
   int64_t stale_segments = 0;  // sequence at or below one already used
+  int64_t stale_steps = 0;     // dropped as too old a policy version
 };
 
 // Joins each stream's segments, in sequence order, into rollouts of exactly
@@ -52,6 +53,11 @@ class RolloutStitcher {
 
   // The rollouts completed so far, oldest first.
   std::vector<Rollout> TakeReady();
+
+  // Drops buffered steps acted by a policy version below `min_version`
+  // (too stale to train on); the streams go on from their newer steps.
+  // Returns the number of steps dropped (also in stats().stale_steps).
+  int64_t DropStepsOlderThan(int64_t min_version);
 
   // Steps waiting in partial rollouts, over all streams.
   int64_t buffered_steps() const;

@@ -124,6 +124,26 @@ TEST(RolloutStitcherTest, NothingIsStitchedAcrossAGap) {
   EXPECT_EQ(stitcher.buffered_steps(), 2);
 }
 
+// Segment i of MakeStream was acted by version i + 1. Dropping versions
+// below 3 removes the first two segments' steps; the stream goes on from
+// the third, so the next rollout starts at step 6.
+TEST(RolloutStitcherTest, DropsStepsOfStalePolicyVersions) {
+  const Stream stream = MakeStream({3, 3, 3, 7});
+  RolloutStitcher stitcher(10);
+  for (int i = 0; i < 3; ++i)
+    ASSERT_TRUE(stitcher.Add(stream.segments[i]).ok());
+  EXPECT_EQ(stitcher.DropStepsOlderThan(3), 6);
+  EXPECT_EQ(stitcher.buffered_steps(), 3);
+  EXPECT_EQ(stitcher.stats().stale_steps, 6);
+  EXPECT_EQ(stitcher.DropStepsOlderThan(3), 0);
+  ASSERT_TRUE(stitcher.Add(stream.segments[3]).ok());
+  const std::vector<Rollout> rollouts = stitcher.TakeReady();
+  ASSERT_EQ(rollouts.size(), 1u);
+  EXPECT_TRUE(
+      at::equal(rollouts[0].observations, stream.observations.slice(0, 6, 17)));
+  EXPECT_EQ(rollouts[0].policy_versions.min().item<int64_t>(), 3);
+}
+
 TEST(RolloutStitcherTest, StreamsStayApart) {
   const Stream a = MakeStream({4, 4}, /*actor=*/0, /*slot=*/1);
   const Stream b = MakeStream({4, 4}, /*actor=*/1, /*slot=*/1);
