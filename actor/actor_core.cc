@@ -64,6 +64,7 @@ ActorCore::ActorCore(const ActorConfig& config, std::unique_ptr<VectorEnv> envs)
       // Action sampling is seeded apart from the environments' resets.
       generator_(at::make_generator<at::CPUGeneratorImpl>(
           config.seed * 0x9E3779B97F4A7C15ULL + config.actor_id + 1)),
+      stream_actor_id_(config.actor_id),
       next_sequence_(config.num_envs, 0) {}
 
 absl::Status ActorCore::SetWeights(const PolicyWeights& weights) {
@@ -143,7 +144,7 @@ absl::Status ActorCore::CollectSegments(SegmentSink& sink) {
 
   for (int64_t i = 0; i < m; ++i) {
     Segment& segment = segments[i];
-    segment.actor_id = config_.actor_id;
+    segment.actor_id = stream_actor_id_;
     segment.env_slot = i;
     segment.sequence = next_sequence_[i]++;
     segment.policy_version = version_;

@@ -40,6 +40,10 @@ class ActorCore {
 
   const EnvSpec& spec() const { return envs_->spec(); }
   int64_t policy_version() const { return version_; }
+  // The id segments carry. A learner assigns one per registration, so an
+  // actor that registers again (after the learner restarted) starts new
+  // streams that are never stitched onto the old ones.
+  void set_stream_actor_id(int64_t id) { stream_actor_id_ = id; }
   int64_t env_steps() const { return env_steps_; }
 
   // Takes effect from the next segment on.
@@ -74,6 +78,7 @@ class ActorCore {
   RunningMeanStd normalizer_;
   at::Generator generator_;
   int64_t version_ = 0;
+  int64_t stream_actor_id_;
   bool has_weights_ = false;
   int64_t env_steps_ = 0;
   std::vector<int64_t> next_sequence_;

@@ -7,14 +7,13 @@
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "deploy/run_directory.h"
+#include "deploy/run_recorder.h"
 #include "learner/checkpoint.h"
 
 namespace vantage {
 namespace {
 
 constexpr char kActorState[] = "actor_state";
-constexpr char kConfig[] = "config";
-constexpr char kElapsed[] = "elapsed_seconds";
 
 struct Resumed {
   std::unique_ptr<LearnerCore> learner;
@@ -48,8 +47,9 @@ absl::StatusOr<Resumed> ResumeFromCheckpoint(const RunDirectory& run,
     if (status.ok()) {
       Resumed resumed;
       resumed.learner = *std::move(learner);
-      if (extras->count(kElapsed) != 0) {
-        (void)absl::SimpleAtod(extras->at(kElapsed), &resumed.elapsed_seconds);
+      if (extras->count(kCheckpointElapsed) != 0) {
+        (void)absl::SimpleAtod(extras->at(kCheckpointElapsed),
+                               &resumed.elapsed_seconds);
       }
       return resumed;
     }
@@ -77,7 +77,6 @@ LearnerConfig MakeLearnerConfig(const LocalTrainingConfig& config,
 absl::Status RunLocalTraining(
     const LocalTrainingConfig& config,
     const std::function<bool(const ProgressRow&)>& on_update) {
-  const auto start = std::chrono::steady_clock::now();
   ActorConfig actor_config;
   actor_config.env = config.env;
   actor_config.num_envs = config.num_envs;
@@ -121,31 +120,21 @@ absl::Status RunLocalTraining(
     learner = *std::move(created);
   }
 
-  auto seconds_since_start = [&] {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() -
-                                         start)
-        .count();
-  };
-  auto checkpoint = [&]() -> absl::Status {
-    absl::StatusOr<std::string> actor_state = (*actor)->SaveState();
-    if (!actor_state.ok()) return actor_state.status();
-    const CheckpointExtras extras = {
-        {kActorState, *actor_state},
-        {kConfig, config.config_json},
-        {kElapsed, absl::StrCat(elapsed_before + seconds_since_start())}};
-    if (absl::Status status =
-            WriteCheckpoint(CheckpointPath(run->checkpoint_directory(),
-                                           learner->policy_version()),
-                            *learner, extras);
-        !status.ok()) {
-      return status;
-    }
-    return PruneCheckpoints(run->checkpoint_directory(),
-                            config.keep_checkpoints);
+  RecorderConfig recorder_config;
+  recorder_config.config_json = config.config_json;
+  recorder_config.checkpoint_every = config.checkpoint_every;
+  recorder_config.keep_checkpoints = config.keep_checkpoints;
+  recorder_config.total_env_steps = config.total_env_steps;
+  recorder_config.elapsed_before = elapsed_before;
+  recorder_config.steps_before = learner->env_steps();
+  RunRecorder recorder(std::move(run), recorder_config);
+  auto actor_state = [&]() -> absl::StatusOr<CheckpointExtras> {
+    absl::StatusOr<std::string> state = (*actor)->SaveState();
+    if (!state.ok()) return state.status();
+    return CheckpointExtras{{kActorState, *std::move(state)}};
   };
 
   SegmentQueue queue(static_cast<size_t>(config.num_envs));
-  const int64_t steps_before = learner->env_steps();
   while (learner->env_steps() < config.total_env_steps) {
     if (absl::Status status = (*actor)->SetWeights(learner->CurrentWeights());
         !status.ok()) {
@@ -156,23 +145,10 @@ absl::Status RunLocalTraining(
     }
     absl::StatusOr<UpdateStats> stats = learner->RunUpdate(queue);
     if (!stats.ok()) return stats.status();
-    ProgressRow progress;
-    progress.stats = *stats;
-    progress.mean_return = learner->MeanRecentReturn();
-    const double seconds = seconds_since_start();
-    progress.elapsed_seconds = elapsed_before + seconds;
-    progress.steps_per_second =
-        (stats->env_steps - steps_before) / std::max(seconds, 1e-9);
-    if (run.has_value()) {
-      if (absl::Status status = run->AppendProgress(progress); !status.ok()) {
-        return status;
-      }
-      const bool last = stats->env_steps >= config.total_env_steps;
-      if (last || stats->policy_version % config.checkpoint_every == 0) {
-        if (absl::Status status = checkpoint(); !status.ok()) return status;
-      }
-    }
-    if (!on_update(progress)) break;
+    absl::StatusOr<ProgressRow> progress =
+        recorder.Record(*learner, *stats, actor_state);
+    if (!progress.ok()) return progress.status();
+    if (!on_update(*progress)) break;
   }
   return absl::OkStatus();
 }

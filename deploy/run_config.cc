@@ -73,6 +73,11 @@ absl::StatusOr<pb::RunConfig> ResolveRunConfig(const pb::RunConfig& given) {
   if (!c.has_max_kl()) c.set_max_kl(algorithms.trpo.max_kl);
   if (!c.has_checkpoint_every()) c.set_checkpoint_every(10);
   if (!c.has_keep_checkpoints()) c.set_keep_checkpoints(3);
+  if (!c.has_sync()) c.set_sync(true);
+  if (!c.has_max_policy_lag()) c.set_max_policy_lag(c.sync() ? 0 : 4);
+  if (!c.has_segment_length()) {
+    c.set_segment_length(std::min<int64_t>(128, c.horizon()));
+  }
 
   absl::StatusOr<Statistic> statistic = ParseStatistic(c.estimator());
   if (!statistic.ok())
@@ -96,6 +101,18 @@ absl::StatusOr<pb::RunConfig> ResolveRunConfig(const pb::RunConfig& given) {
   }
   if (c.checkpoint_every() < 1)
     return Invalid("checkpoint_every", "must be >= 1");
+  if (c.sync() && c.max_policy_lag() != 0) {
+    return Invalid("max_policy_lag", "must be 0 with --sync");
+  }
+  if (c.max_policy_lag() < 0) return Invalid("max_policy_lag", "must be >= 0");
+  if (c.segment_length() < 1 || c.segment_length() > c.horizon()) {
+    return Invalid("segment_length", "must be in [1, --horizon]");
+  }
+  if (c.sync() && c.horizon() % c.segment_length() != 0) {
+    return Invalid("segment_length",
+                   "must divide --horizon in a --sync run (each actor sends "
+                   "exactly one horizon per policy version)");
+  }
   if (c.keep_checkpoints() < 1)
     return Invalid("keep_checkpoints", "must be >= 1");
   // The estimator's own rules (gamma, lambda, rho, ensemble).
@@ -154,6 +171,7 @@ LocalTrainingConfig ToLocalTrainingConfig(const pb::RunConfig& c) {
   local.seed = c.seed();
   LearnerConfig& learner = local.learner;
   learner.horizon = c.horizon();
+  learner.max_policy_lag = c.max_policy_lag();
   learner.scale_rewards = c.scale_rewards();
   learner.network.hidden.assign(c.hidden().begin(), c.hidden().end());
   AdvantageConfig& advantage = learner.advantage;

@@ -1,0 +1,54 @@
+#ifndef VANTAGE_DEPLOY_RUN_RECORDER_H_
+#define VANTAGE_DEPLOY_RUN_RECORDER_H_
+
+#include <chrono>
+#include <cstdint>
+#include <optional>
+#include <string>
+
+#include "absl/functional/function_ref.h"
+#include "absl/status/statusor.h"
+#include "deploy/run_directory.h"
+#include "learner/checkpoint.h"
+#include "learner/learner_core.h"
+
+namespace vantage {
+
+// Extras every run checkpoint carries besides the caller's.
+inline constexpr char kCheckpointConfig[] = "config";
+inline constexpr char kCheckpointElapsed[] = "elapsed_seconds";
+
+struct RecorderConfig {
+  std::string config_json;  // the resolved run config
+  int checkpoint_every = 10;
+  int keep_checkpoints = 3;
+  int64_t total_env_steps = 0;
+  // Where a resumed run starts: its elapsed time and env steps so far.
+  double elapsed_before = 0.0;
+  int64_t steps_before = 0;
+};
+
+// Records a training run as it goes: a progress row per update, appended to
+// progress.csv, and a checkpoint every `checkpoint_every` updates and at
+// the end (when there is a run directory), plus the wall-clock figures.
+class RunRecorder {
+ public:
+  RunRecorder(std::optional<RunDirectory> run, RecorderConfig config);
+
+  // `extras` adds the caller's byte strings to the checkpoint (e.g. the
+  // local actor's state); it is called only when one is written.
+  absl::StatusOr<ProgressRow> Record(
+      const LearnerCore& learner, const UpdateStats& stats,
+      absl::FunctionRef<absl::StatusOr<CheckpointExtras>()> extras);
+
+ private:
+  double Seconds() const;
+
+  std::optional<RunDirectory> run_;
+  RecorderConfig config_;
+  std::chrono::steady_clock::time_point start_;
+};
+
+}  // namespace vantage
+
+#endif  // VANTAGE_DEPLOY_RUN_RECORDER_H_
