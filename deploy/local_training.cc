@@ -80,7 +80,15 @@ absl::Status RunLocalTraining(
   ActorConfig actor_config;
   actor_config.env = config.env;
   actor_config.num_envs = config.num_envs;
-  actor_config.segment_length = config.learner.horizon;
+  const int64_t segment_length = config.segment_length > 0
+                                     ? config.segment_length
+                                     : config.learner.horizon;
+  if (config.learner.horizon % segment_length != 0) {
+    return absl::InvalidArgumentError(
+        "the segment length must divide the horizon");
+  }
+  const int64_t rounds = config.learner.horizon / segment_length;
+  actor_config.segment_length = segment_length;
   actor_config.seed = config.seed;
   actor_config.network = config.learner.network;
   actor_config.observation_clip = config.learner.observation_clip;
@@ -134,14 +142,18 @@ absl::Status RunLocalTraining(
     return CheckpointExtras{{kActorState, *std::move(state)}};
   };
 
-  SegmentQueue queue(static_cast<size_t>(config.num_envs));
+  // One horizon of segments per version, all queued before the update.
+  SegmentQueue queue(static_cast<size_t>(config.num_envs * rounds));
   while (learner->env_steps() < config.total_env_steps) {
     if (absl::Status status = (*actor)->SetWeights(learner->CurrentWeights());
         !status.ok()) {
       return status;
     }
-    if (absl::Status status = (*actor)->CollectSegments(queue); !status.ok()) {
-      return status;
+    for (int64_t round = 0; round < rounds; ++round) {
+      if (absl::Status status = (*actor)->CollectSegments(queue);
+          !status.ok()) {
+        return status;
+      }
     }
     absl::StatusOr<UpdateStats> stats = learner->RunUpdate(queue);
     if (!stats.ok()) return stats.status();

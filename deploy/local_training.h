@@ -18,6 +18,9 @@ struct LocalTrainingConfig {
   int64_t total_env_steps = 300000;
   uint64_t seed = 0;
   LearnerConfig learner;  // spec, rollouts_per_batch and total steps filled in
+  // Steps per segment (must divide learner.horizon; 0: the horizon). The
+  // same segments as a distributed run's make the two runs' progress equal.
+  int64_t segment_length = 0;
 
   // Optional run directory (see deploy/run_directory.h): config.json with
   // `config_json`, progress.csv, and a checkpoint every `checkpoint_every`

@@ -172,6 +172,7 @@ LocalTrainingConfig ToLocalTrainingConfig(const pb::RunConfig& c) {
   LearnerConfig& learner = local.learner;
   learner.horizon = c.horizon();
   learner.max_policy_lag = c.max_policy_lag();
+  local.segment_length = c.segment_length();
   learner.scale_rewards = c.scale_rewards();
   learner.network.hidden.assign(c.hidden().begin(), c.hidden().end());
   AdvantageConfig& advantage = learner.advantage;

@@ -19,6 +19,7 @@
 #include "bench/advantage_bench.h"
 #include "bench/env_bench.h"
 #include "bench/learner_bench.h"
+#include "deploy/cli/actor_command.h"
 #include "deploy/cli/advantages_command.h"
 #include "deploy/cli/env_commands.h"
 #include "deploy/cli/train_command.h"
@@ -72,6 +73,24 @@ ABSL_FLAG(std::string, run_dir, "",
 ABSL_FLAG(std::string, resume, "",
           "train: continue the run in this directory from its last "
           "checkpoint");
+ABSL_FLAG(bool, sync, true,
+          "train, learner: each batch only from the current policy version "
+          "(actors wait for it); --nosync: async with --max_policy_lag");
+ABSL_FLAG(int64_t, max_policy_lag, 4,
+          "learner (async): segments older than this many versions are "
+          "dropped and counted");
+ABSL_FLAG(int64_t, segment_length, 128,
+          "learner: steps per segment its actors send (divides --horizon "
+          "with --sync)");
+ABSL_FLAG(std::string, listen, "127.0.0.1:0",
+          "learner: HOST:PORT to serve actors on (port 0: a free one)");
+ABSL_FLAG(std::string, port_file, "",
+          "learner: write the bound port here once serving");
+ABSL_FLAG(std::string, learner, "", "actor: the learner's HOST:PORT");
+ABSL_FLAG(std::string, name, "actor", "actor: a name for logs");
+ABSL_FLAG(int, max_reconnects, -1,
+          "actor: reconnection attempts (0: exit at the first failure, -1: "
+          "forever)");
 ABSL_FLAG(std::string, checkpoint, "",
           "rollout: a run directory or checkpoint file whose policy acts");
 ABSL_FLAG(bool, stochastic, false,
@@ -166,9 +185,8 @@ bool ParseIntegers(const char* name, const std::vector<std::string>& values,
   return true;
 }
 
-int RunTrain(const std::vector<std::string>& args) {
-  if (int code = NoArguments("train", args); code != 0) return code;
-  TrainRequest request;
+// The train flags given on the command line; false after a message.
+bool BuildTrainRequest(TrainRequest& request) {
   pb::RunConfig& c = request.flags;
   if (Given("mode")) c.set_mode(absl::GetFlag(FLAGS_mode));
   if (Given("env")) c.set_env(absl::GetFlag(FLAGS_env));
@@ -178,7 +196,7 @@ int RunTrain(const std::vector<std::string>& args) {
   if (Given("ensemble") &&
       !ParseIntegers("ensemble", absl::GetFlag(FLAGS_ensemble),
                      *c.mutable_ensemble())) {
-    return kUsageExitCode;
+    return false;
   }
   if (Given("steps")) c.set_steps(absl::GetFlag(FLAGS_steps));
   if (Given("seed")) c.set_seed(absl::GetFlag(FLAGS_seed));
@@ -196,7 +214,7 @@ int RunTrain(const std::vector<std::string>& args) {
   }
   if (Given("hidden") && !ParseIntegers("hidden", absl::GetFlag(FLAGS_hidden),
                                         *c.mutable_hidden())) {
-    return kUsageExitCode;
+    return false;
   }
   if (Given("scale_rewards")) {
     c.set_scale_rewards(absl::GetFlag(FLAGS_scale_rewards));
@@ -208,10 +226,45 @@ int RunTrain(const std::vector<std::string>& args) {
   if (Given("keep_checkpoints")) {
     c.set_keep_checkpoints(absl::GetFlag(FLAGS_keep_checkpoints));
   }
+  if (Given("sync") || Given("nosync")) c.set_sync(absl::GetFlag(FLAGS_sync));
+  if (Given("max_policy_lag")) {
+    c.set_max_policy_lag(absl::GetFlag(FLAGS_max_policy_lag));
+  }
+  if (Given("segment_length")) {
+    c.set_segment_length(absl::GetFlag(FLAGS_segment_length));
+  }
   request.config_file = absl::GetFlag(FLAGS_config);
   request.run_dir = absl::GetFlag(FLAGS_run_dir);
   request.resume = absl::GetFlag(FLAGS_resume);
+  return true;
+}
+
+int RunTrain(const std::vector<std::string>& args) {
+  if (int code = NoArguments("train", args); code != 0) return code;
+  TrainRequest request;
+  if (!BuildTrainRequest(request)) return kUsageExitCode;
   return RunTrainCommand(request);
+}
+
+int RunLearner(const std::vector<std::string>& args) {
+  if (int code = NoArguments("learner", args); code != 0) return code;
+  LearnerRequest request;
+  if (!BuildTrainRequest(request.train)) return kUsageExitCode;
+  request.listen = absl::GetFlag(FLAGS_listen);
+  request.port_file = absl::GetFlag(FLAGS_port_file);
+  return RunLearnerCommand(request);
+}
+
+int RunActor(const std::vector<std::string>& args) {
+  if (int code = NoArguments("actor", args); code != 0) return code;
+  RemoteActorConfig config;
+  config.learner = absl::GetFlag(FLAGS_learner);
+  if (Given("env")) config.env = absl::GetFlag(FLAGS_env);
+  config.num_envs = absl::GetFlag(FLAGS_envs);
+  config.seed = absl::GetFlag(FLAGS_seed);
+  config.name = absl::GetFlag(FLAGS_name);
+  config.max_reconnects = absl::GetFlag(FLAGS_max_reconnects);
+  return RunActorCommand(config);
 }
 
 int RunBench(const std::vector<std::string>& args) {
@@ -243,8 +296,10 @@ int RunBench(const std::vector<std::string>& args) {
 
 const std::map<std::string, Command>& Commands() {
   static const auto* commands = new std::map<std::string, Command>{
-      {"advantages", RunAdvantages}, {"bench", RunBench}, {"envs", RunEnvs},
-      {"rollout", RunRollout},       {"train", RunTrain},
+      {"actor", RunActor},     {"advantages", RunAdvantages},
+      {"bench", RunBench},     {"envs", RunEnvs},
+      {"learner", RunLearner}, {"rollout", RunRollout},
+      {"train", RunTrain},
   };
   return *commands;
 }
@@ -278,6 +333,10 @@ int main(int argc, char** argv) {
       "                                 local PPO / A2C / TRPO training\n"
       "  train --config=FILE.json       flags from a run config file\n"
       "  train --resume=RUN_DIR         continue from the last checkpoint\n"
+      "  learner --listen=HOST:PORT [--port_file=F] [train flags]\n"
+      "                                 serve actors over gRPC and train\n"
+      "  actor --learner=HOST:PORT --env=NAME --envs=M\n"
+      "                                 act and stream segments to a learner\n"
       "  envs                           registered environments\n"
       "  rollout --env=NAME --episodes=N --seed=S   random-policy episodes\n"
       "  rollout --checkpoint=RUN_DIR [--episodes=N] [--stochastic]\n"

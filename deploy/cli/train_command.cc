@@ -9,6 +9,8 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_join.h"
+#include "deploy/cli/stop_signal.h"
+#include "deploy/learner_server.h"
 #include "deploy/local_training.h"
 #include "deploy/run_config.h"
 
@@ -63,35 +65,91 @@ std::string Duration(double seconds) {
 
 }  // namespace
 
-int RunTrainCommand(const TrainRequest& request) {
-  pb::RunConfig given;
+namespace {
+
+struct ResolvedRun {
+  pb::RunConfig config;
   LocalTrainingConfig local;
+};
+
+absl::StatusOr<ResolvedRun> ResolveRequest(const TrainRequest& request) {
+  pb::RunConfig given;
   if (!request.resume.empty()) {
     if (!request.config_file.empty() || !request.run_dir.empty()) {
-      return Fail(
-          "--resume takes the run directory's own config; drop "
-          "--config and --run_dir");
+      return absl::InvalidArgumentError(
+          "--resume takes the run directory's own config; drop --config and "
+          "--run_dir");
     }
     if (absl::Status status = CheckNoOverrides(request.flags); !status.ok()) {
-      return Fail(status.message());
+      return status;
     }
     absl::StatusOr<pb::RunConfig> saved =
         ReadRunConfigFile(request.resume + "/config.json");
-    if (!saved.ok()) return Fail(saved.status().message());
+    if (!saved.ok()) return saved.status();
     given = *saved;
   } else {
     absl::StatusOr<pb::RunConfig> merged = MergeFlags(request);
-    if (!merged.ok()) return Fail(merged.status().message());
+    if (!merged.ok()) return merged.status();
     given = *merged;
   }
   absl::StatusOr<pb::RunConfig> config = ResolveRunConfig(given);
-  if (!config.ok()) return Fail(config.status().message());
-  local = ToLocalTrainingConfig(*config);
-  local.config_json = RunConfigToJson(*config);
-  local.run_dir = request.resume.empty() ? request.run_dir : request.resume;
-  local.resume = !request.resume.empty();
-  local.checkpoint_every = config->checkpoint_every();
-  local.keep_checkpoints = config->keep_checkpoints();
+  if (!config.ok()) return config.status();
+  ResolvedRun run;
+  run.config = *config;
+  run.local = ToLocalTrainingConfig(*config);
+  run.local.config_json = RunConfigToJson(*config);
+  run.local.run_dir = request.resume.empty() ? request.run_dir : request.resume;
+  run.local.resume = !request.resume.empty();
+  run.local.checkpoint_every = config->checkpoint_every();
+  run.local.keep_checkpoints = config->keep_checkpoints();
+  return run;
+}
+
+void PrintResult(const pb::RunConfig& config, const ProgressRow& last) {
+  std::printf(
+      "RESULT train env=%s algo=%s estimator=%s rho=%g steps=%ld "
+      "mean_return=%.1f elapsed_s=%.1f sps=%.0f\n",
+      config.env().c_str(), config.algo().c_str(), config.estimator().c_str(),
+      config.rho(), static_cast<long>(last.stats.env_steps), last.mean_return,
+      last.elapsed_seconds, last.steps_per_second);
+}
+
+}  // namespace
+
+int RunLearnerCommand(const LearnerRequest& request) {
+  if (!request.train.resume.empty()) {
+    return Fail("--resume of a distributed run is not supported yet");
+  }
+  absl::StatusOr<ResolvedRun> resolved = ResolveRequest(request.train);
+  if (!resolved.ok()) return Fail(resolved.status().message());
+  at::set_num_threads(1);
+  LearnerServerConfig server;
+  server.training = resolved->local;
+  server.run_config = resolved->config;
+  server.listen = request.listen;
+  server.port_file = request.port_file;
+  ProgressRow last;
+  last.mean_return = std::nan("");
+  const absl::Status status =
+      RunLearnerServer(server, StopRequested(), [&](const ProgressRow& row) {
+        last = row;
+        std::fprintf(stderr,
+                     "learner: update %ld steps %ld return(last100) %.1f "
+                     "%.0f steps/s\n",
+                     static_cast<long>(row.stats.policy_version),
+                     static_cast<long>(row.stats.env_steps), row.mean_return,
+                     row.steps_per_second);
+      });
+  if (!status.ok()) return Fail(status.message());
+  PrintResult(resolved->config, last);
+  return 0;
+}
+
+int RunTrainCommand(const TrainRequest& request) {
+  absl::StatusOr<ResolvedRun> resolved = ResolveRequest(request);
+  if (!resolved.ok()) return Fail(resolved.status().message());
+  const pb::RunConfig* config = &resolved->config;
+  const LocalTrainingConfig& local = resolved->local;
 
   at::set_num_threads(1);
   std::printf(
@@ -125,13 +183,7 @@ int RunTrainCommand(const TrainRequest& request) {
       });
   if (terminal) std::printf("\n");
   if (!status.ok()) return Fail(status.message());
-  std::printf(
-      "RESULT train env=%s algo=%s estimator=%s rho=%g steps=%ld "
-      "mean_return=%.1f elapsed_s=%.1f sps=%.0f\n",
-      config->env().c_str(), config->algo().c_str(),
-      config->estimator().c_str(), config->rho(),
-      static_cast<long>(last.stats.env_steps), last.mean_return,
-      last.elapsed_seconds, last.steps_per_second);
+  PrintResult(*config, last);
   return 0;
 }
 

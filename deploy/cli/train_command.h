@@ -20,6 +20,17 @@ struct TrainRequest {
 // files: one line on stderr, exit code 2.
 int RunTrainCommand(const TrainRequest& request);
 
+struct LearnerRequest {
+  TrainRequest train;     // the run's settings, as for train
+  std::string listen;     // HOST:PORT; port 0 picks a free one
+  std::string port_file;  // the bound port is written here
+};
+
+// `vantage learner`: serves actors (see deploy/learner_server.h) until the
+// run's steps are done or SIGINT/SIGTERM; a line per update on stderr and
+// the RESULT train line at the end.
+int RunLearnerCommand(const LearnerRequest& request);
+
 }  // namespace vantage
 
 #endif  // VANTAGE_DEPLOY_CLI_TRAIN_COMMAND_H_

@@ -1,6 +1,8 @@
 #include "tests/deploy/cli/run_vantage.h"
 
+#include <signal.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <cstdio>
 #include <cstdlib>
@@ -31,6 +33,31 @@ std::string WriteTemp(const std::string& name, const std::string& text) {
   const std::string path = TempPath(name);
   std::ofstream(path) << text;
   return path;
+}
+
+int StartVantage(const std::string& args, const std::string& out_path,
+                 const std::string& err_path) {
+  const std::string command = absl::StrCat("exec ", VANTAGE_BINARY, " ", args,
+                                           " >", out_path, " 2>", err_path);
+  const pid_t pid = fork();
+  if (pid == 0) {
+    execl("/bin/sh", "sh", "-c", command.c_str(), static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  return pid;
+}
+
+int WaitVantage(int pid, double seconds) {
+  for (double waited = 0; waited < seconds; waited += 0.05) {
+    int status = 0;
+    if (waitpid(pid, &status, WNOHANG) == pid) {
+      return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    }
+    usleep(50000);
+  }
+  kill(pid, SIGKILL);
+  waitpid(pid, nullptr, 0);
+  return -1;
 }
 
 Outcome RunVantage(const std::string& args) {

@@ -17,6 +17,15 @@ struct Outcome {
 // `vantage <args>` through the shell; stdout and stderr captured.
 Outcome RunVantage(const std::string& args);
 
+// `vantage <args>` in the background, output to the given files; returns
+// its process id.
+int StartVantage(const std::string& args, const std::string& out_path,
+                 const std::string& err_path);
+// Waits up to `seconds` for the process to exit and returns its exit code
+// (-1 if it was killed by a signal or did not exit in time, then it is
+// killed).
+int WaitVantage(int pid, double seconds);
+
 std::string ReadFile(const std::string& path);
 
 // ctest runs tests as parallel processes: every path gets the running

@@ -1,0 +1,227 @@
+#include "actor/remote/remote_actor.h"
+
+#include <grpcpp/grpcpp.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <memory>
+#include <mutex>
+#include <thread>
+
+#include "absl/strings/str_cat.h"
+#include "actor/actor_core.h"
+#include "actor/envs/env_registry.h"
+#include "proto/vantage.grpc.pb.h"
+#include "proto/wire_format.h"
+
+namespace vantage {
+namespace {
+
+absl::Status FromGrpc(const grpc::Status& status, absl::string_view what) {
+  if (status.ok()) return absl::OkStatus();
+  return absl::Status(static_cast<absl::StatusCode>(status.error_code()),
+                      absl::StrCat(what, ": ", status.error_message()));
+}
+
+// Refusals that no retry can mend.
+bool IsRefusal(const absl::Status& status) {
+  return absl::IsInvalidArgument(status) || absl::IsUnauthenticated(status) ||
+         absl::IsPermissionDenied(status);
+}
+
+// Segments onto an open client stream.
+class StreamSink : public SegmentSink {
+ public:
+  explicit StreamSink(grpc::ClientWriter<pb::Segment>& writer)
+      : writer_(writer) {}
+  absl::Status Send(Segment segment) override {
+    pb::Segment proto;
+    SegmentToProto(segment, &proto);
+    if (!writer_.Write(proto)) {
+      return absl::UnavailableError("the learner closed the segment stream");
+    }
+    return absl::OkStatus();
+  }
+
+ private:
+  grpc::ClientWriter<pb::Segment>& writer_;
+};
+
+// The newest weights a subscription delivered.
+class WeightsSlot {
+ public:
+  void Put(pb::Weights weights) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (weights_ == nullptr || weights.version() > weights_->version()) {
+      weights_ = std::make_shared<pb::Weights>(std::move(weights));
+    }
+  }
+  std::shared_ptr<const pb::Weights> Get() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return weights_;
+  }
+  void End() { ended_ = true; }
+  bool ended() const { return ended_; }
+
+ private:
+  mutable std::mutex mutex_;
+  std::shared_ptr<const pb::Weights> weights_;
+  std::atomic<bool> ended_{false};
+};
+
+class Session {
+ public:
+  Session(const RemoteActorConfig& config,
+          std::shared_ptr<grpc::Channel> channel)
+      : config_(config), stub_(pb::Learner::NewStub(channel)) {}
+
+  // Registers, then acts and streams until an error or `stop`.
+  // `progressed` tells whether the learner accepted us at all.
+  absl::Status Run(const EnvSpec& spec, std::unique_ptr<ActorCore>& actor,
+                   const std::atomic<bool>& stop, bool& progressed) {
+    pb::RegisterRequest request;
+    EnvSpecToProto(spec, request.mutable_spec());
+    request.set_actor_name(config_.name);
+    request.set_num_envs(config_.num_envs);
+    pb::RegisterResponse response;
+    grpc::ClientContext register_context;
+    register_context.set_deadline(std::chrono::system_clock::now() +
+                                  std::chrono::seconds(120));
+    if (absl::Status status =
+            FromGrpc(stub_->Register(&register_context, request, &response),
+                     "registration");
+        !status.ok()) {
+      return status;
+    }
+    progressed = true;
+    const pb::RunConfig& run = response.run_config();
+    if (actor == nullptr) {
+      ActorConfig actor_config;
+      actor_config.env = config_.env;
+      actor_config.num_envs = config_.num_envs;
+      actor_config.segment_length = run.segment_length();
+      actor_config.seed = config_.seed;
+      actor_config.actor_id = response.actor_id();
+      actor_config.network.hidden.assign(run.hidden().begin(),
+                                         run.hidden().end());
+      absl::StatusOr<std::unique_ptr<ActorCore>> created =
+          ActorCore::Create(actor_config);
+      if (!created.ok()) return created.status();
+      actor = *std::move(created);
+    }
+    actor->set_stream_actor_id(response.actor_id());
+    if (absl::Status status = Apply(response.weights(), *actor); !status.ok()) {
+      return status;
+    }
+    std::fprintf(stderr, "%s: registered as actor %ld, policy version %ld\n",
+                 config_.name.c_str(), static_cast<long>(response.actor_id()),
+                 static_cast<long>(actor->policy_version()));
+
+    WeightsSlot slot;
+    grpc::ClientContext subscription_context;
+    pb::WeightsRequest weights_request;
+    weights_request.set_actor_id(response.actor_id());
+    weights_request.set_known_version(actor->policy_version());
+    std::unique_ptr<grpc::ClientReader<pb::Weights>> subscription =
+        stub_->SubscribeWeights(&subscription_context, weights_request);
+    std::thread reader([&] {
+      pb::Weights weights;
+      while (subscription->Read(&weights)) slot.Put(weights);
+      slot.End();
+    });
+
+    grpc::ClientContext stream_context;
+    pb::SegmentAck ack;
+    std::unique_ptr<grpc::ClientWriter<pb::Segment>> writer =
+        stub_->StreamSegments(&stream_context, &ack);
+    StreamSink sink(*writer);
+    const int64_t rounds_per_version =
+        run.sync() ? run.horizon() / run.segment_length() : 0;
+    int64_t rounds = 0;
+    absl::Status status;
+    while (!stop && status.ok()) {
+      if (run.sync() && rounds == rounds_per_version) {
+        // One horizon per version: wait for the next one.
+        while (!stop && !slot.ended() &&
+               (slot.Get() == nullptr ||
+                slot.Get()->version() <= actor->policy_version())) {
+          std::this_thread::sleep_for(std::chrono::milliseconds(2));
+        }
+        rounds = 0;
+        if (stop) break;
+      }
+      if (std::shared_ptr<const pb::Weights> newest = slot.Get();
+          newest != nullptr && newest->version() > actor->policy_version()) {
+        status = Apply(*newest, *actor);
+        if (!status.ok()) break;
+      }
+      if (slot.ended()) {
+        status = absl::UnavailableError("the weights subscription ended");
+        break;
+      }
+      status = actor->CollectSegments(sink);
+      ++rounds;
+    }
+    writer->WritesDone();
+    const absl::Status finished = FromGrpc(writer->Finish(), "segment stream");
+    subscription_context.TryCancel();
+    reader.join();
+    if (stop) return absl::OkStatus();
+    return finished.ok() ? status : finished;
+  }
+
+ private:
+  static absl::Status Apply(const pb::Weights& proto, ActorCore& actor) {
+    absl::StatusOr<PolicyWeights> weights = WeightsFromProto(proto, 1LL << 30);
+    if (!weights.ok()) return weights.status();
+    return actor.SetWeights(*weights);
+  }
+
+  const RemoteActorConfig& config_;
+  std::unique_ptr<pb::Learner::Stub> stub_;
+};
+
+}  // namespace
+
+absl::Status RunRemoteActor(const RemoteActorConfig& config,
+                            const std::atomic<bool>& stop) {
+  absl::StatusOr<std::unique_ptr<Environment>> probe =
+      MakeEnvironment(config.env);
+  if (!probe.ok()) return probe.status();
+  const EnvSpec spec = (*probe)->spec();
+  grpc::ChannelArguments arguments;
+  arguments.SetMaxReceiveMessageSize(config.max_message_bytes);
+  arguments.SetMaxSendMessageSize(config.max_message_bytes);
+  std::unique_ptr<ActorCore> actor;  // kept across reconnects
+  int failures = 0;
+  absl::Duration backoff = config.initial_backoff;
+  while (!stop) {
+    const std::shared_ptr<grpc::Channel> channel = grpc::CreateCustomChannel(
+        config.learner, grpc::InsecureChannelCredentials(), arguments);
+    Session session(config, channel);
+    bool progressed = false;
+    const absl::Status status = session.Run(spec, actor, stop, progressed);
+    if (stop) break;
+    if (IsRefusal(status)) return status;
+    if (progressed) {
+      failures = 0;
+      backoff = config.initial_backoff;
+    }
+    if (config.max_reconnects >= 0 && failures >= config.max_reconnects) {
+      return absl::UnavailableError(absl::StrCat(
+          "giving up after ", failures, " reconnects: ", status.message()));
+    }
+    ++failures;
+    std::fprintf(stderr, "%s: %s; reconnecting in %s\n", config.name.c_str(),
+                 std::string(status.message()).c_str(),
+                 absl::FormatDuration(backoff).c_str());
+    for (absl::Time until = absl::Now() + backoff;
+         !stop && absl::Now() < until;) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    backoff = std::min(backoff * 2, config.max_backoff);
+  }
+  return absl::OkStatus();
+}
+
+}  // namespace vantage

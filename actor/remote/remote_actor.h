@@ -1,0 +1,39 @@
+#ifndef VANTAGE_ACTOR_REMOTE_REMOTE_ACTOR_H_
+#define VANTAGE_ACTOR_REMOTE_REMOTE_ACTOR_H_
+
+// `vantage actor`: an actor core streaming to a learner over gRPC.
+
+#include <atomic>
+#include <cstdint>
+#include <string>
+
+#include "absl/status/status.h"
+#include "absl/time/time.h"
+
+namespace vantage {
+
+struct RemoteActorConfig {
+  std::string learner = "127.0.0.1:50051";  // HOST:PORT
+  std::string env = "InvertedPendulum";
+  int num_envs = 1;
+  uint64_t seed = 0;
+  std::string name = "actor";
+  // Reconnection attempts after the learner went away or refused; 0: give
+  // up at the first failure, -1: forever.
+  int max_reconnects = -1;
+  absl::Duration initial_backoff = absl::Milliseconds(200);
+  absl::Duration max_backoff = absl::Seconds(10);
+  int max_message_bytes = 256 << 20;
+};
+
+// Registers, acts with the newest weights (picked up between segments; in
+// a sync run it waits for version v + 1 after each horizon), streams
+// segments, and reconnects with exponential backoff when the learner goes
+// away, keeping its environments. Returns OK once `stop` is set, or the
+// error that ended it (a refusal, or the reconnects exhausted).
+absl::Status RunRemoteActor(const RemoteActorConfig& config,
+                            const std::atomic<bool>& stop);
+
+}  // namespace vantage
+
+#endif  // VANTAGE_ACTOR_REMOTE_REMOTE_ACTOR_H_

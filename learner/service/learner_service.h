@@ -1,0 +1,58 @@
+#ifndef VANTAGE_LEARNER_SERVICE_LEARNER_SERVICE_H_
+#define VANTAGE_LEARNER_SERVICE_LEARNER_SERVICE_H_
+
+#include <grpcpp/grpcpp.h>
+
+#include <memory>
+#include <string>
+
+#include "absl/status/statusor.h"
+#include "learner/service/actor_gateway.h"
+#include "proto/vantage.grpc.pb.h"
+
+namespace vantage {
+
+// absl::Status -> grpc::Status with the same code and message.
+grpc::Status ToGrpcStatus(const absl::Status& status);
+
+// The gRPC face of an ActorGateway; every method only translates.
+class LearnerService final : public pb::Learner::Service {
+ public:
+  explicit LearnerService(ActorGateway& gateway) : gateway_(gateway) {}
+
+  grpc::Status Register(grpc::ServerContext* context,
+                        const pb::RegisterRequest* request,
+                        pb::RegisterResponse* response) override;
+  // Ends at the first refused segment with its error (counted); the actor
+  // reopens the stream.
+  grpc::Status StreamSegments(grpc::ServerContext* context,
+                              grpc::ServerReader<pb::Segment>* reader,
+                              pb::SegmentAck* ack) override;
+  grpc::Status SubscribeWeights(
+      grpc::ServerContext* context, const pb::WeightsRequest* request,
+      grpc::ServerWriter<pb::Weights>* writer) override;
+  grpc::Status GetWeights(grpc::ServerContext* context,
+                          const pb::WeightsRequest* request,
+                          pb::Weights* response) override;
+
+ private:
+  ActorGateway& gateway_;
+};
+
+struct ServerOptions {
+  std::string listen = "127.0.0.1:0";  // port 0: the OS picks one
+  int max_message_bytes = 256 << 20;
+};
+
+struct RunningServer {
+  std::unique_ptr<grpc::Server> server;
+  int port = 0;
+};
+
+// Builds and starts a server for `service` (which must outlive it).
+absl::StatusOr<RunningServer> StartServer(const ServerOptions& options,
+                                          grpc::Service& service);
+
+}  // namespace vantage
+
+#endif  // VANTAGE_LEARNER_SERVICE_LEARNER_SERVICE_H_

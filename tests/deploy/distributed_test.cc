@@ -1,0 +1,134 @@
+// The learner and actors as separate processes over loopback gRPC.
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "absl/strings/str_join.h"
+#include "absl/strings/str_split.h"
+#include "gmock/gmock.h"
+#include "gtest/gtest.h"
+#include "tests/deploy/cli/run_vantage.h"
+
+namespace vantage {
+namespace {
+
+using ::testing::HasSubstr;
+
+std::string FreshDirectory(const std::string& name) {
+  const std::string path = TempPath(name);
+  std::filesystem::remove_all(path);
+  return path;
+}
+
+// progress.csv without the wall-clock columns (the last two).
+std::vector<std::string> DeterministicProgress(const std::string& run_dir) {
+  std::ifstream file(run_dir + "/progress.csv");
+  std::vector<std::string> rows;
+  std::string line;
+  while (std::getline(file, line)) {
+    std::vector<std::string> fields = absl::StrSplit(line, ',');
+    fields.resize(fields.size() - 2);
+    rows.push_back(absl::StrJoin(fields, ","));
+  }
+  return rows;
+}
+
+struct Learner {
+  int pid = 0;
+  std::string port;
+  std::string out, err;
+};
+
+// Starts `vantage learner <args>` and waits for its port file.
+Learner StartLearner(const std::string& args) {
+  Learner learner;
+  const std::string port_file = TempPath("port");
+  std::filesystem::remove(port_file);  // a stale one from an earlier run
+  learner.out = TempPath("learner.out");
+  learner.err = TempPath("learner.err");
+  learner.pid = StartVantage(
+      "learner --listen=127.0.0.1:0 --port_file=" + port_file + " " + args,
+      learner.out, learner.err);
+  for (int i = 0; i < 600 && !std::filesystem::exists(port_file); ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  learner.port = ReadFile(port_file);
+  while (!learner.port.empty() && learner.port.back() == '\n') {
+    learner.port.pop_back();
+  }
+  EXPECT_FALSE(learner.port.empty()) << ReadFile(learner.err);
+  return learner;
+}
+
+constexpr char kRun[] = "--steps=3072 --horizon=256 --envs=2 --seed=5";
+
+// The equivalence: a --sync run with one actor trains on exactly
+// the data of local mode and repeats its progress.csv (wall clock aside).
+TEST(DistributedTest, SyncWithOneActorReproducesLocalMode) {
+  const std::string local = FreshDirectory("local");
+  const std::string remote = FreshDirectory("remote");
+  ASSERT_EQ(RunVantage(std::string("train ") + kRun + " --run_dir=" + local)
+                .exit_code,
+            0);
+  const Learner learner =
+      StartLearner(std::string(kRun) + " --run_dir=" + remote);
+  const int actor =
+      StartVantage("actor --learner=127.0.0.1:" + learner.port +
+                       " --env=InvertedPendulum --envs=2 --seed=5",
+                   TempPath("actor.out"), TempPath("actor.err"));
+  EXPECT_EQ(WaitVantage(learner.pid, 120), 0) << ReadFile(learner.err);
+  kill(actor, SIGTERM);
+  EXPECT_EQ(WaitVantage(actor, 20), 0);
+  EXPECT_THAT(ReadFile(learner.out), HasSubstr("RESULT train"));
+  const std::vector<std::string> expected = DeterministicProgress(local);
+  ASSERT_EQ(expected.size(), 1u + 6);
+  EXPECT_EQ(DeterministicProgress(remote), expected);
+}
+
+// Two actors of two envs each fill the learner's four-stream batches: no
+// update can happen without both.
+TEST(DistributedTest, TwoActorsFeedOneLearner) {
+  const std::string run = FreshDirectory("two");
+  const Learner learner = StartLearner(
+      "--steps=4096 --horizon=256 --envs=4 --seed=1 --run_dir=" + run);
+  std::vector<int> actors;
+  for (int i = 0; i < 2; ++i) {
+    actors.push_back(StartVantage(
+        "actor --learner=127.0.0.1:" + learner.port +
+            " --env=InvertedPendulum --envs=2 --seed=" + std::to_string(10 + i),
+        TempPath("a.out"), TempPath("a.err")));
+  }
+  EXPECT_EQ(WaitVantage(learner.pid, 120), 0) << ReadFile(learner.err);
+  for (int pid : actors) {
+    kill(pid, SIGTERM);
+    EXPECT_EQ(WaitVantage(pid, 20), 0);
+  }
+  const std::vector<std::string> rows = DeterministicProgress(run);
+  ASSERT_EQ(rows.size(), 1u + 4);
+  EXPECT_THAT(rows[4], ::testing::StartsWith("4096,4,4,"));
+}
+
+TEST(DistributedTest, AnActorOfAnotherEnvironmentIsRefused) {
+  const Learner learner = StartLearner("--steps=512 --horizon=256");
+  const Outcome actor = RunVantage("actor --learner=127.0.0.1:" + learner.port +
+                                   " --env=Hopper --envs=1 --max_reconnects=0");
+  EXPECT_EQ(actor.exit_code, 1);
+  EXPECT_THAT(actor.err,
+              HasSubstr("this learner trains InvertedPendulum, not Hopper"));
+  kill(learner.pid, SIGTERM);
+  EXPECT_EQ(WaitVantage(learner.pid, 20), 0);
+}
+
+TEST(DistributedTest, AnActorWithoutALearnerGivesUpWhenTold) {
+  const Outcome actor = RunVantage(
+      "actor --learner=127.0.0.1:1 --env=InvertedPendulum --max_reconnects=2");
+  EXPECT_EQ(actor.exit_code, 1);
+  EXPECT_THAT(actor.err, HasSubstr("giving up after 2 reconnects"));
+  EXPECT_EQ(RunVantage("actor --envs=1").exit_code, 2);
+}
+
+}  // namespace
+}  // namespace vantage
