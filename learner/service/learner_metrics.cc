@@ -1,0 +1,181 @@
+#include "learner/service/learner_metrics.h"
+
+#include <cmath>
+#include <exception>
+#include <utility>
+#include <vector>
+
+#include "absl/memory/memory.h"
+#include "absl/status/status.h"
+#include "absl/strings/str_cat.h"
+
+namespace vantage {
+namespace {
+
+// The reasons the gateway refuses segments for; created up front so that
+// their series exist (at 0) before the first refusal and rate() works.
+constexpr const char* kKnownRejectReasons[] = {
+    "malformed", "invalid", "unknown_actor", "future_version", "stale"};
+
+prometheus::Counter& AddCounter(prometheus::Registry& registry,
+                                const std::string& name,
+                                const std::string& help) {
+  return prometheus::BuildCounter()
+      .Name("vantage_learner_" + name)
+      .Help(help)
+      .Register(registry)
+      .Add({});
+}
+
+prometheus::Gauge& AddGauge(prometheus::Registry& registry,
+                            const std::string& name, const std::string& help) {
+  return prometheus::BuildGauge()
+      .Name("vantage_learner_" + name)
+      .Help(help)
+      .Register(registry)
+      .Add({});
+}
+
+prometheus::Histogram& AddHistogram(
+    prometheus::Registry& registry, const std::string& name,
+    const std::string& help,
+    const prometheus::Histogram::BucketBoundaries& buckets) {
+  return prometheus::BuildHistogram()
+      .Name("vantage_learner_" + name)
+      .Help(help)
+      .Register(registry)
+      .Add({}, buckets);
+}
+
+}  // namespace
+
+LearnerMetrics::LearnerMetrics()
+    : registry_(std::make_shared<prometheus::Registry>()),
+      env_steps_(AddCounter(*registry_, "env_steps_total",
+                            "Environment steps consumed by updates.")),
+      segments_accepted_(
+          AddCounter(*registry_, "segments_accepted_total",
+                     "Segments admitted into the learner's queue.")),
+      segments_rejected_(prometheus::BuildCounter()
+                             .Name("vantage_learner_segments_rejected_total")
+                             .Help("Segments refused or dropped, by reason.")
+                             .Register(*registry_)),
+      policy_version_(AddGauge(*registry_, "policy_version",
+                               "Newest published policy version.")),
+      policy_lag_(AddHistogram(
+          *registry_, "policy_lag",
+          "Versions between the newest policy and the one that acted an "
+          "admitted segment.",
+          {0, 1, 2, 4, 8, 16, 32})),
+      queue_depth_(AddGauge(*registry_, "queue_depth",
+                            "Segments waiting in the learner's queue.")),
+      buffered_steps_(
+          AddGauge(*registry_, "buffered_steps",
+                   "Steps held in stitching buffers and pending rollouts.")),
+      update_seconds_(AddHistogram(
+          *registry_, "update_seconds",
+          "Wall time of one update (advantages and optimisation).",
+          {0.01, 0.025, 0.05, 0.1, 0.25, 0.5, 1, 2.5, 5, 10, 30, 60})),
+      mean_return_(AddGauge(*registry_, "mean_return",
+                            "Mean return of the last 100 finished episodes.")),
+      steps_per_second_(AddGauge(*registry_, "steps_per_second",
+                                 "Environment steps consumed per second.")),
+      updates_(AddCounter(*registry_, "updates_total",
+                          "Updates made by this learner process.")),
+      episodes_(AddCounter(*registry_, "episodes_total",
+                           "Episodes finished in consumed segments.")),
+      actors_registered_(AddGauge(*registry_, "actors_registered",
+                                  "Actors registered with the learner.")) {
+  for (const char* reason : kKnownRejectReasons) RejectedCounter(reason);
+}
+
+LearnerMetrics::~LearnerMetrics() = default;
+
+absl::StatusOr<std::unique_ptr<LearnerMetrics>> LearnerMetrics::Start(
+    const std::string& bind_address) {
+  if (bind_address.empty()) {
+    return absl::InvalidArgumentError(
+        "the metrics address is empty (expected IP:PORT)");
+  }
+  auto metrics = absl::WrapUnique(new LearnerMetrics());
+  try {
+    metrics->exposer_ = std::make_unique<prometheus::Exposer>(bind_address);
+  } catch (const std::exception& e) {
+    // civetweb reports every failure to listen the same way.
+    return absl::UnavailableError(
+        absl::StrCat("cannot serve learner metrics on \"", bind_address,
+                     "\" (in use, malformed, or not a local address; "
+                     "expected IP:PORT): ",
+                     e.what()));
+  }
+  metrics->exposer_->RegisterCollectable(metrics->registry_);
+  return metrics;
+}
+
+int LearnerMetrics::port() const {
+  const std::vector<int> ports = exposer_->GetListeningPorts();
+  return ports.empty() ? 0 : ports.front();
+}
+
+void LearnerMetrics::RecordUpdate(int64_t policy_version,
+                                  int64_t env_steps_total,
+                                  int64_t episodes_total, double update_seconds,
+                                  double mean_return, double steps_per_second) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (policy_version > last_update_version_) {
+    last_update_version_ = policy_version;
+    updates_.Increment();
+    // A NaN would poison the histogram's sum for good.
+    if (std::isfinite(update_seconds) && update_seconds >= 0) {
+      update_seconds_.Observe(update_seconds);
+    }
+  }
+  policy_version_.Set(static_cast<double>(policy_version));
+  env_steps_.Increment(
+      static_cast<double>(env_steps_total_.Advance(env_steps_total)));
+  episodes_.Increment(
+      static_cast<double>(episodes_total_.Advance(episodes_total)));
+  if (std::isfinite(mean_return)) mean_return_.Set(mean_return);
+  if (std::isfinite(steps_per_second)) steps_per_second_.Set(steps_per_second);
+}
+
+void LearnerMetrics::RecordSegmentsAccepted(int64_t total_segments) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  segments_accepted_.Increment(
+      static_cast<double>(segments_accepted_total_.Advance(total_segments)));
+}
+
+void LearnerMetrics::RecordRejected(
+    const std::map<std::string, int64_t>& totals_by_reason) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  for (const auto& [reason, total] : totals_by_reason) {
+    const int64_t increment = rejected_totals_[reason].Advance(total);
+    if (increment > 0) {
+      RejectedCounter(reason).Increment(static_cast<double>(increment));
+    }
+  }
+}
+
+void LearnerMetrics::RecordPolicyLag(int64_t lag) {
+  if (lag < 0) return;
+  policy_lag_.Observe(static_cast<double>(lag));
+}
+
+void LearnerMetrics::SetQueueDepth(int64_t segments, int64_t buffered_steps) {
+  queue_depth_.Set(static_cast<double>(segments));
+  buffered_steps_.Set(static_cast<double>(buffered_steps));
+}
+
+void LearnerMetrics::SetActorsRegistered(int64_t n) {
+  actors_registered_.Set(static_cast<double>(n));
+}
+
+prometheus::Counter& LearnerMetrics::RejectedCounter(
+    const std::string& reason) {
+  prometheus::Counter*& counter = rejected_counters_[reason];
+  if (counter == nullptr)
+    counter = &segments_rejected_.Add({{"reason", reason}});
+  return *counter;
+}
+
+}  // namespace vantage

@@ -1,0 +1,99 @@
+#ifndef VANTAGE_LEARNER_SERVICE_LEARNER_METRICS_H_
+#define VANTAGE_LEARNER_SERVICE_LEARNER_METRICS_H_
+
+// The learner's Prometheus endpoint (GET /metrics). Every method takes
+// plain values, so the learner core and the gateway stay unaware of
+// Prometheus; the process that owns them reports into this.
+
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <string>
+
+#include "absl/status/statusor.h"
+#include "common/util/running_total.h"
+#include "prometheus/counter.h"
+#include "prometheus/exposer.h"
+#include "prometheus/family.h"
+#include "prometheus/gauge.h"
+#include "prometheus/histogram.h"
+#include "prometheus/registry.h"
+
+namespace vantage {
+
+class LearnerMetrics {
+ public:
+  // Serves the metrics over HTTP on `bind_address` ("IP:PORT", e.g.
+  // "0.0.0.0:9100"; port 0 lets the OS choose, see port()). An address
+  // that cannot be bound (in use, malformed, not local) is an Unavailable
+  // error naming it.
+  static absl::StatusOr<std::unique_ptr<LearnerMetrics>> Start(
+      const std::string& bind_address);
+  ~LearnerMetrics();
+
+  LearnerMetrics(const LearnerMetrics&) = delete;
+  LearnerMetrics& operator=(const LearnerMetrics&) = delete;
+
+  // The port actually listened on.
+  int port() const;
+
+  // After an update that published `policy_version`. The totals are the
+  // learner's running totals (counters advance by the difference to the
+  // highest total seen). The update is counted, and `update_seconds`
+  // observed, only if `policy_version` is above the last one recorded, so
+  // the same update recorded twice counts once. A non-finite mean return
+  // (NaN before the first episode ends) or steps per second leaves its
+  // gauge as it was.
+  void RecordUpdate(int64_t policy_version, int64_t env_steps_total,
+                    int64_t episodes_total, double update_seconds,
+                    double mean_return, double steps_per_second);
+  // Running total of segments admitted into the learner's queue.
+  void RecordSegmentsAccepted(int64_t total_segments);
+  // Running totals of refused segments by reason (the gateway's "malformed",
+  // "invalid", "unknown_actor", "future_version", "stale", or any other).
+  // Each reason's total must come from a single counting source.
+  void RecordRejected(const std::map<std::string, int64_t>& totals_by_reason);
+  // Versions between the newest policy and the one that acted an admitted
+  // segment. Negative lags (future versions are refused) are ignored.
+  void RecordPolicyLag(int64_t lag);
+  // Segments waiting in the learner's queue, and steps held in the
+  // stitcher's buffers and pending rollouts.
+  void SetQueueDepth(int64_t segments, int64_t buffered_steps);
+  void SetActorsRegistered(int64_t n);
+
+ private:
+  LearnerMetrics();
+  prometheus::Counter& RejectedCounter(const std::string& reason);
+
+  // Declared before the exposer, so it outlives the exposer's threads.
+  std::shared_ptr<prometheus::Registry> registry_;
+  prometheus::Counter& env_steps_;
+  prometheus::Counter& segments_accepted_;
+  prometheus::Family<prometheus::Counter>& segments_rejected_;
+  prometheus::Gauge& policy_version_;
+  prometheus::Histogram& policy_lag_;
+  prometheus::Gauge& queue_depth_;
+  prometheus::Gauge& buffered_steps_;
+  prometheus::Histogram& update_seconds_;
+  prometheus::Gauge& mean_return_;
+  prometheus::Gauge& steps_per_second_;
+  prometheus::Counter& updates_;
+  prometheus::Counter& episodes_;
+  prometheus::Gauge& actors_registered_;
+
+  // Guards the totals: the learner loop and the gRPC threads both report.
+  std::mutex mutex_;
+  int64_t last_update_version_ = 0;
+  RunningTotal env_steps_total_;
+  RunningTotal episodes_total_;
+  RunningTotal segments_accepted_total_;
+  std::map<std::string, RunningTotal> rejected_totals_;
+  std::map<std::string, prometheus::Counter*> rejected_counters_;
+
+  std::unique_ptr<prometheus::Exposer> exposer_;
+};
+
+}  // namespace vantage
+
+#endif  // VANTAGE_LEARNER_SERVICE_LEARNER_METRICS_H_

@@ -1,0 +1,220 @@
+#include "learner/service/learner_metrics.h"
+
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <memory>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_split.h"
+#include "gmock/gmock.h"
+#include "gtest/gtest.h"
+#include "tests/fakes/http_get.h"
+
+namespace vantage {
+namespace {
+
+using ::testing::Contains;
+using ::testing::HasSubstr;
+using ::testing::Not;
+
+std::unique_ptr<LearnerMetrics> StartOnAnyPort() {
+  absl::StatusOr<std::unique_ptr<LearnerMetrics>> metrics =
+      LearnerMetrics::Start("127.0.0.1:0");
+  EXPECT_TRUE(metrics.ok()) << metrics.status();
+  if (!metrics.ok()) return nullptr;
+  EXPECT_GT((*metrics)->port(), 0);
+  return *std::move(metrics);
+}
+
+// The exposition text's lines, as a scraper sees them.
+std::vector<std::string> Scrape(const LearnerMetrics& metrics) {
+  absl::StatusOr<std::string> body = HttpGet(metrics.port(), "/metrics");
+  EXPECT_TRUE(body.ok()) << body.status();
+  if (!body.ok()) return {};
+  return absl::StrSplit(*body, '\n');
+}
+
+TEST(LearnerMetricsTest, ServesRecordedValuesWithHelp) {
+  std::unique_ptr<LearnerMetrics> metrics = StartOnAnyPort();
+  ASSERT_NE(metrics, nullptr);
+  metrics->RecordUpdate(/*policy_version=*/1, /*env_steps_total=*/4096,
+                        /*episodes_total=*/3, /*update_seconds=*/0.5,
+                        /*mean_return=*/12.5, /*steps_per_second=*/1000);
+  metrics->RecordSegmentsAccepted(32);
+  metrics->RecordRejected({{"stale", 3}, {"malformed", 1}});
+  metrics->SetQueueDepth(5, 640);
+  metrics->SetActorsRegistered(2);
+
+  const std::vector<std::string> lines = Scrape(*metrics);
+  for (const char* line : {
+           "vantage_learner_env_steps_total 4096",
+           "vantage_learner_episodes_total 3",
+           "vantage_learner_updates_total 1",
+           "vantage_learner_policy_version 1",
+           "vantage_learner_mean_return 12.5",
+           "vantage_learner_steps_per_second 1000",
+           "vantage_learner_segments_accepted_total 32",
+           "vantage_learner_segments_rejected_total{reason=\"stale\"} 3",
+           "vantage_learner_segments_rejected_total{reason=\"malformed\"} 1",
+           "vantage_learner_queue_depth 5",
+           "vantage_learner_buffered_steps 640",
+           "vantage_learner_actors_registered 2",
+           "vantage_learner_update_seconds_count 1",
+           "vantage_learner_update_seconds_sum 0.5",
+           "vantage_learner_update_seconds_bucket{le=\"0.25\"} 0",
+           "vantage_learner_update_seconds_bucket{le=\"0.5\"} 1",
+           "vantage_learner_update_seconds_bucket{le=\"60\"} 1",
+           "# TYPE vantage_learner_env_steps_total counter",
+           "# TYPE vantage_learner_policy_lag histogram",
+           "# TYPE vantage_learner_mean_return gauge",
+       }) {
+    EXPECT_THAT(lines, Contains(line));
+  }
+  for (const char* name :
+       {"env_steps_total", "segments_accepted_total", "segments_rejected_total",
+        "policy_version", "policy_lag", "queue_depth", "buffered_steps",
+        "update_seconds", "mean_return", "steps_per_second", "updates_total",
+        "episodes_total", "actors_registered"}) {
+    EXPECT_THAT(
+        lines,
+        Contains(HasSubstr(absl::StrCat("# HELP vantage_learner_", name, " "))))
+        << name;
+  }
+}
+
+TEST(LearnerMetricsTest, KnownRejectReasonsStartAtZero) {
+  std::unique_ptr<LearnerMetrics> metrics = StartOnAnyPort();
+  ASSERT_NE(metrics, nullptr);
+  const std::vector<std::string> lines = Scrape(*metrics);
+  for (const char* reason :
+       {"malformed", "invalid", "unknown_actor", "future_version", "stale"}) {
+    EXPECT_THAT(lines, Contains(absl::StrCat(
+                           "vantage_learner_segments_rejected_total{reason=\"",
+                           reason, "\"} 0")));
+  }
+}
+
+TEST(LearnerMetricsTest, SameTotalsTwiceCountOnce) {
+  std::unique_ptr<LearnerMetrics> metrics = StartOnAnyPort();
+  ASSERT_NE(metrics, nullptr);
+  for (int i = 0; i < 2; ++i) {
+    metrics->RecordUpdate(1, 4096, 3, 0.5, 12.5, 1000);
+    metrics->RecordSegmentsAccepted(32);
+    metrics->RecordRejected({{"stale", 3}});
+  }
+  std::vector<std::string> lines = Scrape(*metrics);
+  EXPECT_THAT(lines, Contains("vantage_learner_env_steps_total 4096"));
+  EXPECT_THAT(lines, Contains("vantage_learner_episodes_total 3"));
+  EXPECT_THAT(lines, Contains("vantage_learner_updates_total 1"));
+  EXPECT_THAT(lines, Contains("vantage_learner_update_seconds_count 1"));
+  EXPECT_THAT(lines, Contains("vantage_learner_segments_accepted_total 32"));
+  EXPECT_THAT(
+      lines,
+      Contains("vantage_learner_segments_rejected_total{reason=\"stale\"} 3"));
+
+  // Newer totals add their difference; an older total arriving late adds
+  // nothing.
+  metrics->RecordUpdate(2, 8192, 5, 0.25, 13.0, 1100);
+  metrics->RecordUpdate(1, 4096, 3, 0.5, 12.5, 1000);
+  metrics->RecordSegmentsAccepted(40);
+  metrics->RecordSegmentsAccepted(35);
+  metrics->RecordRejected({{"stale", 7}, {"unknown_actor", 2}});
+  metrics->RecordRejected({{"stale", 5}});
+  lines = Scrape(*metrics);
+  EXPECT_THAT(lines, Contains("vantage_learner_env_steps_total 8192"));
+  EXPECT_THAT(lines, Contains("vantage_learner_episodes_total 5"));
+  EXPECT_THAT(lines, Contains("vantage_learner_updates_total 2"));
+  EXPECT_THAT(lines, Contains("vantage_learner_update_seconds_count 2"));
+  EXPECT_THAT(lines, Contains("vantage_learner_segments_accepted_total 40"));
+  EXPECT_THAT(
+      lines,
+      Contains("vantage_learner_segments_rejected_total{reason=\"stale\"} 7"));
+  EXPECT_THAT(lines, Contains("vantage_learner_segments_rejected_total{reason="
+                              "\"unknown_actor\"} 2"));
+}
+
+TEST(LearnerMetricsTest, TotalsFromManyThreadsCountOnce) {
+  std::unique_ptr<LearnerMetrics> metrics = StartOnAnyPort();
+  ASSERT_NE(metrics, nullptr);
+  std::vector<std::thread> threads;
+  for (int t = 0; t < 4; ++t) {
+    threads.emplace_back([&metrics] {
+      for (int64_t total = 1; total <= 1000; ++total) {
+        metrics->RecordSegmentsAccepted(total);
+        metrics->RecordRejected({{"invalid", total}});
+      }
+    });
+  }
+  for (std::thread& thread : threads) thread.join();
+  const std::vector<std::string> lines = Scrape(*metrics);
+  EXPECT_THAT(lines, Contains("vantage_learner_segments_accepted_total 1000"));
+  EXPECT_THAT(
+      lines,
+      Contains(
+          "vantage_learner_segments_rejected_total{reason=\"invalid\"} 1000"));
+}
+
+TEST(LearnerMetricsTest, NanMeanReturnKeepsTheGauge) {
+  std::unique_ptr<LearnerMetrics> metrics = StartOnAnyPort();
+  ASSERT_NE(metrics, nullptr);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  metrics->RecordUpdate(1, 100, 0, 0.1, nan, 50);
+  EXPECT_THAT(Scrape(*metrics), Contains("vantage_learner_mean_return 0"));
+  metrics->RecordUpdate(2, 200, 1, 0.1, -3.5, 50);
+  metrics->RecordUpdate(3, 300, 1, 0.1, nan, nan);
+  const std::vector<std::string> lines = Scrape(*metrics);
+  EXPECT_THAT(lines, Contains("vantage_learner_mean_return -3.5"));
+  EXPECT_THAT(lines, Contains("vantage_learner_steps_per_second 50"));
+  EXPECT_THAT(lines, Contains("vantage_learner_policy_version 3"));
+  EXPECT_THAT(lines, Not(Contains(HasSubstr("NaN"))));
+  EXPECT_THAT(lines, Not(Contains(HasSubstr("Nan"))));
+}
+
+TEST(LearnerMetricsTest, PolicyLagHistogramBuckets) {
+  std::unique_ptr<LearnerMetrics> metrics = StartOnAnyPort();
+  ASSERT_NE(metrics, nullptr);
+  for (int64_t lag : {0, 1, 1, 3, 16, 40, -1}) metrics->RecordPolicyLag(lag);
+  const std::vector<std::string> lines = Scrape(*metrics);
+  for (const char* line : {
+           "vantage_learner_policy_lag_bucket{le=\"0\"} 1",
+           "vantage_learner_policy_lag_bucket{le=\"1\"} 3",
+           "vantage_learner_policy_lag_bucket{le=\"2\"} 3",
+           "vantage_learner_policy_lag_bucket{le=\"4\"} 4",
+           "vantage_learner_policy_lag_bucket{le=\"8\"} 4",
+           "vantage_learner_policy_lag_bucket{le=\"16\"} 5",
+           "vantage_learner_policy_lag_bucket{le=\"32\"} 5",
+           "vantage_learner_policy_lag_bucket{le=\"+Inf\"} 6",
+           "vantage_learner_policy_lag_count 6",
+           "vantage_learner_policy_lag_sum 61",
+       }) {
+    EXPECT_THAT(lines, Contains(line));
+  }
+}
+
+TEST(LearnerMetricsTest, AddressInUseIsAnErrorNamingIt) {
+  std::unique_ptr<LearnerMetrics> first = StartOnAnyPort();
+  ASSERT_NE(first, nullptr);
+  const std::string address = absl::StrCat("127.0.0.1:", first->port());
+  absl::StatusOr<std::unique_ptr<LearnerMetrics>> second =
+      LearnerMetrics::Start(address);
+  ASSERT_FALSE(second.ok());
+  EXPECT_EQ(second.status().code(), absl::StatusCode::kUnavailable);
+  EXPECT_THAT(second.status().message(), HasSubstr(address));
+  // The first one still serves.
+  EXPECT_THAT(Scrape(*first), Contains("vantage_learner_updates_total 0"));
+}
+
+TEST(LearnerMetricsTest, MalformedAddressIsAnError) {
+  for (const char* address : {"", "not an address", "127.0.0.1:99999"}) {
+    absl::StatusOr<std::unique_ptr<LearnerMetrics>> metrics =
+        LearnerMetrics::Start(address);
+    EXPECT_FALSE(metrics.ok()) << address;
+  }
+}
+
+}  // namespace
+}  // namespace vantage
