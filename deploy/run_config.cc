@@ -21,7 +21,11 @@ absl::Status Invalid(absl::string_view flag, absl::string_view rule) {
 
 absl::StatusOr<pb::RunConfig> ResolveRunConfig(const pb::RunConfig& given) {
   pb::RunConfig c = given;
-  if (!c.has_mode()) c.set_mode("local");
+  // Asking for actor processes means a distributed run.
+  if (!c.has_mode()) {
+    c.set_mode(c.has_actors() || c.has_envs_per_actor() ? "distributed"
+                                                        : "local");
+  }
   if (!c.has_env()) c.set_env("InvertedPendulum");
   if (!c.has_algo()) c.set_algo("ppo");
   if (!c.has_estimator()) c.set_estimator("maxabs");
@@ -31,10 +35,31 @@ absl::StatusOr<pb::RunConfig> ResolveRunConfig(const pb::RunConfig& given) {
   }
   if (!c.has_steps()) c.set_steps(150000);
   if (!c.has_seed()) c.set_seed(0);
+  if (c.mode() == "distributed") {
+    if (!c.has_actors()) c.set_actors(2);
+    if (!c.has_envs_per_actor()) c.set_envs_per_actor(1);
+    if (c.actors() < 1 || c.actors() > 256) {
+      return Invalid("actors", "must be in [1, 256]");
+    }
+    if (c.envs_per_actor() < 1)
+      return Invalid("envs_per_actor", "must be >= 1");
+    // The learner's batch holds one rollout per actor environment.
+    if (c.has_envs() && c.envs() != c.actors() * c.envs_per_actor()) {
+      return Invalid("envs",
+                     absl::StrCat("is the learner's batch of --actors x "
+                                  "--envs_per_actor = ",
+                                  c.actors() * c.envs_per_actor(),
+                                  " streams in a distributed run"));
+    }
+    c.set_envs(c.actors() * c.envs_per_actor());
+  } else {
+    c.clear_actors();
+    c.clear_envs_per_actor();
+  }
   if (!c.has_envs()) c.set_envs(1);
-  if (c.mode() != "local") {
+  if (c.mode() != "local" && c.mode() != "distributed") {
     return Invalid("mode:", absl::StrCat("unknown mode '", c.mode(),
-                                         "'; available: local"));
+                                         "'; available: local, distributed"));
   }
   AlgorithmConfig algorithms;
   algorithms.name = c.algo();

@@ -31,7 +31,12 @@ ABSL_FLAG(bool, example, false,
 ABSL_FLAG(std::string, env, "",
           "rollout, bench env, train: environment name (see `vantage envs`) "
           "or mjcf:PATH; train defaults to InvertedPendulum");
-ABSL_FLAG(std::string, mode, "local", "train: local (one process)");
+ABSL_FLAG(std::string, mode, "local",
+          "train: local (one process) | distributed (a learner and --actors "
+          "actor processes over gRPC; implied by --actors)");
+ABSL_FLAG(int, actors, 2, "train --mode=distributed: actor processes");
+ABSL_FLAG(int, envs_per_actor, 1,
+          "train --mode=distributed: environments per actor");
 ABSL_FLAG(std::string, algo, "ppo", "train: ppo | a2c | trpo");
 ABSL_FLAG(std::string, estimator, "maxabs",
           "train: gae | max | min | maxabs | order:D");
@@ -227,6 +232,10 @@ bool BuildTrainRequest(TrainRequest& request) {
     c.set_keep_checkpoints(absl::GetFlag(FLAGS_keep_checkpoints));
   }
   if (Given("sync") || Given("nosync")) c.set_sync(absl::GetFlag(FLAGS_sync));
+  if (Given("actors")) c.set_actors(absl::GetFlag(FLAGS_actors));
+  if (Given("envs_per_actor")) {
+    c.set_envs_per_actor(absl::GetFlag(FLAGS_envs_per_actor));
+  }
   if (Given("max_policy_lag")) {
     c.set_max_policy_lag(absl::GetFlag(FLAGS_max_policy_lag));
   }

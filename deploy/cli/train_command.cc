@@ -5,11 +5,13 @@
 
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <vector>
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_join.h"
 #include "deploy/cli/stop_signal.h"
+#include "deploy/launcher.h"
 #include "deploy/learner_server.h"
 #include "deploy/local_training.h"
 #include "deploy/run_config.h"
@@ -114,6 +116,39 @@ void PrintResult(const pb::RunConfig& config, const ProgressRow& last) {
       last.elapsed_seconds, last.steps_per_second);
 }
 
+// One learner and --actors actor processes (deploy/launcher.h).
+int RunDistributed(const ResolvedRun& run) {
+  if (run.local.resume) {
+    return Fail("--resume of a distributed run is not supported yet");
+  }
+  LaunchConfig launch;
+  launch.run_config = run.config;
+  launch.run_dir = run.local.run_dir;
+  launch.work_dir =
+      run.local.run_dir.empty()
+          ? absl::StrCat(std::filesystem::temp_directory_path().string(),
+                         "/vantage-launch-", ::getpid())
+          : run.local.run_dir + "/launch";
+  std::printf(
+      "training %s with %s, estimator %s (rho %g), %ld steps, seed %lu: "
+      "1 learner + %d actors x %d envs over gRPC%s%s\n",
+      run.config.env().c_str(), run.config.algo().c_str(),
+      run.config.estimator().c_str(), run.config.rho(),
+      static_cast<long>(run.config.steps()),
+      static_cast<unsigned long>(run.config.seed()), run.config.actors(),
+      run.config.envs_per_actor(),
+      run.local.run_dir.empty() ? "" : ", run directory ",
+      run.local.run_dir.c_str());
+  std::fflush(stdout);
+  const absl::Status status = RunDistributedTraining(launch, StopRequested());
+  if (run.local.run_dir.empty()) {
+    std::error_code error;
+    std::filesystem::remove_all(launch.work_dir, error);
+  }
+  if (!status.ok()) return Fail(status.message());
+  return 0;
+}
+
 }  // namespace
 
 int RunLearnerCommand(const LearnerRequest& request) {
@@ -150,6 +185,7 @@ int RunTrainCommand(const TrainRequest& request) {
   if (!resolved.ok()) return Fail(resolved.status().message());
   const pb::RunConfig* config = &resolved->config;
   const LocalTrainingConfig& local = resolved->local;
+  if (config->mode() == "distributed") return RunDistributed(*resolved);
 
   at::set_num_threads(1);
   std::printf(

@@ -1,11 +1,13 @@
 // The learner and actors as separate processes over loopback gRPC.
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <string>
 #include <thread>
 #include <vector>
 
+#include "absl/strings/numbers.h"
 #include "absl/strings/str_join.h"
 #include "absl/strings/str_split.h"
 #include "gmock/gmock.h"
@@ -109,6 +111,57 @@ TEST(DistributedTest, TwoActorsFeedOneLearner) {
   const std::vector<std::string> rows = DeterministicProgress(run);
   ASSERT_EQ(rows.size(), 1u + 4);
   EXPECT_THAT(rows[4], ::testing::StartsWith("4096,4,4,"));
+}
+
+// The children of `parent` whose command line contains `word`.
+std::vector<int> ChildrenRunning(int parent, const std::string& word) {
+  std::vector<int> pids;
+  for (const auto& entry : std::filesystem::directory_iterator("/proc")) {
+    int pid = 0;
+    if (!absl::SimpleAtoi(entry.path().filename().string(), &pid)) continue;
+    const std::string stat = ReadFile(entry.path().string() + "/stat");
+    // Field 4 of /proc/PID/stat is the parent (after "(comm)").
+    const size_t close = stat.rfind(')');
+    if (close == std::string::npos) continue;
+    const std::vector<std::string> fields =
+        absl::StrSplit(stat.substr(close + 2), ' ');
+    if (fields.size() < 2 || fields[1] != std::to_string(parent)) continue;
+    std::string command = ReadFile(entry.path().string() + "/cmdline");
+    std::replace(command.begin(), command.end(), '\0', ' ');
+    if (command.find(word) != std::string::npos) pids.push_back(pid);
+  }
+  return pids;
+}
+
+// The main job: `vantage train --actors=2` supervises its processes; an
+// actor killed with SIGKILL mid-run is restarted (and logged), the learner
+// keeps training and the run completes.
+TEST(DistributedTest, TrainRestartsAKilledActor) {
+  const std::string run = FreshDirectory("supervised");
+  const std::string err = TempPath("train.err");
+  const int train = StartVantage(
+      "train --actors=2 --envs_per_actor=1 --steps=6144 --horizon=512 "
+      "--seed=3 --run_dir=" +
+          run,
+      TempPath("train.out"), err);
+  // Wait for the first update, then kill one actor.
+  for (int i = 0; i < 1200 && DeterministicProgress(run).size() < 2; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  ASSERT_GE(DeterministicProgress(run).size(), 2u) << ReadFile(err);
+  const std::vector<int> actors = ChildrenRunning(train, " actor ");
+  ASSERT_EQ(actors.size(), 2u);
+  kill(actors[0], SIGKILL);
+  EXPECT_EQ(WaitVantage(train, 180), 0) << ReadFile(err);
+  EXPECT_THAT(ReadFile(err), HasSubstr("ended (signal 9); restarting it"));
+  // Under a new id: its streams are new ones, never stitched onto the
+  // killed actor's.
+  EXPECT_THAT(ReadFile(err), HasSubstr("registered as actor 2,"));
+  const std::vector<std::string> rows = DeterministicProgress(run);
+  ASSERT_EQ(rows.size(), 1u + 6);
+  EXPECT_THAT(rows[6], ::testing::StartsWith("6144,6,6,"));
+  // No process of the run is left behind.
+  EXPECT_TRUE(ChildrenRunning(train, "vantage").empty());
 }
 
 TEST(DistributedTest, AnActorOfAnotherEnvironmentIsRefused) {

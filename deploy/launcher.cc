@@ -1,0 +1,176 @@
+#include "deploy/launcher.h"
+
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <thread>
+#include <vector>
+
+#include "absl/strings/numbers.h"
+#include "absl/strings/str_cat.h"
+#include "absl/strings/strip.h"
+#include "deploy/run_config.h"
+
+namespace vantage {
+namespace {
+
+// Runs this binary with `args` as a child process.
+absl::StatusOr<pid_t> Spawn(const std::vector<std::string>& args) {
+  std::error_code error;
+  const std::string self =
+      std::filesystem::read_symlink("/proc/self/exe", error).string();
+  if (error) return absl::InternalError("cannot find this binary");
+  std::vector<char*> argv;
+  argv.push_back(const_cast<char*>(self.c_str()));
+  for (const std::string& arg : args) {
+    argv.push_back(const_cast<char*>(arg.c_str()));
+  }
+  argv.push_back(nullptr);
+  const pid_t pid = fork();
+  if (pid < 0) return absl::InternalError("fork failed");
+  if (pid == 0) {
+    execv(self.c_str(), argv.data());
+    _exit(127);
+  }
+  return pid;
+}
+
+std::string Describe(int status) {
+  if (WIFEXITED(status)) return absl::StrCat("exit code ", WEXITSTATUS(status));
+  if (WIFSIGNALED(status)) return absl::StrCat("signal ", WTERMSIG(status));
+  return "unknown status";
+}
+
+// SIGTERM, then SIGKILL after `grace`.
+void Terminate(const std::vector<pid_t>& pids, std::chrono::seconds grace) {
+  for (pid_t pid : pids) {
+    if (pid > 0) kill(pid, SIGTERM);
+  }
+  const auto deadline = std::chrono::steady_clock::now() + grace;
+  for (pid_t pid : pids) {
+    if (pid <= 0) continue;
+    while (waitpid(pid, nullptr, WNOHANG) == 0) {
+      if (std::chrono::steady_clock::now() > deadline) {
+        kill(pid, SIGKILL);
+        waitpid(pid, nullptr, 0);
+        break;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+  }
+}
+
+}  // namespace
+
+absl::Status RunDistributedTraining(const LaunchConfig& config,
+                                    const std::atomic<bool>& stop) {
+  const pb::RunConfig& run = config.run_config;
+  std::error_code error;
+  std::filesystem::create_directories(config.work_dir, error);
+  const std::string config_path = config.work_dir + "/launch_config.json";
+  const std::string port_file = config.work_dir + "/learner.port";
+  std::filesystem::remove(port_file, error);
+  {
+    std::ofstream file(config_path, std::ios::trunc);
+    file << RunConfigToJson(run);
+    if (!file.flush()) {
+      return absl::InternalError(absl::StrCat("cannot write ", config_path));
+    }
+  }
+  std::vector<std::string> learner_args = {"learner", "--config=" + config_path,
+                                           "--listen=127.0.0.1:0",
+                                           "--port_file=" + port_file};
+  if (!config.run_dir.empty()) {
+    learner_args.push_back("--run_dir=" + config.run_dir);
+  }
+  absl::StatusOr<pid_t> learner = Spawn(learner_args);
+  if (!learner.ok()) return learner.status();
+
+  // The learner writes its port once serving.
+  std::string port;
+  while (port.empty()) {
+    int status = 0;
+    if (waitpid(*learner, &status, WNOHANG) == *learner) {
+      return absl::InternalError(absl::StrCat(
+          "the learner ended before serving (", Describe(status), ")"));
+    }
+    if (stop) {
+      Terminate({*learner}, std::chrono::seconds(10));
+      return absl::OkStatus();
+    }
+    std::ifstream file(port_file);
+    std::string line;
+    if (std::getline(file, line) && !line.empty()) port = line;
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  std::fprintf(stderr, "launcher: learner on port %s, starting %d actors\n",
+               port.c_str(), run.actors());
+
+  auto start_actor = [&](int i) {
+    return Spawn({"actor", "--learner=127.0.0.1:" + port, "--env=" + run.env(),
+                  absl::StrCat("--envs=", run.envs_per_actor()),
+                  absl::StrCat("--seed=", run.seed() + i),
+                  absl::StrCat("--name=actor-", i)});
+  };
+  std::vector<pid_t> actors(run.actors(), -1);
+  for (int i = 0; i < run.actors(); ++i) {
+    absl::StatusOr<pid_t> pid = start_actor(i);
+    if (!pid.ok()) {
+      Terminate({*learner}, std::chrono::seconds(10));
+      return pid.status();
+    }
+    actors[i] = *pid;
+  }
+
+  int restarts = 0;
+  absl::Status result;
+  while (true) {
+    if (stop) {
+      // Everyone gets the signal; the learner writes its last checkpoint.
+      std::vector<pid_t> all = actors;
+      all.push_back(*learner);
+      Terminate(all, std::chrono::seconds(30));
+      return absl::OkStatus();
+    }
+    int status = 0;
+    const pid_t done = waitpid(-1, &status, WNOHANG);
+    if (done == *learner) {
+      if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
+        result = absl::InternalError(
+            absl::StrCat("the learner failed (", Describe(status), ")"));
+      }
+      break;
+    }
+    for (int i = 0; done > 0 && i < run.actors(); ++i) {
+      if (actors[i] != done) continue;
+      if (restarts >= config.max_actor_restarts) {
+        actors[i] = -1;
+        result = absl::InternalError(
+            absl::StrCat("actor ", i, " ended (", Describe(status), ") after ",
+                         restarts, " restarts; giving up"));
+        break;
+      }
+      ++restarts;
+      std::fprintf(stderr, "launcher: actor %d ended (%s); restarting it\n", i,
+                   Describe(status).c_str());
+      absl::StatusOr<pid_t> pid = start_actor(i);
+      actors[i] = pid.ok() ? *pid : -1;
+    }
+    if (!result.ok()) {
+      std::vector<pid_t> all = actors;
+      all.push_back(*learner);
+      Terminate(all, std::chrono::seconds(30));
+      return result;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  Terminate(actors, std::chrono::seconds(10));
+  return result;
+}
+
+}  // namespace vantage

@@ -1,0 +1,35 @@
+#ifndef VANTAGE_DEPLOY_LAUNCHER_H_
+#define VANTAGE_DEPLOY_LAUNCHER_H_
+
+// The main job on one machine: one learner process and N actor processes
+// of this same binary over loopback gRPC, supervised.
+
+#include <atomic>
+#include <string>
+
+#include "absl/status/status.h"
+#include "proto/run_config.pb.h"
+
+namespace vantage {
+
+struct LaunchConfig {
+  pb::RunConfig run_config;  // resolved, mode "distributed"
+  std::string run_dir;       // may be empty
+  // Where the learner's port file and the config it reads go.
+  std::string work_dir;
+  // Restarts of crashed actors before the run is given up.
+  int max_actor_restarts = 20;
+};
+
+// Starts `vantage learner` on 127.0.0.1 with a free port, then the actors
+// (actor i gets seed + i, so one actor repeats a local run), restarts an
+// actor that dies (logged), forwards `stop` (SIGINT/SIGTERM) to every
+// process, and returns when the learner finishes the run (the actors are
+// then stopped). The learner's output (progress, the RESULT line) passes
+// through.
+absl::Status RunDistributedTraining(const LaunchConfig& config,
+                                    const std::atomic<bool>& stop);
+
+}  // namespace vantage
+
+#endif  // VANTAGE_DEPLOY_LAUNCHER_H_
