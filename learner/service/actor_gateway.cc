@@ -63,7 +63,9 @@ absl::Status ActorGateway::Reject(const std::string& reason,
   return status;
 }
 
-absl::Status ActorGateway::Admit(const pb::Segment& proto) {
+absl::Status ActorGateway::Admit(const pb::Segment& proto,
+                                 std::string* dropped) {
+  if (dropped != nullptr) dropped->clear();
   int64_t newest = -1;
   std::optional<EnvSpec> spec;
   {
@@ -93,6 +95,11 @@ absl::Status ActorGateway::Admit(const pb::Segment& proto) {
   }
   if (config_.max_policy_lag >= 0 &&
       segment->policy_version < newest - config_.max_policy_lag) {
+    if (dropped != nullptr) {
+      *dropped = absl::StrCat(
+          "segment.policy_version ", segment->policy_version, " is more than ",
+          config_.max_policy_lag, " versions behind the newest (", newest, ")");
+    }
     std::lock_guard<std::mutex> lock(mutex_);
     ++counters_.rejected["stale"];
     return absl::OkStatus();

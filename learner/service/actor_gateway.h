@@ -57,9 +57,11 @@ class ActorGateway {
   // Decodes and validates one segment and hands it to the learner.
   // InvalidArgument (malformed, or wrong for the spec) and
   // FailedPrecondition (unknown actor, a version not published yet) name
-  // the problem; too stale a version is dropped with OK. Every refusal is
+  // the problem; too stale a version is dropped with OK and, if `dropped`
+  // is not null, *dropped says why (else it is cleared). Every refusal is
   // counted by reason.
-  absl::Status Admit(const pb::Segment& segment);
+  absl::Status Admit(const pb::Segment& segment,
+                     std::string* dropped = nullptr);
 
   // The spec, once known.
   std::optional<EnvSpec> WaitForSpec(absl::Duration timeout);

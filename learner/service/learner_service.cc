@@ -1,5 +1,7 @@
 #include "learner/service/learner_service.h"
 
+#include <string>
+
 #include "absl/strings/str_cat.h"
 
 namespace vantage {
@@ -32,11 +34,17 @@ grpc::Status LearnerService::StreamSegments(
     grpc::ServerContext* /*context*/, grpc::ServerReader<pb::Segment>* reader,
     pb::SegmentAck* ack) {
   pb::Segment segment;
+  std::string dropped;
   while (reader->Read(&segment)) {
-    if (absl::Status status = gateway_.Admit(segment); !status.ok()) {
+    if (absl::Status status = gateway_.Admit(segment, &dropped); !status.ok()) {
       return ToGrpcStatus(status);
     }
-    ack->set_accepted(ack->accepted() + 1);
+    if (dropped.empty()) {
+      ack->set_accepted(ack->accepted() + 1);
+    } else {
+      ack->set_rejected(ack->rejected() + 1);
+      ack->set_last_error(dropped);
+    }
   }
   return grpc::Status::OK;
 }

@@ -24,7 +24,8 @@ class LearnerService final : public pb::Learner::Service {
                         const pb::RegisterRequest* request,
                         pb::RegisterResponse* response) override;
   // Ends at the first refused segment with its error (counted); the actor
-  // reopens the stream.
+  // reopens the stream. Too stale segments are dropped and counted in the
+  // ack's `rejected`.
   grpc::Status StreamSegments(grpc::ServerContext* context,
                               grpc::ServerReader<pb::Segment>* reader,
                               pb::SegmentAck* ack) override;

@@ -1,0 +1,636 @@
+#include "learner/service/learner_service.h"
+
+#include <ATen/ATen.h>
+#include <grpcpp/grpcpp.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <future>
+#include <limits>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "absl/status/status.h"
+#include "absl/status/statusor.h"
+#include "absl/time/time.h"
+#include "common/env/environment.h"
+#include "common/nn/networks.h"
+#include "common/nn/policy_weights.h"
+#include "common/nn/running_mean_std.h"
+#include "common/rollout/segment.h"
+#include "common/rollout/segment_queue.h"
+#include "gmock/gmock.h"
+#include "gtest/gtest.h"
+#include "learner/service/actor_gateway.h"
+#include "proto/run_config.pb.h"
+#include "proto/vantage.grpc.pb.h"
+#include "proto/vantage.pb.h"
+#include "proto/wire_format.h"
+
+namespace vantage {
+namespace {
+
+using ::testing::HasSubstr;
+
+constexpr int64_t kNoLimit = std::numeric_limits<int64_t>::max();
+constexpr int64_t kObs = 4;
+constexpr int64_t kAct = 1;
+// Guards every call so that a server that never answers fails the test
+// instead of hanging it.
+constexpr auto kRpcDeadline = std::chrono::seconds(30);
+
+EnvSpec Spec() {
+  EnvSpec spec;
+  spec.name = "InvertedPendulum";
+  spec.observation_size = kObs;
+  spec.discrete = false;
+  spec.action_size = kAct;
+  spec.action_low = {-3.0};
+  spec.action_high = {3.0};
+  spec.max_episode_steps = 1000;
+  spec.control_dt = 0.04;
+  return spec;
+}
+
+pb::RegisterRequest Request(const EnvSpec& spec) {
+  pb::RegisterRequest request;
+  EnvSpecToProto(spec, request.mutable_spec());
+  request.set_actor_name("test-actor");
+  request.set_num_envs(2);
+  return request;
+}
+
+pb::RunConfig RunConfig() {
+  pb::RunConfig config;
+  config.set_env("InvertedPendulum");
+  config.set_algo("ppo");
+  config.set_horizon(16);
+  config.set_segment_length(8);
+  return config;
+}
+
+// Weights of a real policy and normaliser; every call draws new parameters,
+// so two versions differ.
+PolicyWeights MakeWeights(int64_t version) {
+  NetworkConfig network;
+  network.hidden = {8};
+  PolicyNetwork policy(Spec(), network);
+  RunningMeanStd normalizer(kObs);
+  EXPECT_TRUE(normalizer
+                  .Update(at::arange(3 * kObs, at::kFloat).reshape({3, kObs}) *
+                          static_cast<double>(version + 1))
+                  .ok());
+  return ExportPolicyWeights(*policy, normalizer, version);
+}
+
+// Same dtype, shape and bytes.
+::testing::AssertionResult BitEqual(const at::Tensor& a, const at::Tensor& b) {
+  if (a.defined() != b.defined()) {
+    return ::testing::AssertionFailure() << "one tensor is undefined";
+  }
+  if (!a.defined()) return ::testing::AssertionSuccess();
+  if (a.scalar_type() != b.scalar_type() || a.sizes() != b.sizes()) {
+    return ::testing::AssertionFailure()
+           << a.scalar_type() << a.sizes() << " vs " << b.scalar_type()
+           << b.sizes();
+  }
+  const at::Tensor ca = a.contiguous();
+  const at::Tensor cb = b.contiguous();
+  if (ca.nbytes() > 0 &&
+      std::memcmp(ca.data_ptr(), cb.data_ptr(), ca.nbytes()) != 0) {
+    return ::testing::AssertionFailure() << "bytes differ";
+  }
+  return ::testing::AssertionSuccess();
+}
+
+void ExpectWeightsAre(const pb::Weights& proto, const PolicyWeights& expected) {
+  absl::StatusOr<PolicyWeights> got = WeightsFromProto(proto, kNoLimit);
+  ASSERT_TRUE(got.ok()) << got.status();
+  EXPECT_EQ(got->version, expected.version);
+  ASSERT_EQ(got->parameters.size(), expected.parameters.size());
+  for (size_t i = 0; i < expected.parameters.size(); ++i) {
+    EXPECT_TRUE(BitEqual(got->parameters[i], expected.parameters[i]))
+        << "parameter " << i;
+  }
+  EXPECT_EQ(got->normalizer_count, expected.normalizer_count);
+  EXPECT_TRUE(BitEqual(got->normalizer_mean, expected.normalizer_mean));
+  EXPECT_TRUE(BitEqual(got->normalizer_var, expected.normalizer_var));
+}
+
+// T steps whose values depend on `sequence`, with a truncation at step 1 and
+// a termination at the last step, so final_observations is not empty.
+Segment MakeSegment(int64_t actor_id, int64_t policy_version, int64_t sequence,
+                    int64_t steps = 5, int64_t obs = kObs) {
+  Segment segment;
+  segment.actor_id = actor_id;
+  segment.env_slot = 1;
+  segment.sequence = sequence;
+  segment.policy_version = policy_version;
+  const double offset = 0.25 * static_cast<double>(sequence);
+  segment.observations =
+      at::arange((steps + 1) * obs, at::kFloat).reshape({steps + 1, obs}) *
+          0.1 +
+      offset;
+  segment.actions =
+      at::linspace(-2.5, 2.5, steps * kAct, at::kFloat).reshape({steps, kAct});
+  segment.rewards = at::arange(steps, at::kFloat) * 0.5 - offset;
+  segment.terminated = at::zeros({steps}, at::kBool);
+  segment.truncated = at::zeros({steps}, at::kBool);
+  segment.truncated[1] = true;
+  segment.terminated[steps - 1] = true;
+  segment.final_observations = at::full({1, obs}, 7.5f + offset, at::kFloat);
+  segment.behaviour_log_probs = -at::arange(1, steps + 1, at::kFloat) * 0.01;
+  segment.episode_returns = {2.5 + offset, -1.0};
+  segment.episode_lengths = {2, 3};
+  return segment;
+}
+
+pb::Segment ToProto(const Segment& segment) {
+  pb::Segment proto;
+  SegmentToProto(segment, &proto);
+  return proto;
+}
+
+void ExpectSameSegment(const Segment& got, const Segment& expected) {
+  EXPECT_EQ(got.actor_id, expected.actor_id);
+  EXPECT_EQ(got.env_slot, expected.env_slot);
+  EXPECT_EQ(got.sequence, expected.sequence);
+  EXPECT_EQ(got.policy_version, expected.policy_version);
+  EXPECT_TRUE(BitEqual(got.observations, expected.observations));
+  EXPECT_TRUE(BitEqual(got.actions, expected.actions));
+  EXPECT_TRUE(BitEqual(got.rewards, expected.rewards));
+  EXPECT_TRUE(BitEqual(got.terminated, expected.terminated));
+  EXPECT_TRUE(BitEqual(got.truncated, expected.truncated));
+  EXPECT_TRUE(BitEqual(got.final_observations, expected.final_observations));
+  EXPECT_TRUE(BitEqual(got.behaviour_log_probs, expected.behaviour_log_probs));
+  EXPECT_EQ(got.episode_returns, expected.episode_returns);
+  EXPECT_EQ(got.episode_lengths, expected.episode_lengths);
+}
+
+// Waits for a segment in `queue` without blocking forever when none comes.
+absl::StatusOr<Segment> ReceiveWithin(SegmentQueue& queue,
+                                      std::chrono::milliseconds timeout) {
+  const auto end = std::chrono::steady_clock::now() + timeout;
+  while (queue.size() == 0) {
+    if (std::chrono::steady_clock::now() > end) {
+      return absl::DeadlineExceededError("no segment arrived");
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+  return queue.Receive();
+}
+
+void SetDeadline(grpc::ClientContext& context) {
+  context.set_deadline(std::chrono::system_clock::now() + kRpcDeadline);
+}
+
+struct StreamResult {
+  grpc::Status status;
+  pb::SegmentAck ack;
+};
+
+class LearnerServiceTest : public ::testing::Test {
+ protected:
+  ~LearnerServiceTest() override {
+    // Waiters (subscriptions, registrations, blocked Sends) end first, so
+    // that the server's shutdown does not wait for them.
+    if (gateway_ != nullptr) gateway_->Close();
+    if (queue_ != nullptr) queue_->Close();
+    if (server_ != nullptr) {
+      server_->Shutdown(std::chrono::system_clock::now() +
+                        std::chrono::seconds(5));
+    }
+  }
+
+  void Start(GatewayConfig config = DefaultConfig(), size_t capacity = 16) {
+    queue_ = std::make_unique<SegmentQueue>(capacity);
+    gateway_ = std::make_unique<ActorGateway>(std::move(config), *queue_);
+    service_ = std::make_unique<LearnerService>(*gateway_);
+    grpc::ServerBuilder builder;
+    builder.RegisterService(service_.get());
+    server_ = builder.BuildAndStart();
+    ASSERT_NE(server_, nullptr);
+    stub_ = pb::Learner::NewStub(
+        server_->InProcessChannel(grpc::ChannelArguments()));
+  }
+
+  static GatewayConfig DefaultConfig() {
+    GatewayConfig config;
+    config.run_config = RunConfig();
+    config.max_segment_steps = 8;
+    config.max_policy_lag = 0;
+    return config;
+  }
+
+  grpc::Status Register(const EnvSpec& spec, pb::RegisterResponse* response) {
+    grpc::ClientContext context;
+    SetDeadline(context);
+    return stub_->Register(&context, Request(spec), response);
+  }
+
+  // Registers actor 0 and publishes version 0.
+  void StartRegistered(GatewayConfig config = DefaultConfig(),
+                       size_t capacity = 16) {
+    Start(std::move(config), capacity);
+    gateway_->Publish(MakeWeights(0));
+    pb::RegisterResponse response;
+    const grpc::Status status = Register(Spec(), &response);
+    ASSERT_TRUE(status.ok()) << status.error_message();
+    ASSERT_EQ(response.actor_id(), 0);
+  }
+
+  StreamResult Stream(const std::vector<pb::Segment>& segments) {
+    StreamResult result;
+    grpc::ClientContext context;
+    SetDeadline(context);
+    std::unique_ptr<grpc::ClientWriter<pb::Segment>> writer =
+        stub_->StreamSegments(&context, &result.ack);
+    for (const pb::Segment& segment : segments) {
+      // A refusal ends the stream early; later writes may then fail.
+      if (!writer->Write(segment)) break;
+    }
+    writer->WritesDone();
+    result.status = writer->Finish();
+    return result;
+  }
+
+  // A refused segment ends its stream with `code` and a message holding
+  // `message`, reaches no queue, is counted under `reason` only, and the
+  // learner goes on serving new streams.
+  void ExpectRefused(const pb::Segment& segment, grpc::StatusCode code,
+                     const std::string& message, const std::string& reason) {
+    const StreamResult refused = Stream({segment});
+    EXPECT_EQ(refused.status.error_code(), code)
+        << refused.status.error_message();
+    EXPECT_THAT(refused.status.error_message(), HasSubstr(message));
+    EXPECT_EQ(queue_->size(), 0u);
+    const GatewayCounters counters = gateway_->counters();
+    EXPECT_EQ(counters.rejected, (std::map<std::string, int64_t>{{reason, 1}}));
+    EXPECT_EQ(counters.accepted_segments, 0);
+
+    const Segment valid =
+        MakeSegment(0, gateway_->published_version(), /*sequence=*/42);
+    const StreamResult accepted = Stream({ToProto(valid)});
+    ASSERT_TRUE(accepted.status.ok()) << accepted.status.error_message();
+    EXPECT_EQ(accepted.ack.accepted(), 1);
+    ASSERT_EQ(queue_->size(), 1u);
+    absl::StatusOr<Segment> received = queue_->Receive();
+    ASSERT_TRUE(received.ok()) << received.status();
+    ExpectSameSegment(*received, valid);
+    EXPECT_EQ(gateway_->counters().accepted_segments, 1);
+  }
+
+  std::unique_ptr<SegmentQueue> queue_;
+  std::unique_ptr<ActorGateway> gateway_;
+  std::unique_ptr<LearnerService> service_;
+  std::unique_ptr<grpc::Server> server_;
+  std::unique_ptr<pb::Learner::Stub> stub_;
+};
+
+// --- Register ---
+
+TEST_F(LearnerServiceTest, RegisterFixesTheSpecAndNumbersActors) {
+  Start();
+  const PolicyWeights weights = MakeWeights(3);
+  gateway_->Publish(weights);
+  EXPECT_FALSE(gateway_->WaitForSpec(absl::ZeroDuration()).has_value());
+
+  for (int64_t expected_id : {0, 1, 2}) {
+    pb::RegisterResponse response;
+    const grpc::Status status = Register(Spec(), &response);
+    ASSERT_TRUE(status.ok()) << status.error_message();
+    EXPECT_EQ(response.actor_id(), expected_id);
+    EXPECT_EQ(response.run_config().SerializeAsString(),
+              RunConfig().SerializeAsString());
+    ExpectWeightsAre(response.weights(), weights);
+  }
+  std::optional<EnvSpec> spec = gateway_->WaitForSpec(absl::ZeroDuration());
+  ASSERT_TRUE(spec.has_value());
+  EXPECT_TRUE(CheckSameSpec(Spec(), *spec).ok());
+  EXPECT_EQ(gateway_->counters().registrations, 3);
+}
+
+TEST_F(LearnerServiceTest, RegisterWithAnotherSpecNamesTheField) {
+  Start();
+  gateway_->Publish(MakeWeights(0));
+  pb::RegisterResponse response;
+  ASSERT_TRUE(Register(Spec(), &response).ok());
+
+  EnvSpec wider = Spec();
+  wider.observation_size = 5;
+  grpc::Status status = Register(wider, &response);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(status.error_message(), HasSubstr("observation_size"));
+
+  EnvSpec bounds = Spec();
+  bounds.action_high = {2.0};
+  status = Register(bounds, &response);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(status.error_message(), HasSubstr("action_high"));
+
+  // A spec no environment can have is refused before it is compared.
+  EnvSpec broken = Spec();
+  broken.action_low = {4.0};
+  status = Register(broken, &response);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+
+  // Refusals take no actor id, and the first spec still holds.
+  pb::RegisterResponse second;
+  status = Register(Spec(), &second);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  EXPECT_EQ(second.actor_id(), 1);
+  EXPECT_EQ(gateway_->counters().registrations, 2);
+}
+
+TEST_F(LearnerServiceTest, RegisterForAnotherEnvironmentIsRefused) {
+  Start();
+  gateway_->Publish(MakeWeights(0));
+  EnvSpec hopper = Spec();
+  hopper.name = "Hopper";
+  pb::RegisterResponse response;
+  const grpc::Status status = Register(hopper, &response);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(status.error_message(),
+              HasSubstr("this learner trains InvertedPendulum"));
+  // It fixed nothing: the right environment still registers as actor 0.
+  EXPECT_FALSE(gateway_->WaitForSpec(absl::ZeroDuration()).has_value());
+  ASSERT_TRUE(Register(Spec(), &response).ok());
+  EXPECT_EQ(response.actor_id(), 0);
+}
+
+TEST_F(LearnerServiceTest, RegisterWaitsForTheFirstWeights) {
+  Start();
+  const PolicyWeights weights = MakeWeights(5);
+  std::thread publisher([&] {
+    // Publish only once the registration is waiting: the spec is fixed
+    // before the wait begins.
+    EXPECT_TRUE(gateway_->WaitForSpec(absl::Seconds(10)).has_value());
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    gateway_->Publish(weights);
+  });
+  pb::RegisterResponse response;
+  const grpc::Status status = Register(Spec(), &response);
+  publisher.join();
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  EXPECT_EQ(response.actor_id(), 0);
+  ExpectWeightsAre(response.weights(), weights);
+}
+
+TEST_F(LearnerServiceTest, RegisterIsUnavailableWhenNoWeightsArrive) {
+  Start();
+  const auto begin = std::chrono::steady_clock::now();
+  absl::StatusOr<pb::RegisterResponse> response =
+      gateway_->Register(Request(Spec()), absl::Milliseconds(100));
+  const auto waited = std::chrono::steady_clock::now() - begin;
+  EXPECT_TRUE(absl::IsUnavailable(response.status())) << response.status();
+  EXPECT_GE(waited, std::chrono::milliseconds(90));
+}
+
+// --- StreamSegments ---
+
+TEST_F(LearnerServiceTest, ValidSegmentsReachTheQueueUnchanged) {
+  StartRegistered();
+  const std::vector<Segment> segments = {MakeSegment(0, 0, 0, 5),
+                                         MakeSegment(0, 0, 1, 8)};
+  const StreamResult result =
+      Stream({ToProto(segments[0]), ToProto(segments[1])});
+  ASSERT_TRUE(result.status.ok()) << result.status.error_message();
+  EXPECT_EQ(result.ack.accepted(), 2);
+  EXPECT_EQ(result.ack.rejected(), 0);
+  ASSERT_EQ(queue_->size(), 2u);
+  for (const Segment& expected : segments) {
+    absl::StatusOr<Segment> got = queue_->Receive();
+    ASSERT_TRUE(got.ok()) << got.status();
+    ExpectSameSegment(*got, expected);
+  }
+  const GatewayCounters counters = gateway_->counters();
+  EXPECT_EQ(counters.accepted_segments, 2);
+  EXPECT_EQ(counters.accepted_steps, 13);
+  EXPECT_TRUE(counters.rejected.empty());
+}
+
+TEST_F(LearnerServiceTest, SegmentFromAnUnregisteredActorIsRefused) {
+  StartRegistered();
+  ExpectRefused(ToProto(MakeSegment(7, 0, 0)),
+                grpc::StatusCode::FAILED_PRECONDITION, "segment.actor_id",
+                "unknown_actor");
+}
+
+TEST_F(LearnerServiceTest, SegmentOfAnUnpublishedVersionIsRefused) {
+  StartRegistered();
+  ExpectRefused(ToProto(MakeSegment(0, 1, 0)),
+                grpc::StatusCode::FAILED_PRECONDITION, "segment.policy_version",
+                "future_version");
+}
+
+TEST_F(LearnerServiceTest, TensorWithTheWrongByteCountIsRefused) {
+  StartRegistered();
+  pb::Segment segment = ToProto(MakeSegment(0, 0, 0));
+  segment.mutable_rewards()->mutable_data()->resize(
+      segment.rewards().data().size() - 4);
+  ExpectRefused(segment, grpc::StatusCode::INVALID_ARGUMENT, "segment.rewards",
+                "malformed");
+}
+
+TEST_F(LearnerServiceTest, NanRewardIsRefused) {
+  StartRegistered();
+  Segment segment = MakeSegment(0, 0, 0);
+  segment.rewards[2] = std::nanf("");
+  ExpectRefused(ToProto(segment), grpc::StatusCode::INVALID_ARGUMENT, "rewards",
+                "invalid");
+}
+
+TEST_F(LearnerServiceTest, WrongObservationWidthIsRefused) {
+  StartRegistered();
+  ExpectRefused(ToProto(MakeSegment(0, 0, 0, 5, kObs + 1)),
+                grpc::StatusCode::INVALID_ARGUMENT, "observations", "invalid");
+}
+
+TEST_F(LearnerServiceTest, TooManyStepsAreRefused) {
+  StartRegistered();  // max_segment_steps = 8
+  ExpectRefused(ToProto(MakeSegment(0, 0, 0, 9)),
+                grpc::StatusCode::INVALID_ARGUMENT, "9 steps", "invalid");
+}
+
+TEST_F(LearnerServiceTest, StaleSegmentIsDroppedAndCounted) {
+  StartRegistered();  // max_policy_lag = 0
+  gateway_->Publish(MakeWeights(1));
+  const StreamResult result = Stream({ToProto(MakeSegment(0, 0, 0))});
+  ASSERT_TRUE(result.status.ok()) << result.status.error_message();
+  EXPECT_EQ(result.ack.accepted(), 0);
+  EXPECT_EQ(result.ack.rejected(), 1);
+  EXPECT_THAT(result.ack.last_error(), HasSubstr("policy_version"));
+  EXPECT_EQ(queue_->size(), 0u);
+  EXPECT_EQ(gateway_->counters().rejected,
+            (std::map<std::string, int64_t>{{"stale", 1}}));
+  EXPECT_EQ(gateway_->counters().accepted_segments, 0);
+
+  // The current version still gets through.
+  const Segment current = MakeSegment(0, 1, 1);
+  const StreamResult accepted = Stream({ToProto(current)});
+  ASSERT_TRUE(accepted.status.ok()) << accepted.status.error_message();
+  EXPECT_EQ(accepted.ack.accepted(), 1);
+  absl::StatusOr<Segment> got = ReceiveWithin(*queue_, std::chrono::seconds(5));
+  ASSERT_TRUE(got.ok()) << got.status();
+  ExpectSameSegment(*got, current);
+}
+
+TEST_F(LearnerServiceTest, LaggingSegmentWithinTheAllowedLagIsAdmitted) {
+  GatewayConfig config = DefaultConfig();
+  config.max_policy_lag = 1;
+  StartRegistered(config);
+  gateway_->Publish(MakeWeights(1));
+  gateway_->Publish(MakeWeights(2));
+  const StreamResult result =
+      Stream({ToProto(MakeSegment(0, 1, 0)), ToProto(MakeSegment(0, 0, 1)),
+              ToProto(MakeSegment(0, 2, 2))});
+  ASSERT_TRUE(result.status.ok()) << result.status.error_message();
+  EXPECT_EQ(result.ack.accepted(), 2);
+  EXPECT_EQ(result.ack.rejected(), 1);
+  ASSERT_EQ(queue_->size(), 2u);
+  EXPECT_EQ(queue_->Receive()->policy_version, 1);
+  EXPECT_EQ(queue_->Receive()->policy_version, 2);
+}
+
+TEST_F(LearnerServiceTest, EveryRefusalIsCountedByItsReason) {
+  StartRegistered();
+  gateway_->Publish(MakeWeights(1));
+  Segment nan = MakeSegment(0, 1, 0);
+  nan.rewards[0] = std::nanf("");
+  pb::Segment short_rewards = ToProto(MakeSegment(0, 1, 0));
+  short_rewards.mutable_rewards()->mutable_data()->resize(3);
+  const std::vector<pb::Segment> refused = {
+      ToProto(MakeSegment(9, 1, 0)),
+      ToProto(MakeSegment(0, 2, 0)),
+      short_rewards,
+      ToProto(nan),
+      ToProto(MakeSegment(0, 1, 0, 5, kObs + 1)),
+      ToProto(MakeSegment(0, 1, 0, 9)),
+      ToProto(MakeSegment(0, 0, 0))};
+  for (const pb::Segment& segment : refused) Stream({segment});
+  EXPECT_EQ(queue_->size(), 0u);
+  const GatewayCounters counters = gateway_->counters();
+  EXPECT_EQ(counters.rejected, (std::map<std::string, int64_t>{
+                                   {"unknown_actor", 1},
+                                   {"future_version", 1},
+                                   {"malformed", 1},
+                                   {"invalid", 3},
+                                   {"stale", 1},
+                               }));
+  EXPECT_EQ(counters.accepted_segments, 0);
+}
+
+// --- Weights ---
+
+TEST_F(LearnerServiceTest, GetWeightsIsUnavailableUntilPublished) {
+  Start();
+  pb::Weights weights;
+  {
+    grpc::ClientContext context;
+    SetDeadline(context);
+    const grpc::Status status =
+        stub_->GetWeights(&context, pb::WeightsRequest(), &weights);
+    EXPECT_EQ(status.error_code(), grpc::StatusCode::UNAVAILABLE);
+  }
+  const PolicyWeights published = MakeWeights(4);
+  gateway_->Publish(published);
+  grpc::ClientContext context;
+  SetDeadline(context);
+  const grpc::Status status =
+      stub_->GetWeights(&context, pb::WeightsRequest(), &weights);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  ExpectWeightsAre(weights, published);
+}
+
+TEST_F(LearnerServiceTest, SubscriptionDeliversEachNewerVersionUntilCancelled) {
+  StartRegistered();  // publishes version 0
+  grpc::ClientContext context;
+  SetDeadline(context);
+  pb::WeightsRequest request;
+  request.set_actor_id(0);
+  request.set_known_version(0);
+  std::unique_ptr<grpc::ClientReader<pb::Weights>> reader =
+      stub_->SubscribeWeights(&context, request);
+  // Give the server time to start waiting, so that one which resent the
+  // known version 0 would be caught by the first read.
+  std::this_thread::sleep_for(std::chrono::milliseconds(100));
+
+  for (int64_t version : {1, 2}) {
+    const PolicyWeights published = MakeWeights(version);
+    gateway_->Publish(published);
+    pb::Weights weights;
+    ASSERT_TRUE(reader->Read(&weights));
+    ExpectWeightsAre(weights, published);
+  }
+  context.TryCancel();
+  pb::Weights extra;
+  EXPECT_FALSE(reader->Read(&extra));
+  EXPECT_EQ(reader->Finish().error_code(), grpc::StatusCode::CANCELLED);
+
+  // The server's side ends too, with the gateway still open: shutdown
+  // waits for running handlers.
+  std::future<void> shutdown = std::async(std::launch::async, [&] {
+    server_->Shutdown(std::chrono::system_clock::now() +
+                      std::chrono::seconds(10));
+  });
+  const bool ended =
+      shutdown.wait_for(std::chrono::seconds(3)) == std::future_status::ready;
+  EXPECT_TRUE(ended) << "the subscription outlived its cancellation";
+  // Closing the gateway is what ends a handler that ignored it.
+  if (!ended) gateway_->Close();
+}
+
+TEST_F(LearnerServiceTest, SubscriptionEndsWhenTheGatewayCloses) {
+  Start();
+  const PolicyWeights published = MakeWeights(0);
+  gateway_->Publish(published);
+  grpc::ClientContext context;
+  SetDeadline(context);
+  pb::WeightsRequest request;
+  request.set_known_version(-1);
+  std::unique_ptr<grpc::ClientReader<pb::Weights>> reader =
+      stub_->SubscribeWeights(&context, request);
+  pb::Weights weights;
+  ASSERT_TRUE(reader->Read(&weights));
+  ExpectWeightsAre(weights, published);
+
+  gateway_->Close();
+  EXPECT_FALSE(reader->Read(&weights));
+  const grpc::Status status = reader->Finish();
+  EXPECT_TRUE(status.ok()) << status.error_message();
+}
+
+// --- Backpressure ---
+
+TEST_F(LearnerServiceTest, FullQueueBlocksTheStreamUntilDrained) {
+  StartRegistered(DefaultConfig(), /*capacity=*/1);
+  const std::vector<Segment> segments = {
+      MakeSegment(0, 0, 0), MakeSegment(0, 0, 1), MakeSegment(0, 0, 2)};
+  std::future<StreamResult> stream = std::async(std::launch::async, [&] {
+    return Stream(
+        {ToProto(segments[0]), ToProto(segments[1]), ToProto(segments[2])});
+  });
+  EXPECT_EQ(stream.wait_for(std::chrono::milliseconds(300)),
+            std::future_status::timeout);
+  EXPECT_EQ(queue_->size(), 1u);
+  for (const Segment& expected : segments) {
+    absl::StatusOr<Segment> got =
+        ReceiveWithin(*queue_, std::chrono::seconds(10));
+    ASSERT_TRUE(got.ok()) << got.status();
+    ExpectSameSegment(*got, expected);
+  }
+  ASSERT_EQ(stream.wait_for(std::chrono::seconds(10)),
+            std::future_status::ready);
+  const StreamResult result = stream.get();
+  ASSERT_TRUE(result.status.ok()) << result.status.error_message();
+  EXPECT_EQ(result.ack.accepted(), 3);
+}
+
+}  // namespace
+}  // namespace vantage
