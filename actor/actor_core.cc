@@ -6,6 +6,7 @@
 #include <c10/util/Exception.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cstring>
 #include <mutex>
 #include <utility>
@@ -105,6 +106,7 @@ absl::Status ActorCore::CollectSegments(SegmentSink& sink) {
   at::NoGradGuard no_grad;
   observations[0].copy_(CurrentObservations());
   for (int64_t t = 0; t < steps; ++t) {
+    const auto inference_start = std::chrono::steady_clock::now();
     const at::Tensor output = policy_->forward(
         normalizer_.Normalize(observations[t], config_.observation_clip));
     const at::Tensor action = policy_->Act(output, false, generator_);
@@ -113,9 +115,14 @@ absl::Status ActorCore::CollectSegments(SegmentSink& sink) {
     const at::Tensor as_double = action.to(at::kDouble).contiguous();
     actions_.assign(as_double.data_ptr<double>(),
                     as_double.data_ptr<double>() + as_double.numel());
+    const auto env_start = std::chrono::steady_clock::now();
     if (absl::Status status = envs_->Step(actions_); !status.ok()) {
       return status;
     }
+    const auto env_end = std::chrono::steady_clock::now();
+    inference_seconds_ +=
+        std::chrono::duration<double>(env_start - inference_start).count();
+    env_seconds_ += std::chrono::duration<double>(env_end - env_start).count();
     // Plain stores: a tensor op per element would cost more than a step.
     float* reward_row = rewards.data_ptr<float>() + t * m;
     bool* terminated_row = terminated.data_ptr<bool>() + t * m;

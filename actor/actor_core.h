@@ -45,6 +45,10 @@ class ActorCore {
   // streams that are never stitched onto the old ones.
   void set_stream_actor_id(int64_t id) { stream_actor_id_ = id; }
   int64_t env_steps() const { return env_steps_; }
+  // Wall-clock seconds spent so far in batched inference and in stepping
+  // the environments (for the actor's metrics).
+  double inference_seconds() const { return inference_seconds_; }
+  double env_seconds() const { return env_seconds_; }
 
   // Takes effect from the next segment on.
   absl::Status SetWeights(const PolicyWeights& weights);
@@ -79,6 +83,8 @@ class ActorCore {
   at::Generator generator_;
   int64_t version_ = 0;
   int64_t stream_actor_id_;
+  double inference_seconds_ = 0.0;
+  double env_seconds_ = 0.0;
   bool has_weights_ = false;
   int64_t env_steps_ = 0;
   std::vector<int64_t> next_sequence_;

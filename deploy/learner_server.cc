@@ -8,6 +8,7 @@
 #include "absl/strings/str_cat.h"
 #include "deploy/run_recorder.h"
 #include "learner/service/actor_gateway.h"
+#include "learner/service/learner_metrics.h"
 #include "learner/service/learner_service.h"
 
 namespace vantage {
@@ -54,10 +55,31 @@ absl::Status RunLearnerServer(
       return status;
     }
   }
-  // Closing the queue is how a stop request reaches a blocked update.
+  std::unique_ptr<LearnerMetrics> metrics;
+  if (!config.metrics_address.empty()) {
+    absl::StatusOr<std::unique_ptr<LearnerMetrics>> started =
+        LearnerMetrics::Start(config.metrics_address);
+    if (!started.ok()) {
+      server->server->Shutdown();
+      return started.status();
+    }
+    metrics = *std::move(started);
+    std::fprintf(stderr, "learner: metrics on port %d\n", metrics->port());
+  }
+  auto record_gateway = [&] {
+    if (metrics == nullptr) return;
+    const GatewayCounters counters = gateway.counters();
+    metrics->RecordSegmentsAccepted(counters.accepted_segments);
+    metrics->RecordRejected(counters.rejected);
+    metrics->SetActorsRegistered(counters.registrations);
+    metrics->SetQueueDepth(static_cast<int64_t>(queue.size()), 0);
+  };
+  // Closing the queue is how a stop request reaches a blocked update; the
+  // same thread keeps the ingest metrics fresh while updates block.
   std::thread watcher([&] {
     while (!stop && !gateway.closed()) {
       std::this_thread::sleep_for(std::chrono::milliseconds(50));
+      record_gateway();
     }
     queue.Close();
   });
@@ -103,6 +125,15 @@ absl::Status RunLearnerServer(
       return absl::StatusOr<CheckpointExtras>(CheckpointExtras());
     });
     if (!row.ok()) return finish(row.status());
+    if (metrics != nullptr) {
+      for (int64_t lag : stats->rollout_policy_lags) {
+        metrics->RecordPolicyLag(lag);
+      }
+      metrics->RecordUpdate(stats->policy_version, stats->env_steps,
+                            stats->episodes, stats->update_seconds,
+                            row->mean_return, row->steps_per_second);
+      record_gateway();
+    }
     on_update(*row);
   }
   return finish(absl::OkStatus());

@@ -18,6 +18,8 @@ struct LearnerServerConfig {
   pb::RunConfig run_config;  // resolved; actors receive it
   std::string listen = "127.0.0.1:0";
   std::string port_file;  // written with the bound port once serving
+  // Prometheus endpoint HOST:PORT (port 0: a free one); empty: none.
+  std::string metrics_address;
 };
 
 // `vantage learner`: serves actors over gRPC, trains on their segments and

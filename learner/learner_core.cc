@@ -4,6 +4,7 @@
 #include <ATen/core/grad_mode.h>
 #include <torch/serialize/archive.h>
 
+#include <chrono>
 #include <limits>
 #include <numeric>
 #include <sstream>
@@ -115,6 +116,7 @@ absl::StatusOr<UpdateStats> LearnerCore::RunUpdate(SegmentSource& source) {
       pending_.push_back(std::move(rollout));
     }
   }
+  const auto update_start = std::chrono::steady_clock::now();
   std::vector<Rollout> rollouts(pending_.begin(),
                                 pending_.begin() + config_.rollouts_per_batch);
   pending_.erase(pending_.begin(),
@@ -156,6 +158,10 @@ absl::StatusOr<UpdateStats> LearnerCore::RunUpdate(SegmentSource& source) {
       return status;
     }
   }
+  for (const Rollout& rollout : rollouts) {
+    stats.rollout_policy_lags.push_back(
+        version_ - rollout.policy_versions.min().item<int64_t>());
+  }
   env_steps_ += samples;
   ++version_;
   stats.policy_version = version_;
@@ -171,6 +177,9 @@ absl::StatusOr<UpdateStats> LearnerCore::RunUpdate(SegmentSource& source) {
   stats.rejected_segments = rejected_;
   stats.stale_segments = stale_segments_;
   stats.stale_steps = stale_steps_;
+  stats.update_seconds = std::chrono::duration<double>(
+                             std::chrono::steady_clock::now() - update_start)
+                             .count();
   return stats;
 }
 

@@ -52,6 +52,12 @@ struct UpdateStats {
   int64_t rejected_segments = 0;  // so far, any reason (stale included)
   int64_t stale_segments = 0;     // so far, too old a policy version
   int64_t stale_steps = 0;        // so far, dropped for their version
+  // Wall-clock seconds of this update once its batch was complete (not
+  // reproducible, so not in progress.csv).
+  double update_seconds = 0.0;
+  // Per rollout of this batch: how many versions behind the updated policy
+  // its oldest step was acted (0 throughout in sync mode).
+  std::vector<int64_t> rollout_policy_lags;
 };
 
 // Consumes segments, stitches rollouts, evaluates the critic, estimates

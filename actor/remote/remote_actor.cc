@@ -11,6 +11,7 @@
 #include "absl/strings/str_cat.h"
 #include "actor/actor_core.h"
 #include "actor/envs/env_registry.h"
+#include "actor/remote/actor_metrics.h"
 #include "proto/vantage.grpc.pb.h"
 #include "proto/wire_format.h"
 
@@ -32,19 +33,27 @@ bool IsRefusal(const absl::Status& status) {
 // Segments onto an open client stream.
 class StreamSink : public SegmentSink {
  public:
-  explicit StreamSink(grpc::ClientWriter<pb::Segment>& writer)
-      : writer_(writer) {}
+  StreamSink(grpc::ClientWriter<pb::Segment>& writer, ActorMetrics* metrics)
+      : writer_(writer), metrics_(metrics) {}
   absl::Status Send(Segment segment) override {
+    const auto start = std::chrono::steady_clock::now();
     pb::Segment proto;
     SegmentToProto(segment, &proto);
     if (!writer_.Write(proto)) {
       return absl::UnavailableError("the learner closed the segment stream");
+    }
+    if (metrics_ != nullptr) {
+      metrics_->AddSegmentsSent(1);
+      metrics_->AddSendSeconds(std::chrono::duration<double>(
+                                   std::chrono::steady_clock::now() - start)
+                                   .count());
     }
     return absl::OkStatus();
   }
 
  private:
   grpc::ClientWriter<pb::Segment>& writer_;
+  ActorMetrics* metrics_;
 };
 
 // The newest weights a subscription delivered.
@@ -72,8 +81,10 @@ class WeightsSlot {
 class Session {
  public:
   Session(const RemoteActorConfig& config,
-          std::shared_ptr<grpc::Channel> channel)
-      : config_(config), stub_(pb::Learner::NewStub(channel)) {}
+          std::shared_ptr<grpc::Channel> channel, ActorMetrics* metrics)
+      : config_(config),
+        stub_(pb::Learner::NewStub(channel)),
+        metrics_(metrics) {}
 
   // Registers, then acts and streams until an error or `stop`.
   // `progressed` tells whether the learner accepted us at all.
@@ -134,7 +145,7 @@ class Session {
     pb::SegmentAck ack;
     std::unique_ptr<grpc::ClientWriter<pb::Segment>> writer =
         stub_->StreamSegments(&stream_context, &ack);
-    StreamSink sink(*writer);
+    StreamSink sink(*writer, metrics_);
     const int64_t rounds_per_version =
         run.sync() ? run.horizon() / run.segment_length() : 0;
     int64_t rounds = 0;
@@ -159,8 +170,17 @@ class Session {
         status = absl::UnavailableError("the weights subscription ended");
         break;
       }
+      const double inference_before = actor->inference_seconds();
+      const double env_before = actor->env_seconds();
       status = actor->CollectSegments(sink);
       ++rounds;
+      if (metrics_ != nullptr) {
+        metrics_->RecordEnvSteps(actor->env_steps());
+        metrics_->AddInferenceSeconds(actor->inference_seconds() -
+                                      inference_before);
+        metrics_->AddEnvSeconds(actor->env_seconds() - env_before);
+        metrics_->SetPolicyVersion(actor->policy_version());
+      }
     }
     writer->WritesDone();
     const absl::Status finished = FromGrpc(writer->Finish(), "segment stream");
@@ -179,6 +199,7 @@ class Session {
 
   const RemoteActorConfig& config_;
   std::unique_ptr<pb::Learner::Stub> stub_;
+  ActorMetrics* metrics_;
 };
 
 }  // namespace
@@ -192,13 +213,22 @@ absl::Status RunRemoteActor(const RemoteActorConfig& config,
   grpc::ChannelArguments arguments;
   arguments.SetMaxReceiveMessageSize(config.max_message_bytes);
   arguments.SetMaxSendMessageSize(config.max_message_bytes);
+  std::unique_ptr<ActorMetrics> metrics;
+  if (!config.metrics_address.empty()) {
+    absl::StatusOr<std::unique_ptr<ActorMetrics>> started =
+        ActorMetrics::Start(config.metrics_address);
+    if (!started.ok()) return started.status();
+    metrics = *std::move(started);
+    std::fprintf(stderr, "%s: metrics on port %d\n", config.name.c_str(),
+                 metrics->port());
+  }
   std::unique_ptr<ActorCore> actor;  // kept across reconnects
   int failures = 0;
   absl::Duration backoff = config.initial_backoff;
   while (!stop) {
     const std::shared_ptr<grpc::Channel> channel = grpc::CreateCustomChannel(
         config.learner, grpc::InsecureChannelCredentials(), arguments);
-    Session session(config, channel);
+    Session session(config, channel, metrics.get());
     bool progressed = false;
     const absl::Status status = session.Run(spec, actor, stop, progressed);
     if (stop) break;
@@ -212,6 +242,7 @@ absl::Status RunRemoteActor(const RemoteActorConfig& config,
           "giving up after ", failures, " reconnects: ", status.message()));
     }
     ++failures;
+    if (metrics != nullptr) metrics->AddReconnect();
     std::fprintf(stderr, "%s: %s; reconnecting in %s\n", config.name.c_str(),
                  std::string(status.message()).c_str(),
                  absl::FormatDuration(backoff).c_str());

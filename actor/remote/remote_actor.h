@@ -24,6 +24,8 @@ struct RemoteActorConfig {
   absl::Duration initial_backoff = absl::Milliseconds(200);
   absl::Duration max_backoff = absl::Seconds(10);
   int max_message_bytes = 256 << 20;
+  // Prometheus endpoint HOST:PORT (port 0: a free one); empty: none.
+  std::string metrics_address;
 };
 
 // Registers, acts with the newest weights (picked up between segments; in

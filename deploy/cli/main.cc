@@ -92,6 +92,9 @@ ABSL_FLAG(std::string, listen, "127.0.0.1:0",
 ABSL_FLAG(std::string, port_file, "",
           "learner: write the bound port here once serving");
 ABSL_FLAG(std::string, learner, "", "actor: the learner's HOST:PORT");
+ABSL_FLAG(std::string, metrics, "",
+          "learner, actor: serve Prometheus metrics on HOST:PORT (port 0: a "
+          "free one, printed on stderr); empty: none");
 ABSL_FLAG(std::string, name, "actor", "actor: a name for logs");
 ABSL_FLAG(int, max_reconnects, -1,
           "actor: reconnection attempts (0: exit at the first failure, -1: "
@@ -261,6 +264,7 @@ int RunLearner(const std::vector<std::string>& args) {
   if (!BuildTrainRequest(request.train)) return kUsageExitCode;
   request.listen = absl::GetFlag(FLAGS_listen);
   request.port_file = absl::GetFlag(FLAGS_port_file);
+  request.metrics = absl::GetFlag(FLAGS_metrics);
   return RunLearnerCommand(request);
 }
 
@@ -273,6 +277,7 @@ int RunActor(const std::vector<std::string>& args) {
   config.seed = absl::GetFlag(FLAGS_seed);
   config.name = absl::GetFlag(FLAGS_name);
   config.max_reconnects = absl::GetFlag(FLAGS_max_reconnects);
+  config.metrics_address = absl::GetFlag(FLAGS_metrics);
   return RunActorCommand(config);
 }
 

@@ -163,6 +163,7 @@ int RunLearnerCommand(const LearnerRequest& request) {
   server.run_config = resolved->config;
   server.listen = request.listen;
   server.port_file = request.port_file;
+  server.metrics_address = request.metrics;
   ProgressRow last;
   last.mean_return = std::nan("");
   const absl::Status status =

@@ -24,6 +24,7 @@ struct LearnerRequest {
   TrainRequest train;     // the run's settings, as for train
   std::string listen;     // HOST:PORT; port 0 picks a free one
   std::string port_file;  // the bound port is written here
+  std::string metrics;    // Prometheus HOST:PORT; empty: none
 };
 
 // `vantage learner`: serves actors (see deploy/learner_server.h) until the

@@ -1,5 +1,7 @@
 // The learner and actors as separate processes over loopback gRPC.
 
+#include <signal.h>
+
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
@@ -10,9 +12,11 @@
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_join.h"
 #include "absl/strings/str_split.h"
+#include "absl/strings/strip.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
 #include "tests/deploy/cli/run_vantage.h"
+#include "tests/fakes/http_get.h"
 
 namespace vantage {
 namespace {
@@ -162,6 +166,85 @@ TEST(DistributedTest, TrainRestartsAKilledActor) {
   EXPECT_THAT(rows[6], ::testing::StartsWith("6144,6,6,"));
   // No process of the run is left behind.
   EXPECT_TRUE(ChildrenRunning(train, "vantage").empty());
+}
+
+// The port a process printed as "<who>: metrics on port N".
+int MetricsPort(const std::string& err_path, const std::string& who) {
+  const std::string marker = who + ": metrics on port ";
+  for (int i = 0; i < 600; ++i) {
+    const std::string err = ReadFile(err_path);
+    const size_t at = err.find(marker);
+    int port = 0;
+    if (at != std::string::npos &&
+        absl::SimpleAtoi(err.substr(at + marker.size(),
+                                    err.find('\n', at) - at - marker.size()),
+                         &port)) {
+      return port;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  return 0;
+}
+
+// The value of an unlabelled sample in Prometheus text.
+double Sample(const std::string& text, const std::string& name) {
+  for (absl::string_view line : absl::StrSplit(text, '\n')) {
+    if (absl::ConsumePrefix(&line, name + " ")) {
+      double value = 0;
+      if (absl::SimpleAtod(line, &value)) return value;
+    }
+  }
+  return -1;
+}
+
+// Scrapes the learner while it trains: every scrape's policy version,
+// env steps and episodes agree with that update's row of progress.csv.
+TEST(DistributedTest, PrometheusCountersAgreeWithProgressCsv) {
+  const std::string run = FreshDirectory("metrics");
+  const Learner learner = StartLearner(
+      "--steps=6144 --horizon=256 --envs=2 --seed=2 --metrics=127.0.0.1:0 "
+      "--run_dir=" +
+      run);
+  const std::string actor_err = TempPath("actor.err");
+  const int actor =
+      StartVantage("actor --learner=127.0.0.1:" + learner.port +
+                       " --env=InvertedPendulum --envs=2 --metrics=127.0.0.1:0",
+                   TempPath("actor.out"), actor_err);
+  const int learner_port = MetricsPort(learner.err, "learner");
+  const int actor_port = MetricsPort(actor_err, "actor");
+  ASSERT_GT(learner_port, 0) << ReadFile(learner.err);
+  ASSERT_GT(actor_port, 0) << ReadFile(actor_err);
+  int agreeing = 0;
+  double actor_steps = 0;
+  // Scrape while the learner runs (WaitVantage reaps it later).
+  for (int i = 0; i < 600 && agreeing < 3 && kill(learner.pid, 0) == 0; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    absl::StatusOr<std::string> text = HttpGet(learner_port, "/metrics");
+    absl::StatusOr<std::string> actor_text = HttpGet(actor_port, "/metrics");
+    if (actor_text.ok()) {
+      actor_steps = Sample(*actor_text, "vantage_actor_env_steps_total");
+    }
+    if (!text.ok()) continue;
+    const int version =
+        static_cast<int>(Sample(*text, "vantage_learner_policy_version"));
+    const std::vector<std::string> rows = DeterministicProgress(run);
+    if (version < 1 || version >= static_cast<int>(rows.size())) continue;
+    const std::vector<std::string> row = absl::StrSplit(rows[version], ',');
+    // A scrape may fall between two updates' gauges; count only whole ones.
+    if (std::to_string(static_cast<int64_t>(
+            Sample(*text, "vantage_learner_env_steps_total"))) == row[0] &&
+        std::to_string(static_cast<int64_t>(
+            Sample(*text, "vantage_learner_episodes_total"))) == row[3]) {
+      ++agreeing;
+      EXPECT_EQ(Sample(*text, "vantage_learner_updates_total"), version);
+      EXPECT_EQ(Sample(*text, "vantage_learner_actors_registered"), 1);
+    }
+  }
+  EXPECT_GE(agreeing, 3);
+  EXPECT_GT(actor_steps, 0);
+  EXPECT_EQ(WaitVantage(learner.pid, 120), 0) << ReadFile(learner.err);
+  kill(actor, SIGTERM);
+  EXPECT_EQ(WaitVantage(actor, 30), 0);
 }
 
 TEST(DistributedTest, AnActorOfAnotherEnvironmentIsRefused) {

@@ -23,10 +23,12 @@ std::string ReadFile(const std::string& path) {
 
 std::string TempPath(const std::string& name) {
   static int counter = 0;
+  // The process id keeps files of an earlier run (a stale port file, an
+  // old log) from being taken for this one's.
   return absl::StrCat(
       ::testing::TempDir(), "/vantage_",
       ::testing::UnitTest::GetInstance()->current_test_info()->name(), "_",
-      counter++, "_", name);
+      getpid(), "_", counter++, "_", name);
 }
 
 std::string WriteTemp(const std::string& name, const std::string& text) {
