@@ -17,6 +17,7 @@
 #include "gtest/gtest.h"
 #include "tests/deploy/cli/run_vantage.h"
 #include "tests/fakes/http_get.h"
+#include "tests/fakes/run_files.h"
 
 namespace vantage {
 namespace {
@@ -27,19 +28,6 @@ std::string FreshDirectory(const std::string& name) {
   const std::string path = TempPath(name);
   std::filesystem::remove_all(path);
   return path;
-}
-
-// progress.csv without the wall-clock columns (the last two).
-std::vector<std::string> DeterministicProgress(const std::string& run_dir) {
-  std::ifstream file(run_dir + "/progress.csv");
-  std::vector<std::string> rows;
-  std::string line;
-  while (std::getline(file, line)) {
-    std::vector<std::string> fields = absl::StrSplit(line, ',');
-    fields.resize(fields.size() - 2);
-    rows.push_back(absl::StrJoin(fields, ","));
-  }
-  return rows;
 }
 
 struct Learner {

@@ -13,6 +13,7 @@
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
 #include "learner/checkpoint.h"
+#include "tests/fakes/run_files.h"
 
 namespace vantage {
 namespace {
@@ -51,19 +52,6 @@ LocalTrainingConfig SmallRun(const std::string& algorithm, uint64_t seed,
   config.config_json = "{}";
   config.checkpoint_every = 2;
   return config;
-}
-
-// progress.csv without the wall-clock columns (the last two).
-std::vector<std::string> DeterministicProgress(const std::string& run_dir) {
-  std::ifstream file(run_dir + "/progress.csv");
-  std::vector<std::string> rows;
-  std::string line;
-  while (std::getline(file, line)) {
-    std::vector<std::string> fields = absl::StrSplit(line, ',');
-    fields.resize(fields.size() - 2);
-    rows.push_back(absl::StrJoin(fields, ","));
-  }
-  return rows;
 }
 
 // Runs to the end, or stops after update `stop_after` like a killed run.
