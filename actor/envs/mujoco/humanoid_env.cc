@@ -7,7 +7,6 @@
 #include "absl/strings/str_cat.h"
 #include "actor/envs/mujoco/models.h"
 #include "actor/envs/mujoco/mujoco_env.h"
-#include "common/util/state_bytes.h"
 
 namespace vantage {
 namespace {
@@ -47,23 +46,6 @@ class Humanoid : public MujocoEnv {
     out = std::copy(d->cvel, d->cvel + 6 * m->nbody, out);
     out = std::copy(d->qfrc_actuator, d->qfrc_actuator + m->nv, out);
     std::copy(d->cfrc_ext, d->cfrc_ext + 6 * m->nbody, out);
-  }
-
-  // BeforeStep rewrites x_before_ before Evaluate reads it, so nothing
-  // carries over between steps today; it is saved all the same so that a
-  // restored task equals the saved one member for member.
-  std::string SaveTaskState() const override {
-    StateWriter writer("humanoid_task", 1);
-    writer.PutDouble(x_before_);
-    return std::move(writer).Finish();
-  }
-  absl::Status RestoreTaskState(absl::string_view state) override {
-    StateReader reader(state, "humanoid_task", 1,
-                       absl::StrCat(spec().name, ": task state"));
-    const double x_before = reader.GetDouble("x_before");
-    if (absl::Status status = reader.Finish(); !status.ok()) return status;
-    x_before_ = x_before;
-    return absl::OkStatus();
   }
 
  private:

@@ -6,7 +6,6 @@
 #include <utility>
 
 #include "absl/strings/str_cat.h"
-#include "common/util/state_bytes.h"
 
 namespace vantage {
 namespace {
@@ -54,23 +53,6 @@ class LocomotionEnv : public MujocoEnv {
     for (int i = 0; i < m->nv; ++i) {
       *out++ = std::clamp(d->qvel[i], -task_.qvel_clip, task_.qvel_clip);
     }
-  }
-
-  // BeforeStep rewrites x_before_ before Evaluate reads it, so nothing
-  // carries over between steps today; it is saved all the same so that a
-  // restored task equals the saved one member for member.
-  std::string SaveTaskState() const override {
-    StateWriter writer("locomotion_task", 1);
-    writer.PutDouble(x_before_);
-    return std::move(writer).Finish();
-  }
-  absl::Status RestoreTaskState(absl::string_view state) override {
-    StateReader reader(state, "locomotion_task", 1,
-                       absl::StrCat(spec().name, ": task state"));
-    const double x_before = reader.GetDouble("x_before");
-    if (absl::Status status = reader.Finish(); !status.ok()) return status;
-    x_before_ = x_before;
-    return absl::OkStatus();
   }
 
  private:
