@@ -15,6 +15,7 @@
 #include "common/nn/running_mean_std.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
+#include "tests/fakes/bit_equal.h"
 
 namespace vantage {
 namespace {
@@ -22,27 +23,6 @@ namespace {
 using ::testing::HasSubstr;
 
 constexpr int64_t kNoLimit = std::numeric_limits<int64_t>::max();
-
-// Same dtype, same shape and the same bytes: NaN payloads and signed zeros
-// must survive, which value comparison would not check.
-::testing::AssertionResult BitEqual(const at::Tensor& a, const at::Tensor& b) {
-  if (a.defined() != b.defined()) {
-    return ::testing::AssertionFailure() << "one tensor is undefined";
-  }
-  if (!a.defined()) return ::testing::AssertionSuccess();
-  if (a.scalar_type() != b.scalar_type() || a.sizes() != b.sizes()) {
-    return ::testing::AssertionFailure()
-           << a.scalar_type() << a.sizes() << " vs " << b.scalar_type()
-           << b.sizes();
-  }
-  const at::Tensor ca = a.contiguous();
-  const at::Tensor cb = b.contiguous();
-  if (ca.nbytes() > 0 &&
-      std::memcmp(ca.data_ptr(), cb.data_ptr(), ca.nbytes()) != 0) {
-    return ::testing::AssertionFailure() << "bytes differ";
-  }
-  return ::testing::AssertionSuccess();
-}
 
 template <typename Bits>
 at::Tensor FromBits(const std::vector<Bits>& bits, at::ScalarType dtype) {

@@ -32,6 +32,7 @@
 #include "proto/vantage.grpc.pb.h"
 #include "proto/vantage.pb.h"
 #include "proto/wire_format.h"
+#include "tests/fakes/bit_equal.h"
 
 namespace vantage {
 namespace {
@@ -87,26 +88,6 @@ PolicyWeights MakeWeights(int64_t version) {
                           static_cast<double>(version + 1))
                   .ok());
   return ExportPolicyWeights(*policy, normalizer, version);
-}
-
-// Same dtype, shape and bytes.
-::testing::AssertionResult BitEqual(const at::Tensor& a, const at::Tensor& b) {
-  if (a.defined() != b.defined()) {
-    return ::testing::AssertionFailure() << "one tensor is undefined";
-  }
-  if (!a.defined()) return ::testing::AssertionSuccess();
-  if (a.scalar_type() != b.scalar_type() || a.sizes() != b.sizes()) {
-    return ::testing::AssertionFailure()
-           << a.scalar_type() << a.sizes() << " vs " << b.scalar_type()
-           << b.sizes();
-  }
-  const at::Tensor ca = a.contiguous();
-  const at::Tensor cb = b.contiguous();
-  if (ca.nbytes() > 0 &&
-      std::memcmp(ca.data_ptr(), cb.data_ptr(), ca.nbytes()) != 0) {
-    return ::testing::AssertionFailure() << "bytes differ";
-  }
-  return ::testing::AssertionSuccess();
 }
 
 void ExpectWeightsAre(const pb::Weights& proto, const PolicyWeights& expected) {
