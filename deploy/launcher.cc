@@ -65,6 +65,19 @@ void Terminate(const std::vector<pid_t>& pids, std::chrono::seconds grace) {
   }
 }
 
+// The security flags both children get.
+std::vector<std::string> SecurityArgs(const LaunchConfig& config) {
+  std::vector<std::string> args;
+  auto add = [&](const char* flag, const std::string& value) {
+    if (!value.empty()) args.push_back(absl::StrCat("--", flag, "=", value));
+  };
+  add("auth_token_file", config.auth_token_file);
+  add("tls_cert", config.tls_cert);
+  add("tls_key", config.tls_key);
+  add("tls_ca", config.tls_ca);
+  return args;
+}
+
 }  // namespace
 
 absl::Status RunDistributedTraining(const LaunchConfig& config,
@@ -88,6 +101,9 @@ absl::Status RunDistributedTraining(const LaunchConfig& config,
   if (!config.run_dir.empty()) {
     learner_args.push_back("--run_dir=" + config.run_dir);
   }
+  const std::vector<std::string> security_args = SecurityArgs(config);
+  learner_args.insert(learner_args.end(), security_args.begin(),
+                      security_args.end());
   absl::StatusOr<pid_t> learner = Spawn(learner_args);
   if (!learner.ok()) return learner.status();
 
@@ -112,10 +128,15 @@ absl::Status RunDistributedTraining(const LaunchConfig& config,
                port.c_str(), run.actors());
 
   auto start_actor = [&](int i) {
-    return Spawn({"actor", "--learner=127.0.0.1:" + port, "--env=" + run.env(),
-                  absl::StrCat("--envs=", run.envs_per_actor()),
-                  absl::StrCat("--seed=", run.seed() + i),
-                  absl::StrCat("--name=actor-", i)});
+    std::vector<std::string> args = {
+        "actor",
+        "--learner=127.0.0.1:" + port,
+        "--env=" + run.env(),
+        absl::StrCat("--envs=", run.envs_per_actor()),
+        absl::StrCat("--seed=", run.seed() + i),
+        absl::StrCat("--name=actor-", i)};
+    args.insert(args.end(), security_args.begin(), security_args.end());
+    return Spawn(args);
   };
   std::vector<pid_t> actors(run.actors(), -1);
   for (int i = 0; i < run.actors(); ++i) {

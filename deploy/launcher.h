@@ -19,6 +19,12 @@ struct LaunchConfig {
   std::string work_dir;
   // Restarts of crashed actors before the run is given up.
   int max_actor_restarts = 20;
+  // Passed to the learner and every actor as --auth_token_file, --tls_cert,
+  // --tls_key, --tls_ca when set (the same files serve both ends).
+  std::string auth_token_file;
+  std::string tls_cert;
+  std::string tls_key;
+  std::string tls_ca;
 };
 
 // Starts `vantage learner` on 127.0.0.1 with a free port, then the actors

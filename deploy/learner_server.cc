@@ -46,6 +46,7 @@ absl::Status RunLearnerServer(
   LearnerService service(gateway);
   ServerOptions options;
   options.listen = config.listen;
+  options.security = config.security;
   absl::StatusOr<RunningServer> server = StartServer(options, service);
   if (!server.ok()) return server.status();
   std::fprintf(stderr, "learner: serving on port %d\n", server->port);

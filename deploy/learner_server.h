@@ -7,6 +7,7 @@
 
 #include "absl/status/status.h"
 #include "deploy/local_training.h"
+#include "learner/service/security.h"
 #include "proto/run_config.pb.h"
 
 namespace vantage {
@@ -17,7 +18,8 @@ struct LearnerServerConfig {
   LocalTrainingConfig training;
   pb::RunConfig run_config;  // resolved; actors receive it
   std::string listen = "127.0.0.1:0";
-  std::string port_file;  // written with the bound port once serving
+  std::string port_file;     // written with the bound port once serving
+  SecurityOptions security;  // TLS and the token every actor must send
   // Prometheus endpoint HOST:PORT (port 0: a free one); empty: none.
   std::string metrics_address;
 };

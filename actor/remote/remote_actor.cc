@@ -98,6 +98,7 @@ class Session {
     grpc::ClientContext register_context;
     register_context.set_deadline(std::chrono::system_clock::now() +
                                   std::chrono::seconds(120));
+    AddAuthToken(config_.security, register_context);
     if (absl::Status status =
             FromGrpc(stub_->Register(&register_context, request, &response),
                      "registration");
@@ -130,6 +131,7 @@ class Session {
 
     WeightsSlot slot;
     grpc::ClientContext subscription_context;
+    AddAuthToken(config_.security, subscription_context);
     pb::WeightsRequest weights_request;
     weights_request.set_actor_id(response.actor_id());
     weights_request.set_known_version(actor->policy_version());
@@ -142,6 +144,7 @@ class Session {
     });
 
     grpc::ClientContext stream_context;
+    AddAuthToken(config_.security, stream_context);
     pb::SegmentAck ack;
     std::unique_ptr<grpc::ClientWriter<pb::Segment>> writer =
         stub_->StreamSegments(&stream_context, &ack);
@@ -213,6 +216,9 @@ absl::Status RunRemoteActor(const RemoteActorConfig& config,
   grpc::ChannelArguments arguments;
   arguments.SetMaxReceiveMessageSize(config.max_message_bytes);
   arguments.SetMaxSendMessageSize(config.max_message_bytes);
+  absl::StatusOr<std::shared_ptr<grpc::ChannelCredentials>> credentials =
+      MakeChannelCredentials(config.security);
+  if (!credentials.ok()) return credentials.status();
   std::unique_ptr<ActorMetrics> metrics;
   if (!config.metrics_address.empty()) {
     absl::StatusOr<std::unique_ptr<ActorMetrics>> started =
@@ -226,8 +232,8 @@ absl::Status RunRemoteActor(const RemoteActorConfig& config,
   int failures = 0;
   absl::Duration backoff = config.initial_backoff;
   while (!stop) {
-    const std::shared_ptr<grpc::Channel> channel = grpc::CreateCustomChannel(
-        config.learner, grpc::InsecureChannelCredentials(), arguments);
+    const std::shared_ptr<grpc::Channel> channel =
+        grpc::CreateCustomChannel(config.learner, *credentials, arguments);
     Session session(config, channel, metrics.get());
     bool progressed = false;
     const absl::Status status = session.Run(spec, actor, stop, progressed);

@@ -9,6 +9,7 @@
 
 #include "absl/status/status.h"
 #include "absl/time/time.h"
+#include "learner/service/security.h"
 
 namespace vantage {
 
@@ -24,6 +25,7 @@ struct RemoteActorConfig {
   absl::Duration initial_backoff = absl::Milliseconds(200);
   absl::Duration max_backoff = absl::Seconds(10);
   int max_message_bytes = 256 << 20;
+  SecurityOptions security;  // TLS and the auth token sent on every call
   // Prometheus endpoint HOST:PORT (port 0: a free one); empty: none.
   std::string metrics_address;
 };

@@ -23,6 +23,7 @@
 #include "deploy/cli/advantages_command.h"
 #include "deploy/cli/env_commands.h"
 #include "deploy/cli/train_command.h"
+#include "learner/service/security.h"
 
 ABSL_FLAG(std::string, input, "",
           "advantages: JSON file with one rollout and the estimator settings");
@@ -99,6 +100,18 @@ ABSL_FLAG(std::string, name, "actor", "actor: a name for logs");
 ABSL_FLAG(int, max_reconnects, -1,
           "actor: reconnection attempts (0: exit at the first failure, -1: "
           "forever)");
+ABSL_FLAG(std::string, auth_token_file, "",
+          "learner, actor, train (distributed): a file holding the shared "
+          "token every RPC must carry; empty: none");
+ABSL_FLAG(std::string, tls_cert, "",
+          "learner: its TLS certificate (PEM, with --tls_key); actor: its "
+          "client certificate");
+ABSL_FLAG(std::string, tls_key, "",
+          "learner: the private key of --tls_cert (PEM); actor: the client "
+          "certificate's key");
+ABSL_FLAG(std::string, tls_ca, "",
+          "actor: TLS with this CA (PEM) verifying the learner; learner: "
+          "clients must present a certificate this CA signed");
 ABSL_FLAG(std::string, checkpoint, "",
           "rollout: a run directory or checkpoint file whose policy acts");
 ABSL_FLAG(bool, stochastic, false,
@@ -251,10 +264,41 @@ bool BuildTrainRequest(TrainRequest& request) {
   return true;
 }
 
+// The security flags, the token read from its file, checked for the side
+// that uses them; false after a message.
+bool BuildSecurity(const char* command, bool server,
+                   SecurityOptions& security) {
+  security.tls_cert_file = absl::GetFlag(FLAGS_tls_cert);
+  security.tls_key_file = absl::GetFlag(FLAGS_tls_key);
+  security.tls_ca_file = absl::GetFlag(FLAGS_tls_ca);
+  absl::Status status = server ? ValidateServerSecurity(security)
+                               : ValidateClientSecurity(security);
+  if (status.ok() && !absl::GetFlag(FLAGS_auth_token_file).empty()) {
+    absl::StatusOr<std::string> token =
+        ReadTokenFile(absl::GetFlag(FLAGS_auth_token_file));
+    if (token.ok()) {
+      security.auth_token = *std::move(token);
+    } else {
+      status = token.status();
+    }
+  }
+  if (status.ok()) return true;
+  std::fprintf(stderr, "vantage %s: %s\n", command,
+               std::string(status.message()).c_str());
+  return false;
+}
+
 int RunTrain(const std::vector<std::string>& args) {
   if (int code = NoArguments("train", args); code != 0) return code;
   TrainRequest request;
   if (!BuildTrainRequest(request)) return kUsageExitCode;
+  // The children read the files themselves; checked here to fail early.
+  SecurityOptions security;
+  if (!BuildSecurity("train", /*server=*/true, security)) return kUsageExitCode;
+  request.auth_token_file = absl::GetFlag(FLAGS_auth_token_file);
+  request.tls_cert = security.tls_cert_file;
+  request.tls_key = security.tls_key_file;
+  request.tls_ca = security.tls_ca_file;
   return RunTrainCommand(request);
 }
 
@@ -265,6 +309,9 @@ int RunLearner(const std::vector<std::string>& args) {
   request.listen = absl::GetFlag(FLAGS_listen);
   request.port_file = absl::GetFlag(FLAGS_port_file);
   request.metrics = absl::GetFlag(FLAGS_metrics);
+  if (!BuildSecurity("learner", /*server=*/true, request.security)) {
+    return kUsageExitCode;
+  }
   return RunLearnerCommand(request);
 }
 
@@ -278,6 +325,9 @@ int RunActor(const std::vector<std::string>& args) {
   config.name = absl::GetFlag(FLAGS_name);
   config.max_reconnects = absl::GetFlag(FLAGS_max_reconnects);
   config.metrics_address = absl::GetFlag(FLAGS_metrics);
+  if (!BuildSecurity("actor", /*server=*/false, config.security)) {
+    return kUsageExitCode;
+  }
   return RunActorCommand(config);
 }
 
@@ -348,8 +398,11 @@ int main(int argc, char** argv) {
       "  train --config=FILE.json       flags from a run config file\n"
       "  train --resume=RUN_DIR         continue from the last checkpoint\n"
       "  learner --listen=HOST:PORT [--port_file=F] [train flags]\n"
+      "          [--auth_token_file=F] [--tls_cert=F --tls_key=F "
+      "[--tls_ca=F]]\n"
       "                                 serve actors over gRPC and train\n"
       "  actor --learner=HOST:PORT --env=NAME --envs=M\n"
+      "        [--auth_token_file=F] [--tls_ca=F [--tls_cert=F --tls_key=F]]\n"
       "                                 act and stream segments to a learner\n"
       "  envs                           registered environments\n"
       "  rollout --env=NAME --episodes=N --seed=S   random-policy episodes\n"

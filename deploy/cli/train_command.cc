@@ -117,7 +117,7 @@ void PrintResult(const pb::RunConfig& config, const ProgressRow& last) {
 }
 
 // One learner and --actors actor processes (deploy/launcher.h).
-int RunDistributed(const ResolvedRun& run) {
+int RunDistributed(const TrainRequest& request, const ResolvedRun& run) {
   if (run.local.resume) {
     return Fail("--resume of a distributed run is not supported yet");
   }
@@ -129,6 +129,10 @@ int RunDistributed(const ResolvedRun& run) {
           ? absl::StrCat(std::filesystem::temp_directory_path().string(),
                          "/vantage-launch-", ::getpid())
           : run.local.run_dir + "/launch";
+  launch.auth_token_file = request.auth_token_file;
+  launch.tls_cert = request.tls_cert;
+  launch.tls_key = request.tls_key;
+  launch.tls_ca = request.tls_ca;
   std::printf(
       "training %s with %s, estimator %s (rho %g), %ld steps, seed %lu: "
       "1 learner + %d actors x %d envs over gRPC%s%s\n",
@@ -163,6 +167,7 @@ int RunLearnerCommand(const LearnerRequest& request) {
   server.run_config = resolved->config;
   server.listen = request.listen;
   server.port_file = request.port_file;
+  server.security = request.security;
   server.metrics_address = request.metrics;
   ProgressRow last;
   last.mean_return = std::nan("");
@@ -186,7 +191,8 @@ int RunTrainCommand(const TrainRequest& request) {
   if (!resolved.ok()) return Fail(resolved.status().message());
   const pb::RunConfig* config = &resolved->config;
   const LocalTrainingConfig& local = resolved->local;
-  if (config->mode() == "distributed") return RunDistributed(*resolved);
+  if (config->mode() == "distributed")
+    return RunDistributed(request, *resolved);
 
   at::set_num_threads(1);
   std::printf(

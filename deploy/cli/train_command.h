@@ -3,6 +3,7 @@
 
 #include <string>
 
+#include "learner/service/security.h"
 #include "proto/run_config.pb.h"
 
 namespace vantage {
@@ -13,6 +14,11 @@ struct TrainRequest {
   std::string config_file;  // --config: JSON RunConfig under the flags
   std::string run_dir;      // --run_dir: where the run is recorded
   std::string resume;       // --resume: a run directory to continue
+  // Distributed: the security flags its learner and actors get.
+  std::string auth_token_file;
+  std::string tls_cert;
+  std::string tls_key;
+  std::string tls_ca;
 };
 
 // `vantage train`: a progress line while a terminal watches, a final
@@ -21,10 +27,11 @@ struct TrainRequest {
 int RunTrainCommand(const TrainRequest& request);
 
 struct LearnerRequest {
-  TrainRequest train;     // the run's settings, as for train
-  std::string listen;     // HOST:PORT; port 0 picks a free one
-  std::string port_file;  // the bound port is written here
-  std::string metrics;    // Prometheus HOST:PORT; empty: none
+  TrainRequest train;        // the run's settings, as for train
+  std::string listen;        // HOST:PORT; port 0 picks a free one
+  std::string port_file;     // the bound port is written here
+  std::string metrics;       // Prometheus HOST:PORT; empty: none
+  SecurityOptions security;  // TLS and the token actors must send
 };
 
 // `vantage learner`: serves actors (see deploy/learner_server.h) until the

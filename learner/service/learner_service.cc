@@ -20,9 +20,12 @@ grpc::Status ToGrpcStatus(const absl::Status& status) {
                       std::string(status.message()));
 }
 
-grpc::Status LearnerService::Register(grpc::ServerContext* /*context*/,
+grpc::Status LearnerService::Register(grpc::ServerContext* context,
                                       const pb::RegisterRequest* request,
                                       pb::RegisterResponse* response) {
+  if (grpc::Status auth = CheckAuthToken(*context, auth_token_); !auth.ok()) {
+    return auth;
+  }
   absl::StatusOr<pb::RegisterResponse> registered =
       gateway_.Register(*request, kRegistrationWait);
   if (!registered.ok()) return ToGrpcStatus(registered.status());
@@ -31,8 +34,11 @@ grpc::Status LearnerService::Register(grpc::ServerContext* /*context*/,
 }
 
 grpc::Status LearnerService::StreamSegments(
-    grpc::ServerContext* /*context*/, grpc::ServerReader<pb::Segment>* reader,
+    grpc::ServerContext* context, grpc::ServerReader<pb::Segment>* reader,
     pb::SegmentAck* ack) {
+  if (grpc::Status auth = CheckAuthToken(*context, auth_token_); !auth.ok()) {
+    return auth;
+  }
   pb::Segment segment;
   std::string dropped;
   while (reader->Read(&segment)) {
@@ -52,6 +58,9 @@ grpc::Status LearnerService::StreamSegments(
 grpc::Status LearnerService::SubscribeWeights(
     grpc::ServerContext* context, const pb::WeightsRequest* request,
     grpc::ServerWriter<pb::Weights>* writer) {
+  if (grpc::Status auth = CheckAuthToken(*context, auth_token_); !auth.ok()) {
+    return auth;
+  }
   int64_t known = request->known_version();
   while (!context->IsCancelled() && !gateway_.closed()) {
     std::shared_ptr<const pb::Weights> weights =
@@ -63,9 +72,12 @@ grpc::Status LearnerService::SubscribeWeights(
   return grpc::Status::OK;
 }
 
-grpc::Status LearnerService::GetWeights(grpc::ServerContext* /*context*/,
+grpc::Status LearnerService::GetWeights(grpc::ServerContext* context,
                                         const pb::WeightsRequest* request,
                                         pb::Weights* response) {
+  if (grpc::Status auth = CheckAuthToken(*context, auth_token_); !auth.ok()) {
+    return auth;
+  }
   std::shared_ptr<const pb::Weights> weights =
       gateway_.WaitForWeightsNewerThan(-1, absl::ZeroDuration());
   if (weights == nullptr) {
@@ -77,11 +89,14 @@ grpc::Status LearnerService::GetWeights(grpc::ServerContext* /*context*/,
 }
 
 absl::StatusOr<RunningServer> StartServer(const ServerOptions& options,
-                                          grpc::Service& service) {
+                                          LearnerService& service) {
+  absl::StatusOr<std::shared_ptr<grpc::ServerCredentials>> credentials =
+      MakeServerCredentials(options.security);
+  if (!credentials.ok()) return credentials.status();
+  service.RequireAuthToken(options.security.auth_token);
   RunningServer running;
   grpc::ServerBuilder builder;
-  builder.AddListeningPort(options.listen, grpc::InsecureServerCredentials(),
-                           &running.port);
+  builder.AddListeningPort(options.listen, *credentials, &running.port);
   builder.SetMaxReceiveMessageSize(options.max_message_bytes);
   builder.SetMaxSendMessageSize(options.max_message_bytes);
   builder.RegisterService(&service);

@@ -8,6 +8,7 @@
 
 #include "absl/status/statusor.h"
 #include "learner/service/actor_gateway.h"
+#include "learner/service/security.h"
 #include "proto/vantage.grpc.pb.h"
 
 namespace vantage {
@@ -15,10 +16,15 @@ namespace vantage {
 // absl::Status -> grpc::Status with the same code and message.
 grpc::Status ToGrpcStatus(const absl::Status& status);
 
-// The gRPC face of an ActorGateway; every method only translates.
+// The gRPC face of an ActorGateway; every method only translates, after
+// checking the auth token (if one is required).
 class LearnerService final : public pb::Learner::Service {
  public:
   explicit LearnerService(ActorGateway& gateway) : gateway_(gateway) {}
+
+  // Every call must then carry `authorization: Bearer <token>`; empty: none.
+  // Set before the server starts.
+  void RequireAuthToken(std::string token) { auth_token_ = std::move(token); }
 
   grpc::Status Register(grpc::ServerContext* context,
                         const pb::RegisterRequest* request,
@@ -38,11 +44,13 @@ class LearnerService final : public pb::Learner::Service {
 
  private:
   ActorGateway& gateway_;
+  std::string auth_token_;
 };
 
 struct ServerOptions {
   std::string listen = "127.0.0.1:0";  // port 0: the OS picks one
   int max_message_bytes = 256 << 20;
+  SecurityOptions security;  // TLS and the auth token
 };
 
 struct RunningServer {
@@ -50,9 +58,10 @@ struct RunningServer {
   int port = 0;
 };
 
-// Builds and starts a server for `service` (which must outlive it).
+// Builds and starts a server for `service` (which must outlive it), with
+// the credentials of options.security and its token required by `service`.
 absl::StatusOr<RunningServer> StartServer(const ServerOptions& options,
-                                          grpc::Service& service);
+                                          LearnerService& service);
 
 }  // namespace vantage
 

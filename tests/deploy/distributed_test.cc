@@ -246,6 +246,36 @@ TEST(DistributedTest, AnActorOfAnotherEnvironmentIsRefused) {
   EXPECT_EQ(WaitVantage(learner.pid, 20), 0);
 }
 
+// A learner with a token refuses an actor with another one for good
+// (UNAUTHENTICATED ends it without retry) and trains with the right one.
+TEST(DistributedTest, OnlyAnActorWithTheLearnersTokenTakesPart) {
+  const std::string token = WriteTemp("token", "learner-token-42\n");
+  const std::string wrong = WriteTemp("wrong-token", "learner-token-43\n");
+  const Learner learner = StartLearner(
+      "--steps=1024 --horizon=256 --envs=2 --auth_token_file=" + token);
+  const std::string actor_args =
+      "actor --learner=127.0.0.1:" + learner.port +
+      " --env=InvertedPendulum --envs=2 --auth_token_file=";
+  const Outcome refused =
+      RunVantage(actor_args + wrong + " --max_reconnects=0");
+  EXPECT_EQ(refused.exit_code, 1);
+  EXPECT_THAT(refused.err,
+              HasSubstr("registration: missing or wrong auth token"));
+
+  const int actor = StartVantage(actor_args + token, TempPath("actor.out"),
+                                 TempPath("actor.err"));
+  EXPECT_EQ(WaitVantage(learner.pid, 120), 0) << ReadFile(learner.err);
+  kill(actor, SIGTERM);
+  EXPECT_EQ(WaitVantage(actor, 20), 0) << ReadFile(TempPath("actor.err"));
+  EXPECT_THAT(ReadFile(learner.out), HasSubstr("RESULT train"));
+  EXPECT_THAT(ReadFile(learner.out), HasSubstr("steps=1024"));
+
+  // Half a TLS configuration is a flag error, before anything starts.
+  const Outcome half = RunVantage("learner --tls_cert=" + token);
+  EXPECT_EQ(half.exit_code, 2);
+  EXPECT_THAT(half.err, HasSubstr("--tls_key"));
+}
+
 TEST(DistributedTest, AnActorWithoutALearnerGivesUpWhenTold) {
   const Outcome actor = RunVantage(
       "actor --learner=127.0.0.1:1 --env=InvertedPendulum --max_reconnects=2");
