@@ -15,6 +15,8 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/strip.h"
 #include "deploy/run_config.h"
+#include "deploy/run_directory.h"
+#include "learner/checkpoint.h"
 
 namespace vantage {
 namespace {
@@ -78,6 +80,29 @@ std::vector<std::string> SecurityArgs(const LaunchConfig& config) {
   return args;
 }
 
+// Waits for the learner `pid` to write its port to `port_file`; empty if
+// it ended first (`status` says how) or `stop` was set.
+std::string WaitForPort(pid_t pid, const std::string& port_file,
+                        const std::atomic<bool>& stop, int& status) {
+  while (!stop) {
+    if (waitpid(pid, &status, WNOHANG) == pid) return "";
+    std::ifstream file(port_file);
+    std::string line;
+    if (std::getline(file, line) && !line.empty()) return line;
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  return "";
+}
+
+// A learner that died (not one that refused its flags, exit code 2) can be
+// restarted when the run has a checkpoint to continue from.
+bool CanResume(const LaunchConfig& config, int status) {
+  if (config.run_dir.empty()) return false;
+  if (WIFEXITED(status) && WEXITSTATUS(status) == 2) return false;
+  absl::StatusOr<RunDirectory> run = RunDirectory::Open(config.run_dir);
+  return run.ok() && !ListCheckpoints(run->checkpoint_directory()).empty();
+}
+
 }  // namespace
 
 absl::Status RunDistributedTraining(const LaunchConfig& config,
@@ -87,7 +112,6 @@ absl::Status RunDistributedTraining(const LaunchConfig& config,
   std::filesystem::create_directories(config.work_dir, error);
   const std::string config_path = config.work_dir + "/launch_config.json";
   const std::string port_file = config.work_dir + "/learner.port";
-  std::filesystem::remove(port_file, error);
   {
     std::ofstream file(config_path, std::ios::trunc);
     file << RunConfigToJson(run);
@@ -95,34 +119,36 @@ absl::Status RunDistributedTraining(const LaunchConfig& config,
       return absl::InternalError(absl::StrCat("cannot write ", config_path));
     }
   }
-  std::vector<std::string> learner_args = {"learner", "--config=" + config_path,
-                                           "--listen=127.0.0.1:0",
-                                           "--port_file=" + port_file};
-  if (!config.run_dir.empty()) {
-    learner_args.push_back("--run_dir=" + config.run_dir);
-  }
   const std::vector<std::string> security_args = SecurityArgs(config);
-  learner_args.insert(learner_args.end(), security_args.begin(),
-                      security_args.end());
-  absl::StatusOr<pid_t> learner = Spawn(learner_args);
-  if (!learner.ok()) return learner.status();
-
-  // The learner writes its port once serving.
-  std::string port;
-  while (port.empty()) {
-    int status = 0;
-    if (waitpid(*learner, &status, WNOHANG) == *learner) {
-      return absl::InternalError(absl::StrCat(
-          "the learner ended before serving (", Describe(status), ")"));
+  // A resumed learner continues the run directory as its config.json says,
+  // on the port the actors already know.
+  auto start_learner = [&](bool resume,
+                           const std::string& port) -> absl::StatusOr<pid_t> {
+    std::filesystem::remove(port_file, error);
+    std::vector<std::string> args = {"learner", "--listen=127.0.0.1:" + port,
+                                     "--port_file=" + port_file};
+    if (resume) {
+      args.push_back("--resume=" + config.run_dir);
+    } else {
+      args.push_back("--config=" + config_path);
+      if (!config.run_dir.empty())
+        args.push_back("--run_dir=" + config.run_dir);
     }
+    args.insert(args.end(), security_args.begin(), security_args.end());
+    return Spawn(args);
+  };
+  absl::StatusOr<pid_t> learner = start_learner(config.resume, "0");
+  if (!learner.ok()) return learner.status();
+  int learner_status = 0;
+  const std::string port =
+      WaitForPort(*learner, port_file, stop, learner_status);
+  if (port.empty()) {
     if (stop) {
       Terminate({*learner}, std::chrono::seconds(10));
       return absl::OkStatus();
     }
-    std::ifstream file(port_file);
-    std::string line;
-    if (std::getline(file, line) && !line.empty()) port = line;
-    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    return absl::InternalError(absl::StrCat(
+        "the learner ended before serving (", Describe(learner_status), ")"));
   }
   std::fprintf(stderr, "launcher: learner on port %s, starting %d actors\n",
                port.c_str(), run.actors());
@@ -139,53 +165,78 @@ absl::Status RunDistributedTraining(const LaunchConfig& config,
     return Spawn(args);
   };
   std::vector<pid_t> actors(run.actors(), -1);
+  auto everyone = [&] {
+    std::vector<pid_t> all = actors;
+    all.push_back(*learner);
+    return all;
+  };
   for (int i = 0; i < run.actors(); ++i) {
     absl::StatusOr<pid_t> pid = start_actor(i);
     if (!pid.ok()) {
-      Terminate({*learner}, std::chrono::seconds(10));
+      Terminate(everyone(), std::chrono::seconds(10));
       return pid.status();
     }
     actors[i] = *pid;
   }
 
-  int restarts = 0;
+  int actor_restarts = 0;
+  int learner_restarts = 0;
   absl::Status result;
   while (true) {
     if (stop) {
       // Everyone gets the signal; the learner writes its last checkpoint.
-      std::vector<pid_t> all = actors;
-      all.push_back(*learner);
-      Terminate(all, std::chrono::seconds(30));
+      Terminate(everyone(), std::chrono::seconds(30));
       return absl::OkStatus();
     }
     int status = 0;
     const pid_t done = waitpid(-1, &status, WNOHANG);
     if (done == *learner) {
-      if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
+      if (WIFEXITED(status) && WEXITSTATUS(status) == 0) break;
+      if (learner_restarts >= config.max_learner_restarts ||
+          !CanResume(config, status)) {
+        *learner = -1;
         result = absl::InternalError(
             absl::StrCat("the learner failed (", Describe(status), ")"));
+        break;
       }
-      break;
+      // The actors keep their environments and reconnect by themselves.
+      ++learner_restarts;
+      std::fprintf(stderr,
+                   "launcher: the learner ended (%s); resuming it from the "
+                   "run's last checkpoint\n",
+                   Describe(status).c_str());
+      learner = start_learner(/*resume=*/true, port);
+      if (!learner.ok()) {
+        Terminate(actors, std::chrono::seconds(10));
+        return learner.status();
+      }
+      if (WaitForPort(*learner, port_file, stop, learner_status).empty() &&
+          !stop) {
+        *learner = -1;
+        result = absl::InternalError(
+            absl::StrCat("the resumed learner ended before serving (",
+                         Describe(learner_status), ")"));
+        break;
+      }
+      continue;
     }
     for (int i = 0; done > 0 && i < run.actors(); ++i) {
       if (actors[i] != done) continue;
-      if (restarts >= config.max_actor_restarts) {
+      if (actor_restarts >= config.max_actor_restarts) {
         actors[i] = -1;
         result = absl::InternalError(
             absl::StrCat("actor ", i, " ended (", Describe(status), ") after ",
-                         restarts, " restarts; giving up"));
+                         actor_restarts, " restarts; giving up"));
         break;
       }
-      ++restarts;
+      ++actor_restarts;
       std::fprintf(stderr, "launcher: actor %d ended (%s); restarting it\n", i,
                    Describe(status).c_str());
       absl::StatusOr<pid_t> pid = start_actor(i);
       actors[i] = pid.ok() ? *pid : -1;
     }
     if (!result.ok()) {
-      std::vector<pid_t> all = actors;
-      all.push_back(*learner);
-      Terminate(all, std::chrono::seconds(30));
+      Terminate(everyone(), std::chrono::seconds(30));
       return result;
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(20));

@@ -17,8 +17,13 @@ struct LaunchConfig {
   std::string run_dir;       // may be empty
   // Where the learner's port file and the config it reads go.
   std::string work_dir;
+  // Continue the run in run_dir from its last checkpoint.
+  bool resume = false;
   // Restarts of crashed actors before the run is given up.
   int max_actor_restarts = 20;
+  // Restarts of a crashed learner (each resumes from the run's last
+  // checkpoint; needs a run_dir with one) before the run is given up.
+  int max_learner_restarts = 5;
   // Passed to the learner and every actor as --auth_token_file, --tls_cert,
   // --tls_key, --tls_ca when set (the same files serve both ends).
   std::string auth_token_file;
@@ -29,7 +34,9 @@ struct LaunchConfig {
 
 // Starts `vantage learner` on 127.0.0.1 with a free port, then the actors
 // (actor i gets seed + i, so one actor repeats a local run), restarts an
-// actor that dies (logged), forwards `stop` (SIGINT/SIGTERM) to every
+// actor that dies (logged), restarts a learner that dies from the run's last
+// checkpoint on the same port (the actors reconnect to it keeping their
+// environments), forwards `stop` (SIGINT/SIGTERM) to every
 // process, and returns when the learner finishes the run (the actors are
 // then stopped). The learner's output (progress, the RESULT line) passes
 // through.

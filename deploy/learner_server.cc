@@ -5,11 +5,14 @@
 #include <fstream>
 #include <thread>
 
+#include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "deploy/run_recorder.h"
+#include "deploy/run_resume.h"
 #include "learner/service/actor_gateway.h"
 #include "learner/service/learner_metrics.h"
 #include "learner/service/learner_service.h"
+#include "proto/wire_format.h"
 
 namespace vantage {
 namespace {
@@ -29,12 +32,97 @@ absl::Status WritePortFile(const std::string& path, int port) {
   return absl::OkStatus();
 }
 
+constexpr char kEnvSpec[] = "env_spec";
+constexpr char kNextActorId[] = "next_actor_id";
+
+// What a learner server keeps in its checkpoints besides the learner: the
+// environment's whole spec (a resumed learner answers registrations before
+// any actor has told it) and the next actor id.
+struct ServerCheckpointState {
+  EnvSpec spec;
+  int64_t next_actor_id = 0;
+};
+
+CheckpointExtras ServerStateExtras(const EnvSpec& spec, int64_t next_actor_id) {
+  pb::EnvSpec proto;
+  EnvSpecToProto(spec, &proto);
+  return {{kEnvSpec, proto.SerializeAsString()},
+          {kNextActorId, absl::StrCat(next_actor_id)}};
+}
+
+absl::StatusOr<ServerCheckpointState> ReadServerState(
+    const std::string& path, const CheckpointExtras& extras) {
+  auto spec_bytes = extras.find(kEnvSpec);
+  auto next_id = extras.find(kNextActorId);
+  if (spec_bytes == extras.end() || next_id == extras.end()) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        path,
+        " holds no learner-server state (a checkpoint of a local run "
+        "resumes with --mode=local)"));
+  }
+  pb::EnvSpec proto;
+  if (!proto.ParseFromString(spec_bytes->second)) {
+    return absl::DataLossError(absl::StrCat(path, ": unreadable env_spec"));
+  }
+  absl::StatusOr<EnvSpec> spec = EnvSpecFromProto(proto);
+  if (!spec.ok()) return spec.status();
+  ServerCheckpointState state;
+  state.spec = *std::move(spec);
+  if (!absl::SimpleAtoi(next_id->second, &state.next_actor_id) ||
+      state.next_actor_id < 0) {
+    return absl::DataLossError(absl::StrCat(path, ": bad next_actor_id"));
+  }
+  return state;
+}
+
 }  // namespace
 
 absl::Status RunLearnerServer(
     const LearnerServerConfig& config, const std::atomic<bool>& stop,
     const std::function<void(const ProgressRow&)>& on_update) {
   const LocalTrainingConfig& training = config.training;
+  auto learner_config_for = [&](const EnvSpec& spec) {
+    LearnerConfig learner_config = MakeLearnerConfig(training, spec);
+    learner_config.max_segment_steps = config.run_config.segment_length();
+    return learner_config;
+  };
+  // A resumed run knows its spec, its learner and the actor ids it handed
+  // out before any actor registers.
+  std::optional<RunDirectory> run;
+  std::unique_ptr<LearnerCore> learner;
+  std::optional<EnvSpec> spec;
+  int64_t first_actor_id = 0;
+  double elapsed_before = 0.0;
+  if (training.resume) {
+    absl::StatusOr<RunDirectory> opened = RunDirectory::Open(training.run_dir);
+    if (!opened.ok()) return opened.status();
+    run = *std::move(opened);
+    absl::StatusOr<ResumePoint> resumed = ResumeFromNewestCheckpoint(
+        *run,
+        [&](const std::string& path, const CheckpointExtras& extras)
+            -> absl::StatusOr<std::unique_ptr<LearnerCore>> {
+          absl::StatusOr<ServerCheckpointState> state =
+              ReadServerState(path, extras);
+          if (!state.ok()) return state.status();
+          absl::StatusOr<std::unique_ptr<LearnerCore>> loaded =
+              ReadCheckpoint(path, learner_config_for(state->spec));
+          if (loaded.ok()) {
+            spec = state->spec;
+            first_actor_id = state->next_actor_id;
+          }
+          return loaded;
+        });
+    if (!resumed.ok()) return resumed.status();
+    learner = std::move(resumed->learner);
+    elapsed_before = resumed->elapsed_seconds;
+    std::fprintf(stderr,
+                 "learner: resuming %s from policy version %ld (%ld env "
+                 "steps)\n",
+                 training.run_dir.c_str(),
+                 static_cast<long>(learner->policy_version()),
+                 static_cast<long>(learner->env_steps()));
+  }
+
   // Room for a few rounds of every stream: actors that outpace the learner
   // block on their streams instead of growing memory.
   SegmentQueue queue(static_cast<size_t>(std::max(8, 4 * training.num_envs)));
@@ -42,7 +130,9 @@ absl::Status RunLearnerServer(
   gateway_config.run_config = config.run_config;
   gateway_config.max_segment_steps = config.run_config.segment_length();
   gateway_config.max_policy_lag = config.run_config.max_policy_lag();
+  gateway_config.first_actor_id = first_actor_id;
   ActorGateway gateway(gateway_config, queue);
+  if (spec.has_value()) gateway.SetSpec(*spec);
   LearnerService service(gateway);
   ServerOptions options;
   options.listen = config.listen;
@@ -93,38 +183,42 @@ absl::Status RunLearnerServer(
     return stop ? absl::OkStatus() : status;
   };
 
-  std::optional<EnvSpec> spec;
-  while (!spec.has_value() && !stop) {
-    spec = gateway.WaitForSpec(absl::Milliseconds(200));
-  }
-  if (!spec.has_value()) return finish(absl::OkStatus());
-  LearnerConfig learner_config = MakeLearnerConfig(training, *spec);
-  learner_config.max_segment_steps = config.run_config.segment_length();
-  absl::StatusOr<std::unique_ptr<LearnerCore>> learner =
-      LearnerCore::Create(learner_config);
-  if (!learner.ok()) return finish(learner.status());
-  std::optional<RunDirectory> run;
-  if (!training.run_dir.empty()) {
-    absl::StatusOr<RunDirectory> created =
-        RunDirectory::Create(training.run_dir, training.config_json);
+  if (learner == nullptr) {
+    while (!spec.has_value() && !stop) {
+      spec = gateway.WaitForSpec(absl::Milliseconds(200));
+    }
+    if (!spec.has_value()) return finish(absl::OkStatus());
+    absl::StatusOr<std::unique_ptr<LearnerCore>> created =
+        LearnerCore::Create(learner_config_for(*spec));
     if (!created.ok()) return finish(created.status());
-    run = *std::move(created);
+    learner = *std::move(created);
+    if (!training.run_dir.empty()) {
+      absl::StatusOr<RunDirectory> made =
+          RunDirectory::Create(training.run_dir, training.config_json);
+      if (!made.ok()) return finish(made.status());
+      run = *std::move(made);
+    }
   }
   RecorderConfig recorder_config;
   recorder_config.config_json = training.config_json;
   recorder_config.checkpoint_every = training.checkpoint_every;
   recorder_config.keep_checkpoints = training.keep_checkpoints;
   recorder_config.total_env_steps = training.total_env_steps;
+  recorder_config.elapsed_before = elapsed_before;
+  recorder_config.steps_before = learner->env_steps();
   RunRecorder recorder(std::move(run), recorder_config);
+  auto server_state = [&]() -> absl::StatusOr<CheckpointExtras> {
+    return ServerStateExtras(*spec, gateway.next_actor_id());
+  };
 
-  gateway.Publish((*learner)->CurrentWeights());
-  while ((*learner)->env_steps() < training.total_env_steps && !stop) {
-    absl::StatusOr<UpdateStats> stats = (*learner)->RunUpdate(queue);
-    if (!stats.ok()) return finish(stop ? absl::OkStatus() : stats.status());
-    gateway.Publish((*learner)->CurrentWeights());
-    absl::StatusOr<ProgressRow> row = recorder.Record(**learner, *stats, [] {
-      return absl::StatusOr<CheckpointExtras>(CheckpointExtras());
-    });
+  gateway.Publish(learner->CurrentWeights());
+  while (learner->env_steps() < training.total_env_steps && !stop) {
+    absl::StatusOr<UpdateStats> stats = learner->RunUpdate(queue);
+    if (!stats.ok() && stop) break;
+    if (!stats.ok()) return finish(stats.status());
+    gateway.Publish(learner->CurrentWeights());
+    absl::StatusOr<ProgressRow> row =
+        recorder.Record(*learner, *stats, server_state);
     if (!row.ok()) return finish(row.status());
     if (metrics != nullptr) {
       for (int64_t lag : stats->rollout_policy_lags) {
@@ -136,6 +230,14 @@ absl::Status RunLearnerServer(
       record_gateway();
     }
     on_update(*row);
+  }
+  // Stopped by a signal (a scheduler's preemption): keep every update.
+  if (stop) {
+    if (absl::Status status = recorder.CheckpointNow(*learner, server_state);
+        !status.ok()) {
+      std::fprintf(stderr, "learner: no checkpoint at the stop: %s\n",
+                   std::string(status.message()).c_str());
+    }
   }
   return finish(absl::OkStatus());
 }

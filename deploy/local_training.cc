@@ -4,62 +4,16 @@
 #include <cstdio>
 #include <optional>
 
-#include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "deploy/run_directory.h"
 #include "deploy/run_recorder.h"
+#include "deploy/run_resume.h"
 #include "learner/checkpoint.h"
 
 namespace vantage {
 namespace {
 
 constexpr char kActorState[] = "actor_state";
-
-struct Resumed {
-  std::unique_ptr<LearnerCore> learner;
-  double elapsed_seconds = 0.0;
-};
-
-// The newest checkpoint that loads, with the actor restored to the state it
-// had then. Unreadable newer ones are reported on stderr and skipped.
-absl::StatusOr<Resumed> ResumeFromCheckpoint(const RunDirectory& run,
-                                             const LearnerConfig& config,
-                                             ActorCore& actor) {
-  const std::vector<std::string> paths =
-      ListCheckpoints(run.checkpoint_directory());
-  if (paths.empty()) {
-    return absl::NotFoundError(
-        absl::StrCat(run.path(), " has no checkpoint to resume from"));
-  }
-  std::string problems;
-  for (auto path = paths.rbegin(); path != paths.rend(); ++path) {
-    absl::StatusOr<CheckpointExtras> extras = ReadCheckpointExtras(*path);
-    absl::StatusOr<std::unique_ptr<LearnerCore>> learner =
-        extras.ok()
-            ? ReadCheckpoint(*path, config)
-            : absl::StatusOr<std::unique_ptr<LearnerCore>>(extras.status());
-    absl::Status status = learner.status();
-    if (status.ok() && extras->count(kActorState) == 0) {
-      status = absl::InvalidArgumentError(
-          absl::StrCat(*path, " holds no actor state"));
-    }
-    if (status.ok()) status = actor.RestoreState(extras->at(kActorState));
-    if (status.ok()) {
-      Resumed resumed;
-      resumed.learner = *std::move(learner);
-      if (extras->count(kCheckpointElapsed) != 0) {
-        (void)absl::SimpleAtod(extras->at(kCheckpointElapsed),
-                               &resumed.elapsed_seconds);
-      }
-      return resumed;
-    }
-    std::fprintf(stderr, "vantage: skipping checkpoint %s: %s\n", path->c_str(),
-                 std::string(status.message()).c_str());
-    absl::StrAppend(&problems, problems.empty() ? "" : "; ", status.message());
-  }
-  return absl::DataLossError(absl::StrCat(
-      "no checkpoint in ", run.checkpoint_directory(), " loads: ", problems));
-}
 
 }  // namespace
 
@@ -106,15 +60,28 @@ absl::Status RunLocalTraining(
     absl::StatusOr<RunDirectory> opened = RunDirectory::Open(config.run_dir);
     if (!opened.ok()) return opened.status();
     run = *std::move(opened);
-    absl::StatusOr<Resumed> resumed =
-        ResumeFromCheckpoint(*run, learner_config, **actor);
+    // The actor continues exactly where the checkpoint's actor was.
+    absl::StatusOr<ResumePoint> resumed = ResumeFromNewestCheckpoint(
+        *run,
+        [&](const std::string& path, const CheckpointExtras& extras)
+            -> absl::StatusOr<std::unique_ptr<LearnerCore>> {
+          auto state = extras.find(kActorState);
+          if (state == extras.end()) {
+            return absl::InvalidArgumentError(
+                absl::StrCat(path, " holds no actor state"));
+          }
+          absl::StatusOr<std::unique_ptr<LearnerCore>> loaded =
+              ReadCheckpoint(path, learner_config);
+          if (!loaded.ok()) return loaded.status();
+          if (absl::Status status = (*actor)->RestoreState(state->second);
+              !status.ok()) {
+            return status;
+          }
+          return loaded;
+        });
     if (!resumed.ok()) return resumed.status();
     learner = std::move(resumed->learner);
     elapsed_before = resumed->elapsed_seconds;
-    if (absl::Status status = run->TruncateProgress(learner->policy_version());
-        !status.ok()) {
-      return status;
-    }
   } else {
     if (!config.run_dir.empty()) {
       absl::StatusOr<RunDirectory> created =

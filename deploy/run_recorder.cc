@@ -33,10 +33,32 @@ absl::StatusOr<ProgressRow> RunRecorder::Record(
   }
   const bool last = stats.env_steps >= config_.total_env_steps;
   if (!last && stats.policy_version % config_.checkpoint_every != 0) return row;
+  if (absl::Status status =
+          WriteRunCheckpoint(learner, row.elapsed_seconds, extras);
+      !status.ok()) {
+    return status;
+  }
+  return row;
+}
+
+absl::Status RunRecorder::CheckpointNow(
+    const LearnerCore& learner,
+    absl::FunctionRef<absl::StatusOr<CheckpointExtras>()> extras) {
+  if (!run_.has_value() || learner.env_steps() == config_.steps_before ||
+      learner.policy_version() == checkpointed_version_) {
+    return absl::OkStatus();
+  }
+  return WriteRunCheckpoint(learner, config_.elapsed_before + Seconds(),
+                            extras);
+}
+
+absl::Status RunRecorder::WriteRunCheckpoint(
+    const LearnerCore& learner, double elapsed_seconds,
+    absl::FunctionRef<absl::StatusOr<CheckpointExtras>()> extras) {
   absl::StatusOr<CheckpointExtras> all = extras();
   if (!all.ok()) return all.status();
   (*all)[kCheckpointConfig] = config_.config_json;
-  (*all)[kCheckpointElapsed] = absl::StrCat(row.elapsed_seconds);
+  (*all)[kCheckpointElapsed] = absl::StrCat(elapsed_seconds);
   if (absl::Status status =
           WriteCheckpoint(CheckpointPath(run_->checkpoint_directory(),
                                          learner.policy_version()),
@@ -44,12 +66,9 @@ absl::StatusOr<ProgressRow> RunRecorder::Record(
       !status.ok()) {
     return status;
   }
-  if (absl::Status status = PruneCheckpoints(run_->checkpoint_directory(),
-                                             config_.keep_checkpoints);
-      !status.ok()) {
-    return status;
-  }
-  return row;
+  checkpointed_version_ = learner.policy_version();
+  return PruneCheckpoints(run_->checkpoint_directory(),
+                          config_.keep_checkpoints);
 }
 
 }  // namespace vantage

@@ -41,12 +41,24 @@ class RunRecorder {
       const LearnerCore& learner, const UpdateStats& stats,
       absl::FunctionRef<absl::StatusOr<CheckpointExtras>()> extras);
 
+  // A checkpoint of the learner as it is now, unless its version already
+  // has one, it has not updated since the run (re)started, or there is no
+  // run directory: a run stopped between its
+  // regular checkpoints (SIGTERM from a scheduler) loses no update.
+  absl::Status CheckpointNow(
+      const LearnerCore& learner,
+      absl::FunctionRef<absl::StatusOr<CheckpointExtras>()> extras);
+
  private:
   double Seconds() const;
+  absl::Status WriteRunCheckpoint(
+      const LearnerCore& learner, double elapsed_seconds,
+      absl::FunctionRef<absl::StatusOr<CheckpointExtras>()> extras);
 
   std::optional<RunDirectory> run_;
   RecorderConfig config_;
   std::chrono::steady_clock::time_point start_;
+  int64_t checkpointed_version_ = -1;
 };
 
 }  // namespace vantage

@@ -118,10 +118,8 @@ void PrintResult(const pb::RunConfig& config, const ProgressRow& last) {
 
 // One learner and --actors actor processes (deploy/launcher.h).
 int RunDistributed(const TrainRequest& request, const ResolvedRun& run) {
-  if (run.local.resume) {
-    return Fail("--resume of a distributed run is not supported yet");
-  }
   LaunchConfig launch;
+  launch.resume = run.local.resume;
   launch.run_config = run.config;
   launch.run_dir = run.local.run_dir;
   launch.work_dir =
@@ -134,11 +132,11 @@ int RunDistributed(const TrainRequest& request, const ResolvedRun& run) {
   launch.tls_key = request.tls_key;
   launch.tls_ca = request.tls_ca;
   std::printf(
-      "training %s with %s, estimator %s (rho %g), %ld steps, seed %lu: "
+      "%s %s with %s, estimator %s (rho %g), %ld steps, seed %lu: "
       "1 learner + %d actors x %d envs over gRPC%s%s\n",
-      run.config.env().c_str(), run.config.algo().c_str(),
-      run.config.estimator().c_str(), run.config.rho(),
-      static_cast<long>(run.config.steps()),
+      run.local.resume ? "resuming" : "training", run.config.env().c_str(),
+      run.config.algo().c_str(), run.config.estimator().c_str(),
+      run.config.rho(), static_cast<long>(run.config.steps()),
       static_cast<unsigned long>(run.config.seed()), run.config.actors(),
       run.config.envs_per_actor(),
       run.local.run_dir.empty() ? "" : ", run directory ",
@@ -156,9 +154,6 @@ int RunDistributed(const TrainRequest& request, const ResolvedRun& run) {
 }  // namespace
 
 int RunLearnerCommand(const LearnerRequest& request) {
-  if (!request.train.resume.empty()) {
-    return Fail("--resume of a distributed run is not supported yet");
-  }
   absl::StatusOr<ResolvedRun> resolved = ResolveRequest(request.train);
   if (!resolved.ok()) return Fail(resolved.status().message());
   at::set_num_threads(1);

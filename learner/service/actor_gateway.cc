@@ -15,7 +15,9 @@ std::chrono::nanoseconds ToChrono(absl::Duration d) {
 }  // namespace
 
 ActorGateway::ActorGateway(GatewayConfig config, SegmentSink& sink)
-    : config_(std::move(config)), sink_(sink) {}
+    : config_(std::move(config)),
+      sink_(sink),
+      next_actor_id_(config_.first_actor_id) {}
 
 absl::StatusOr<pb::RegisterResponse> ActorGateway::Register(
     const pb::RegisterRequest& request, absl::Duration timeout) {
@@ -148,6 +150,11 @@ std::shared_ptr<const pb::Weights> ActorGateway::WaitForWeightsNewerThan(
 int64_t ActorGateway::published_version() const {
   std::lock_guard<std::mutex> lock(mutex_);
   return weights_ == nullptr ? -1 : weights_->version();
+}
+
+int64_t ActorGateway::next_actor_id() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return next_actor_id_;
 }
 
 void ActorGateway::Close() {

@@ -31,6 +31,9 @@ struct GatewayConfig {
   // Segments older than the newest version minus this are dropped and
   // counted (not an error for the actor); -1: any age.
   int64_t max_policy_lag = 0;
+  // Ids are never reused within a run: a resumed learner continues after
+  // the ids its checkpoint had handed out.
+  int64_t first_actor_id = 0;
 };
 
 // Why segments were refused, for logs and metrics.
@@ -74,6 +77,8 @@ class ActorGateway {
   std::shared_ptr<const pb::Weights> WaitForWeightsNewerThan(
       int64_t version, absl::Duration timeout);
   int64_t published_version() const;
+  // The id the next registration gets (saved in checkpoints).
+  int64_t next_actor_id() const;
 
   // Wakes every waiter; no more registrations or weights.
   void Close();

@@ -10,6 +10,8 @@
 #include <vector>
 
 #include "absl/strings/numbers.h"
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
 #include "absl/strings/str_join.h"
 #include "absl/strings/str_split.h"
 #include "absl/strings/strip.h"
@@ -154,6 +156,91 @@ TEST(DistributedTest, TrainRestartsAKilledActor) {
   EXPECT_THAT(rows[6], ::testing::StartsWith("6144,6,6,"));
   // No process of the run is left behind.
   EXPECT_TRUE(ChildrenRunning(train, "vantage").empty());
+}
+
+// The second fault: the learner is killed with SIGKILL mid-run. The
+// launcher restarts it from the run's last checkpoint on the same port, the
+// actor (still holding its environments) reconnects under a new id and
+// gets that checkpoint's policy, and the run completes with one progress
+// row per version: the rows written after the checkpoint were dropped and
+// written again by the resumed learner.
+TEST(DistributedTest, AKilledLearnerResumesFromItsLastCheckpoint) {
+  const std::string run = FreshDirectory("learner_killed");
+  const std::string err = TempPath("train.err");
+  const int train = StartVantage(
+      "train --actors=1 --envs_per_actor=2 --steps=8192 --horizon=512 "
+      "--checkpoint_every=2 --seed=4 --run_dir=" +
+          run,
+      TempPath("train.out"), err);
+  for (int i = 0; i < 1200 && DeterministicProgress(run).size() < 1 + 3; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  ASSERT_GE(DeterministicProgress(run).size(), 1u + 3) << ReadFile(err);
+  const std::vector<int> learners = ChildrenRunning(train, " learner ");
+  ASSERT_EQ(learners.size(), 1u);
+  kill(learners[0], SIGKILL);
+  EXPECT_EQ(WaitVantage(train, 240), 0) << ReadFile(err);
+  const std::string log = ReadFile(err);
+  EXPECT_THAT(log, HasSubstr("the learner ended (signal 9); resuming it"));
+  // The version it resumed from is one that had a checkpoint (every 2).
+  const std::string marker = "from policy version ";
+  const size_t at = log.find(marker);
+  ASSERT_NE(at, std::string::npos) << log;
+  int version = 0;
+  ASSERT_TRUE(absl::SimpleAtoi(
+      log.substr(at + marker.size(),
+                 log.find(' ', at + marker.size()) - at - marker.size()),
+      &version))
+      << log;
+  EXPECT_GE(version, 2);
+  EXPECT_EQ(version % 2, 0);
+  // Actor ids are not reused across the restart, and the reconnected actor
+  // acts with the checkpoint's policy.
+  EXPECT_THAT(log, HasSubstr(absl::StrCat("registered as actor 1, policy "
+                                          "version ",
+                                          version, "\n")));
+  const std::vector<std::string> rows = DeterministicProgress(run);
+  ASSERT_EQ(rows.size(), 1u + 8) << absl::StrJoin(rows, "\n");
+  for (int v = 1; v <= 8; ++v) {
+    EXPECT_THAT(rows[v], ::testing::StartsWith(
+                             absl::StrCat(1024 * v, ",", v, ",", v, ",")));
+  }
+  EXPECT_TRUE(ChildrenRunning(train, "vantage").empty());
+}
+
+// A scheduler's preemption: SIGTERM to `vantage train` mid-run makes the
+// learner checkpoint the update it is at (checkpoint_every alone would
+// have written none yet), and `train --resume` finishes the run from there.
+TEST(DistributedTest, AStoppedRunKeepsEveryUpdateAndResumes) {
+  const std::string run = FreshDirectory("preempted");
+  const std::string err = TempPath("train.err");
+  const int train = StartVantage(
+      "train --actors=1 --envs_per_actor=2 --steps=6144 --horizon=512 "
+      "--checkpoint_every=100 --seed=6 --run_dir=" +
+          run,
+      TempPath("train.out"), err);
+  for (int i = 0; i < 1200 && DeterministicProgress(run).size() < 1 + 2; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  ASSERT_GE(DeterministicProgress(run).size(), 1u + 2) << ReadFile(err);
+  kill(train, SIGTERM);
+  EXPECT_EQ(WaitVantage(train, 60), 0) << ReadFile(err);
+  const size_t updates = DeterministicProgress(run).size() - 1;
+  ASSERT_LT(updates, 6u);
+  EXPECT_TRUE(std::filesystem::exists(
+      absl::StrFormat("%s/checkpoints/checkpoint-%08d.pt", run, updates)))
+      << ReadFile(err);
+
+  const Outcome resumed = RunVantage("train --resume=" + run);
+  ASSERT_EQ(resumed.exit_code, 0) << resumed.err;
+  EXPECT_THAT(resumed.err,
+              HasSubstr(absl::StrCat("from policy version ", updates, " (")));
+  const std::vector<std::string> rows = DeterministicProgress(run);
+  ASSERT_EQ(rows.size(), 1u + 6) << absl::StrJoin(rows, "\n");
+  for (int v = 1; v <= 6; ++v) {
+    EXPECT_THAT(rows[v], ::testing::StartsWith(
+                             absl::StrCat(1024 * v, ",", v, ",", v, ",")));
+  }
 }
 
 // The port a process printed as "<who>: metrics on port N".
