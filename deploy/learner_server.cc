@@ -123,9 +123,16 @@ absl::Status RunLearnerServer(
                  static_cast<long>(learner->env_steps()));
   }
 
-  // Room for a few rounds of every stream: actors that outpace the learner
-  // block on their streams instead of growing memory.
-  SegmentQueue queue(static_cast<size_t>(std::max(8, 4 * training.num_envs)));
+  // Room for two whole batches: asynchronous actors keep acting for the
+  // next batch while an update runs (which is how acting hides behind
+  // learning), and actors that outpace the learner beyond that block on
+  // their streams instead of growing memory.
+  const int64_t batch_segments =
+      training.num_envs *
+      (training.learner.horizon /
+       std::max<int64_t>(1, config.run_config.segment_length()));
+  SegmentQueue queue(
+      static_cast<size_t>(std::max<int64_t>(8, 2 * batch_segments)));
   GatewayConfig gateway_config;
   gateway_config.run_config = config.run_config;
   gateway_config.max_segment_steps = config.run_config.segment_length();

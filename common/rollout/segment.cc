@@ -2,6 +2,7 @@
 
 #include <ATen/ATen.h>
 
+#include <cmath>
 #include <string>
 
 #include "absl/strings/str_cat.h"
@@ -30,11 +31,39 @@ absl::Status Expect(const at::Tensor& t, const char* field,
         "segment field ", field, " has dtype ", at::toString(t.scalar_type()),
         ", expected ", at::toString(dtype)));
   }
-  if (at::isFloatingType(dtype) && !at::isfinite(t).all().item<bool>()) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("segment field ", field, " holds non-finite values"));
+  // Plain loops: a segment is small, and a few tensor ops per field would
+  // cost more than the data (this runs for every segment a learner takes).
+  if (dtype == at::kFloat) {
+    const at::Tensor dense = t.contiguous();
+    const float* values = dense.data_ptr<float>();
+    for (int64_t i = 0, n = dense.numel(); i < n; ++i) {
+      if (!std::isfinite(values[i])) {
+        return absl::InvalidArgumentError(
+            absl::StrCat("segment field ", field, " holds non-finite values"));
+      }
+    }
   }
   return absl::OkStatus();
+}
+
+// The number of set flags, and whether any step has both.
+int64_t CountSet(const at::Tensor& flags) {
+  const at::Tensor dense = flags.contiguous();
+  const bool* values = dense.data_ptr<bool>();
+  int64_t count = 0;
+  for (int64_t i = 0, n = dense.numel(); i < n; ++i) count += values[i];
+  return count;
+}
+
+bool AnyBoth(const at::Tensor& a, const at::Tensor& b) {
+  const at::Tensor dense_a = a.contiguous();
+  const at::Tensor dense_b = b.contiguous();
+  const bool* x = dense_a.data_ptr<bool>();
+  const bool* y = dense_b.data_ptr<bool>();
+  for (int64_t i = 0, n = dense_a.numel(); i < n; ++i) {
+    if (x[i] && y[i]) return true;
+  }
+  return false;
 }
 
 }  // namespace
@@ -49,8 +78,9 @@ absl::Status ValidateSegment(const Segment& segment, const EnvSpec& spec,
   const int64_t obs = spec.observation_size;
   const int64_t act = spec.discrete ? 1 : spec.action_size;
   const int64_t truncations =
-      segment.truncated.defined() && segment.truncated.numel() == steps
-          ? segment.truncated.sum().item<int64_t>()
+      segment.truncated.defined() && segment.truncated.numel() == steps &&
+              segment.truncated.scalar_type() == at::kBool
+          ? CountSet(segment.truncated)
           : -1;
   for (absl::Status status : {
            Expect(segment.rewards, "rewards", {steps}, at::kFloat),
@@ -80,7 +110,7 @@ absl::Status ValidateSegment(const Segment& segment, const EnvSpec& spec,
           spec.action_size, ")"));
     }
   }
-  if ((segment.terminated & segment.truncated).any().item<bool>()) {
+  if (AnyBoth(segment.terminated, segment.truncated)) {
     return absl::InvalidArgumentError(
         "segment marks a step both terminated and truncated");
   }

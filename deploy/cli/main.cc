@@ -19,6 +19,7 @@
 #include "bench/advantage_bench.h"
 #include "bench/env_bench.h"
 #include "bench/learner_bench.h"
+#include "bench/transport_bench.h"
 #include "deploy/cli/actor_command.h"
 #include "deploy/cli/advantages_command.h"
 #include "deploy/cli/env_commands.h"
@@ -121,6 +122,10 @@ ABSL_FLAG(uint64_t, seed, 0, "rollout, train: random seed");
 ABSL_FLAG(int64_t, bench_steps, 2048, "bench advantages: rollout length T");
 ABSL_FLAG(int64_t, bench_streams, 16,
           "bench advantages: number of env streams");
+ABSL_FLAG(int32_t, bench_clients, 4,
+          "bench ingest: loopback clients streaming segments");
+ABSL_FLAG(double, bench_seconds, 5.0,
+          "bench ingest, bench actor: length of each timed window");
 
 namespace vantage {
 namespace {
@@ -346,6 +351,18 @@ int RunBench(const std::vector<std::string>& args) {
          return RunAdvantageBenchmark(steps, streams);
        }},
       {"env", [] { return RunEnvBenchmark(absl::GetFlag(FLAGS_env)); }},
+      {"ingest",
+       [] {
+         const int clients = absl::GetFlag(FLAGS_bench_clients);
+         const double seconds = absl::GetFlag(FLAGS_bench_seconds);
+         if (clients < 1 || !(seconds > 0)) {
+           std::fprintf(stderr,
+                        "vantage bench ingest: --bench_clients must be >= 1 "
+                        "and --bench_seconds > 0\n");
+           return kUsageExitCode;
+         }
+         return RunIngestBenchmark(clients, seconds);
+       }},
       {"learner", [] { return RunLearnerBenchmark(); }},
   };
   std::vector<std::string> names;
@@ -410,7 +427,8 @@ int main(int argc, char** argv) {
       "                                 the trained policy's episodes\n"
       "  bench advantages               path ensemble vs GAE benchmark\n"
       "  bench env --env=NAME           env layer vs raw physics benchmark\n"
-      "  bench learner                  PPO update vs a bare LibTorch loop\n");
+      "  bench learner                  PPO update vs a bare LibTorch loop\n"
+      "  bench ingest                   learner ingest capacity in actors\n");
   vantage::RecordGivenFlags(argc, argv);
   const std::vector<char*> positional = absl::ParseCommandLine(argc, argv);
   if (positional.size() < 2) {

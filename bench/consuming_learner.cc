@@ -1,0 +1,60 @@
+#include "bench/consuming_learner.h"
+
+#include <chrono>
+#include <utility>
+
+namespace vantage {
+namespace {
+
+GatewayConfig MakeGatewayConfig(const pb::RunConfig& run_config) {
+  GatewayConfig config;
+  config.run_config = run_config;
+  config.run_config.set_sync(false);
+  config.max_segment_steps = run_config.segment_length();
+  config.max_policy_lag = -1;
+  return config;
+}
+
+}  // namespace
+
+ConsumingLearner::ConsumingLearner(const pb::RunConfig& run_config)
+    : queue_(64),
+      gateway_(MakeGatewayConfig(run_config), queue_),
+      service_(gateway_),
+      stitcher_(run_config.horizon()) {}
+
+absl::StatusOr<std::unique_ptr<ConsumingLearner>> ConsumingLearner::Start(
+    const pb::RunConfig& run_config, const PolicyWeights& weights) {
+  std::unique_ptr<ConsumingLearner> learner(new ConsumingLearner(run_config));
+  learner->gateway_.Publish(weights);
+  absl::StatusOr<RunningServer> server =
+      StartServer(ServerOptions(), learner->service_);
+  if (!server.ok()) return server.status();
+  learner->server_ = *std::move(server);
+  learner->port_ = learner->server_.port;
+  learner->consumer_ = std::thread([raw = learner.get()] { raw->Consume(); });
+  return learner;
+}
+
+ConsumingLearner::~ConsumingLearner() {
+  gateway_.Close();
+  queue_.Close();
+  if (server_.server != nullptr) {
+    server_.server->Shutdown(std::chrono::system_clock::now() +
+                             std::chrono::seconds(1));
+  }
+  if (consumer_.joinable()) consumer_.join();
+}
+
+void ConsumingLearner::Consume() {
+  while (true) {
+    absl::StatusOr<Segment> segment = queue_.Receive();
+    if (!segment.ok()) return;
+    const int64_t steps = segment->steps();
+    if (stitcher_.Add(*std::move(segment)).ok()) consumed_steps_ += steps;
+    // Finished rollouts would go to an update; here they are dropped.
+    (void)stitcher_.TakeReady();
+  }
+}
+
+}  // namespace vantage

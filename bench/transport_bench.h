@@ -1,0 +1,21 @@
+#ifndef VANTAGE_BENCH_TRANSPORT_BENCH_H_
+#define VANTAGE_BENCH_TRANSPORT_BENCH_H_
+
+// Benchmarks of the actor-learner data path over loopback gRPC, each
+// against a baseline measured in the same run.
+
+namespace vantage {
+
+// `vantage bench ingest`: K clients stream HalfCheetah-sized segments (128
+// steps of one env slot, real data from an actor) as fast as they can into
+// a learner that only ingests (service, validation, queue, stitching); the
+// learner's env steps/s over the window, against one actor's own rate (an
+// actor core with 16 HalfCheetah envs and batched inference, no transport),
+// both over `seconds` split into windows, the fastest window kept.
+// Ends with `RESULT ingest clients=K steps_per_s=<x> actor_steps_per_s=<y>
+// actors_fed=<x/y>`. Returns the exit code.
+int RunIngestBenchmark(int clients, double seconds);
+
+}  // namespace vantage
+
+#endif  // VANTAGE_BENCH_TRANSPORT_BENCH_H_

@@ -1,0 +1,64 @@
+// The transport benchmarks run end to end and print their RESULT lines
+// (their figures are for the README, not for assertions here).
+
+#include <map>
+#include <string>
+
+#include "absl/strings/numbers.h"
+#include "absl/strings/str_split.h"
+#include "absl/strings/strip.h"
+#include "gmock/gmock.h"
+#include "gtest/gtest.h"
+#include "tests/deploy/cli/run_vantage.h"
+
+namespace vantage {
+namespace {
+
+using ::testing::HasSubstr;
+
+// key=value pairs of the line starting with `prefix`.
+std::map<std::string, std::string> ResultFields(const std::string& out,
+                                                const std::string& prefix) {
+  std::map<std::string, std::string> fields;
+  for (absl::string_view line : absl::StrSplit(out, '\n')) {
+    if (!absl::ConsumePrefix(&line, prefix)) continue;
+    for (absl::string_view pair : absl::StrSplit(line, ' ')) {
+      std::pair<std::string, std::string> kv = absl::StrSplit(pair, '=');
+      fields[kv.first] = kv.second;
+    }
+  }
+  return fields;
+}
+
+double Number(const std::map<std::string, std::string>& fields,
+              const std::string& key) {
+  double value = -1;
+  auto found = fields.find(key);
+  if (found == fields.end() || !absl::SimpleAtod(found->second, &value)) {
+    return -1;
+  }
+  return value;
+}
+
+TEST(BenchCommandsTest, IngestStreamsIntoALearnerAndCountsActorsFed) {
+  const Outcome outcome =
+      RunVantage("bench ingest --bench_clients=2 --bench_seconds=0.5");
+  ASSERT_EQ(outcome.exit_code, 0) << outcome.err;
+  const auto fields = ResultFields(outcome.out, "RESULT ingest ");
+  EXPECT_EQ(fields.at("clients"), "2");
+  const double ingested = Number(fields, "steps_per_s");
+  const double actor = Number(fields, "actor_steps_per_s");
+  EXPECT_GT(ingested, 0);
+  EXPECT_GT(actor, 0);
+  EXPECT_NEAR(Number(fields, "actors_fed"), ingested / actor,
+              0.06 + 0.001 * ingested / actor);
+}
+
+TEST(BenchCommandsTest, IngestRefusesBadFlags) {
+  const Outcome outcome = RunVantage("bench ingest --bench_clients=0");
+  EXPECT_EQ(outcome.exit_code, 2);
+  EXPECT_THAT(outcome.err, HasSubstr("--bench_clients must be >= 1"));
+}
+
+}  // namespace
+}  // namespace vantage
