@@ -8,6 +8,8 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_join.h"
 #include "absl/strings/strip.h"
+#include "actor/envs/bullet/biped_walk.h"
+#include "actor/envs/bullet/bullet_hopper.h"
 #include "actor/envs/mujoco/gym_tasks.h"
 #include "actor/envs/mujoco/humanoid_env.h"
 #include "actor/envs/mujoco/pendulum_envs.h"
@@ -22,6 +24,9 @@ using Factory = std::function<absl::StatusOr<std::unique_ptr<Environment>>()>;
 const std::map<std::string, Factory>& Factories() {
   static const auto* factories = new std::map<std::string, Factory>{
       {"Ant", MakeAnt},
+      {"BipedWalkFlat", MakeBipedWalkFlat},
+      {"BipedWalkIncline", MakeBipedWalkIncline},
+      {"BulletHopper", MakeBulletHopper},
       {"HalfCheetah", MakeHalfCheetah},
       {"Hopper", MakeHopper},
       {"Humanoid", MakeHumanoid},

@@ -57,7 +57,8 @@ TEST(EnvRegistryTest, SpecsMatchTheGymnasiumTasks) {
       {"Walker2d", {17, 6}},          {"Ant", {27, 8}},
       {"InvertedPendulum", {4, 1}},   {"InvertedDoublePendulum", {11, 1}},
       {"SparseHalfCheetah", {17, 6}}, {"Humanoid", {376, 17}},
-      {"PointMaze", {4, 2}}};
+      {"PointMaze", {4, 2}},          {"BulletHopper", {11, 3}},
+      {"BipedWalkFlat", {29, 11}},    {"BipedWalkIncline", {29, 11}}};
   for (const auto& [name, sizes] : expected) {
     const auto env = Make(name);
     ASSERT_NE(env, nullptr);
@@ -116,7 +117,8 @@ TEST(EnvRegistryTest, TimeLimitTruncatesWithTheFinalObservation) {
 
 TEST(EnvRegistryTest, FallingBodiesTerminate) {
   for (const char* name :
-       {"Hopper", "Walker2d", "InvertedPendulum", "InvertedDoublePendulum"}) {
+       {"Hopper", "Walker2d", "InvertedPendulum", "InvertedDoublePendulum",
+        "BulletHopper", "BipedWalkFlat", "BipedWalkIncline"}) {
     const auto env = Make(name);
     std::vector<double> observation(env->spec().observation_size);
     ASSERT_TRUE(env->Reset(1, absl::MakeSpan(observation)).ok());

@@ -1,0 +1,245 @@
+#include "actor/envs/bullet/bullet_env.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <utility>
+
+#include "absl/strings/str_cat.h"
+#include "common/util/state_bytes.h"
+
+namespace vantage {
+namespace {
+
+constexpr char kStateKind[] = "bullet_env";
+constexpr uint32_t kStateVersion = 1;
+
+bool BitEqual(absl::Span<const double> a, absl::Span<const double> b) {
+  return a.size() == b.size() &&
+         (a.empty() ||
+          std::memcmp(a.data(), b.data(), a.size() * sizeof(double)) == 0);
+}
+
+}  // namespace
+
+BulletEnv::BulletEnv(EnvSpec spec, PlanarModel model, std::vector<double> gears,
+                     int frame_skip)
+    : spec_(std::move(spec)),
+      model_(std::move(model)),
+      gears_(std::move(gears)),
+      frame_skip_(frame_skip) {
+  spec_.discrete = false;
+  spec_.action_size = static_cast<int64_t>(gears_.size());
+  spec_.action_low.assign(gears_.size(), -1.0);
+  spec_.action_high.assign(gears_.size(), 1.0);
+  spec_.control_dt = model_.timestep * frame_skip_;
+  clipped_.resize(gears_.size());
+  torques_.resize(gears_.size());
+}
+
+std::vector<double> BulletEnv::ZeroPose() const {
+  std::vector<double> q(model_.links.size() + 2, 0.0);
+  q[1] = model_.root_z;
+  return q;
+}
+
+void BulletEnv::Begin(uint64_t seed) {
+  world_ = std::make_unique<BulletWorld>(model_);
+  std::mt19937_64 rng(seed);
+  std::vector<double> q = ZeroPose();
+  std::vector<double> qd(q.size(), 0.0);
+  ResetState(rng, q, qd);
+  world_->SetState(q, qd);
+  BeginEpisode(*world_);
+  seed_ = seed;
+  log_.clear();
+  needs_reset_ = false;
+}
+
+absl::Status BulletEnv::Reset(uint64_t seed, absl::Span<double> observation) {
+  if (observation.size() != static_cast<size_t>(spec_.observation_size)) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        spec_.name, ": observation buffer holds ", observation.size(),
+        " values, expected ", spec_.observation_size));
+  }
+  Begin(seed);
+  Observe(*world_, observation.data());
+  return absl::OkStatus();
+}
+
+absl::Status BulletEnv::Advance(absl::Span<const double> clipped,
+                                StepResult* result) {
+  for (size_t j = 0; j < gears_.size(); ++j) {
+    torques_[j] = gears_[j] * clipped[j];
+  }
+  BeforeStep(*world_);
+  world_->Step(torques_, frame_skip_);
+  if (!world_->IsFinite()) {
+    return absl::InternalError(absl::StrCat(
+        spec_.name,
+        ": the simulation became unstable (non-finite positions "
+        "or velocities) after ",
+        log_.size() / gears_.size() + 1, " steps; reset the environment"));
+  }
+  *result = Evaluate(*world_, clipped);
+  return absl::OkStatus();
+}
+
+absl::StatusOr<StepResult> BulletEnv::Step(absl::Span<const double> action,
+                                           absl::Span<double> observation) {
+  if (needs_reset_) {
+    return absl::FailedPreconditionError(
+        absl::StrCat(spec_.name, ": Reset before stepping"));
+  }
+  if (absl::Status status = CheckAction(spec_, action); !status.ok()) {
+    return status;
+  }
+  if (observation.size() != static_cast<size_t>(spec_.observation_size)) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        spec_.name, ": observation buffer holds ", observation.size(),
+        " values, expected ", spec_.observation_size));
+  }
+  for (size_t j = 0; j < clipped_.size(); ++j) {
+    clipped_[j] =
+        std::clamp(action[j], spec_.action_low[j], spec_.action_high[j]);
+  }
+  StepResult result;
+  if (absl::Status status = Advance(clipped_, &result); !status.ok()) {
+    needs_reset_ = true;
+    return status;
+  }
+  log_.insert(log_.end(), clipped_.begin(), clipped_.end());
+  Observe(*world_, observation.data());
+  return result;
+}
+
+absl::Status BulletEnv::Replay(uint64_t seed, absl::Span<const double> log) {
+  Begin(seed);
+  const size_t width = gears_.size();
+  StepResult result;
+  for (size_t row = 0; row < log.size(); row += width) {
+    absl::Span<const double> clipped = log.subspan(row, width);
+    if (absl::Status status = Advance(clipped, &result); !status.ok()) {
+      needs_reset_ = true;
+      return status;
+    }
+    log_.insert(log_.end(), clipped.begin(), clipped.end());
+  }
+  return absl::OkStatus();
+}
+
+uint64_t BulletEnv::Signature() const {
+  StateWriter writer("bullet_env_signature", 1);
+  writer.PutI64(frame_skip_);
+  writer.PutDoubles(gears_);
+  writer.PutDoubles({model_.root_z, model_.density, model_.slope,
+                     model_.gravity, model_.timestep});
+  writer.PutI64(model_.solver_iterations);
+  for (const PlanarLink& link : model_.links) {
+    writer.PutBytes(link.name);
+    writer.PutI64(link.parent);
+    writer.PutDoubles({link.from_x, link.from_z, link.to_x, link.to_z,
+                       link.radius, link.friction, link.joint_x, link.joint_z,
+                       link.axis, link.lower, link.upper, link.damping,
+                       link.armature});
+  }
+  writer.PutBytes(TaskSignature());
+  return Fingerprint(std::move(writer).Finish());
+}
+
+absl::StatusOr<std::string> BulletEnv::SaveState() const {
+  StateWriter writer(kStateKind, kStateVersion);
+  writer.PutBytes(spec_.name);
+  writer.PutU64(Signature());
+  writer.PutBool(needs_reset_);
+  writer.PutU64(seed_);
+  writer.PutDoubles(log_);
+  std::vector<double> q, qd;
+  if (!needs_reset_) {
+    for (int i = 0; i < world_->num_dofs(); ++i) {
+      q.push_back(world_->q(i));
+      qd.push_back(world_->qd(i));
+    }
+  }
+  writer.PutDoubles(q);
+  writer.PutDoubles(qd);
+  return std::move(writer).Finish();
+}
+
+absl::Status BulletEnv::RestoreState(absl::string_view state) {
+  const std::string context = absl::StrCat(spec_.name, ": Bullet state");
+  StateReader reader(state, kStateKind, kStateVersion, context);
+  reader.ExpectEqual("the environment", reader.GetBytes("name"), spec_.name);
+  reader.Check(reader.GetU64("signature") == Signature(),
+               "the state was saved by a task with another model or rules");
+  const bool needs_reset = reader.GetBool("needs_reset");
+  const uint64_t seed = reader.GetU64("seed");
+  const absl::string_view log_bytes = reader.GetBytes("action log");
+  const absl::string_view q_bytes = reader.GetBytes("positions");
+  const absl::string_view qd_bytes = reader.GetBytes("velocities");
+  if (absl::Status status = reader.Finish(); !status.ok()) return status;
+  // The fields are runs of doubles; their lengths decide how many.
+  const auto doubles = [](absl::string_view bytes, std::vector<double>* out) {
+    if (bytes.size() % sizeof(double) != 0) return false;
+    out->resize(bytes.size() / sizeof(double));
+    if (!out->empty()) std::memcpy(out->data(), bytes.data(), bytes.size());
+    return true;
+  };
+  std::vector<double> log, q, qd;
+  const size_t width = gears_.size();
+  const size_t dofs = model_.links.size() + 2;
+  bool ok = doubles(log_bytes, &log) && doubles(q_bytes, &q) &&
+            doubles(qd_bytes, &qd) && log.size() % width == 0;
+  ok = ok && (needs_reset ? log.empty() && q.empty() && qd.empty()
+                          : q.size() == dofs && qd.size() == dofs);
+  if (!ok) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        context,
+        ": the action log, positions or velocities have impossible "
+        "sizes"));
+  }
+  for (size_t i = 0; i < log.size(); ++i) {
+    const size_t j = i % width;
+    if (!(log[i] >= spec_.action_low[j] && log[i] <= spec_.action_high[j])) {
+      return absl::InvalidArgumentError(
+          absl::StrCat(context, ": logged action ", i / width, " entry ", j,
+                       " (", log[i], ") is not a clipped action"));
+    }
+  }
+  if (needs_reset) {
+    world_.reset();
+    log_.clear();
+    needs_reset_ = true;
+    return absl::OkStatus();
+  }
+
+  // Replaying changes the environment; if the result is not the saved one,
+  // go back by replaying this environment's own state.
+  absl::StatusOr<std::string> before = SaveState();
+  if (!before.ok()) return before.status();
+  absl::Status status = Replay(seed, log);
+  if (status.ok()) {
+    std::vector<double> replayed_q, replayed_qd;
+    for (int i = 0; i < world_->num_dofs(); ++i) {
+      replayed_q.push_back(world_->q(i));
+      replayed_qd.push_back(world_->qd(i));
+    }
+    if (BitEqual(replayed_q, q) && BitEqual(replayed_qd, qd)) {
+      return absl::OkStatus();
+    }
+    status = absl::InvalidArgumentError(
+        absl::StrCat(context,
+                     ": replaying the logged actions does not reproduce the "
+                     "saved positions and velocities (a state from another "
+                     "Bullet build, or a corrupted one)"));
+  } else {
+    status = absl::InvalidArgumentError(absl::StrCat(
+        context, ": replaying the logged actions failed: ", status.message()));
+  }
+  if (absl::Status back = RestoreState(*before); !back.ok()) {
+    needs_reset_ = true;
+  }
+  return status;
+}
+
+}  // namespace vantage

@@ -1,0 +1,310 @@
+#include "actor/envs/bullet/bullet_world.h"
+
+#include <cmath>
+#include <utility>
+
+#include "absl/strings/str_cat.h"
+
+namespace vantage {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+// The slides carry no real body; Bullet wants a positive mass and inertia.
+constexpr double kSlideMass = 1e-3;
+constexpr double kSlideInertia = 1e-5;
+// Manifold points closer than this count as touching.
+constexpr double kTouchDistance = 2e-3;
+// Link colliders only meet the ground, never each other.
+constexpr int kBodyGroup = btBroadphaseProxy::DefaultFilter;
+constexpr int kGroundGroup = btBroadphaseProxy::StaticFilter;
+
+bool AlongX(const PlanarLink& link) { return link.from_z == link.to_z; }
+
+double SegmentLength(const PlanarLink& link) {
+  return std::hypot(link.to_x - link.from_x, link.to_z - link.from_z);
+}
+
+struct CapsuleInertia {
+  double mass;
+  double axial;          // about the segment
+  double perpendicular;  // about an axis through the centre across it
+};
+
+// A cylinder of length `length` capped by two hemispheres of `radius`.
+CapsuleInertia Capsule(double length, double radius, double density) {
+  const double r2 = radius * radius;
+  const double cylinder = density * kPi * r2 * length;
+  const double hemisphere = density * 2.0 / 3.0 * kPi * r2 * radius;
+  CapsuleInertia inertia;
+  inertia.mass = cylinder + 2.0 * hemisphere;
+  inertia.axial = cylinder * r2 / 2.0 + 2.0 * hemisphere * 2.0 * r2 / 5.0;
+  // Each hemisphere about its flat face's diameter is 2/5 m r^2; shifted to
+  // the capsule's centre, its own centre sits 3r/8 beyond the face.
+  inertia.perpendicular = cylinder * (length * length / 12.0 + r2 / 4.0) +
+                          2.0 * hemisphere *
+                              (2.0 * r2 / 5.0 + length * length / 4.0 +
+                               3.0 * length * radius / 8.0);
+  return inertia;
+}
+
+}  // namespace
+
+absl::Status ValidatePlanarModel(const PlanarModel& model) {
+  if (model.links.empty()) {
+    return absl::InvalidArgumentError("planar model: no links");
+  }
+  if (!(model.timestep > 0.0) || model.solver_iterations < 1 ||
+      !(model.density > 0.0) || !(std::abs(model.slope) < kPi / 4)) {
+    return absl::InvalidArgumentError(
+        "planar model: timestep and density must be > 0, solver_iterations "
+        ">= 1 and |slope| < 45 degrees");
+  }
+  for (size_t i = 0; i < model.links.size(); ++i) {
+    const PlanarLink& link = model.links[i];
+    const auto bad = [&](absl::string_view why) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("planar model: link ", i, " (", link.name, ") ", why));
+    };
+    if (i == 0 ? link.parent != -1
+               : link.parent < 0 || link.parent >= static_cast<int>(i)) {
+      return bad("needs the root's parent -1, else an earlier link");
+    }
+    if (link.from_x != link.to_x && link.from_z != link.to_z) {
+      return bad("is not parallel to x or z");
+    }
+    if (!(link.radius > 0.0) || !(link.friction >= 0.0)) {
+      return bad("needs radius > 0 and friction >= 0");
+    }
+    if (i == 0) continue;
+    if (link.axis != 1.0 && link.axis != -1.0) return bad("needs axis +-1");
+    if (!(link.lower < link.upper) || !(link.damping >= 0.0) ||
+        !(link.armature >= 0.0)) {
+      return bad("needs lower < upper, damping >= 0 and armature >= 0");
+    }
+    // The damping torque is explicit: it must not overshoot within one
+    // step, i.e. damping * dt well below the link's inertia about its hinge.
+    const CapsuleInertia capsule =
+        Capsule(SegmentLength(link), link.radius, model.density);
+    const double cx = (link.from_x + link.to_x) / 2.0 - link.joint_x;
+    const double cz = (link.from_z + link.to_z) / 2.0 - link.joint_z;
+    const double about_hinge = capsule.perpendicular + link.armature +
+                               capsule.mass * (cx * cx + cz * cz);
+    if (link.damping * model.timestep > 0.5 * about_hinge) {
+      return bad(absl::StrCat(
+          "damping ", link.damping, " is too high for an explicit step of ",
+          model.timestep, " s (inertia ", about_hinge, ")"));
+    }
+  }
+  return absl::OkStatus();
+}
+
+BulletWorld::BulletWorld(const PlanarModel& model)
+    : slope_tangent_(std::tan(model.slope)), timestep_(model.timestep) {
+  const int links = static_cast<int>(model.links.size());
+  num_dofs_ = 2 + links;
+  int rotors = 0;
+  for (int i = 1; i < links; ++i) {
+    rotors_.push_back(
+        model.links[i].armature > 0.0 ? LinkIndex(links) + rotors++ : -1);
+  }
+
+  // Small pools: the defaults (4096 entries) cost a few megabytes per world,
+  // and a world is built for every episode. Pools overflow to the heap.
+  btDefaultCollisionConstructionInfo construction;
+  construction.m_defaultMaxPersistentManifoldPoolSize = 64;
+  construction.m_defaultMaxCollisionAlgorithmPoolSize = 64;
+  collision_config_ =
+      std::make_unique<btDefaultCollisionConfiguration>(construction);
+  dispatcher_ =
+      std::make_unique<btCollisionDispatcher>(collision_config_.get());
+  broadphase_ = std::make_unique<btDbvtBroadphase>();
+  solver_ = std::make_unique<btMultiBodyConstraintSolver>();
+  world_ = std::make_unique<btMultiBodyDynamicsWorld>(
+      dispatcher_.get(), broadphase_.get(), solver_.get(),
+      collision_config_.get());
+  world_->setGravity(btVector3(0, 0, -model.gravity));
+  world_->getSolverInfo().m_numIterations = model.solver_iterations;
+
+  const btVector3 normal(-std::sin(model.slope), 0, std::cos(model.slope));
+  ground_shape_ = std::make_unique<btStaticPlaneShape>(normal, 0);
+  btRigidBody::btRigidBodyConstructionInfo ground_info(0, nullptr,
+                                                       ground_shape_.get());
+  ground_info.m_friction = 1.0;
+  ground_info.m_restitution = 0.0;
+  ground_ = std::make_unique<btRigidBody>(ground_info);
+  world_->addRigidBody(ground_.get(), kGroundGroup, kBodyGroup);
+
+  body_ = std::make_unique<btMultiBody>(LinkIndex(links) + rotors, 0.0,
+                                        btVector3(0, 0, 0),
+                                        /*fixedBase=*/true,
+                                        /*canSleep=*/false);
+  const btQuaternion identity = btQuaternion::getIdentity();
+  const btVector3 zero(0, 0, 0);
+  const btVector3 slide_inertia(kSlideInertia, kSlideInertia, kSlideInertia);
+  body_->setupPrismatic(0, kSlideMass, slide_inertia, -1, identity,
+                        btVector3(1, 0, 0), zero, zero, true);
+  body_->setupPrismatic(1, kSlideMass, slide_inertia, 0, identity,
+                        btVector3(0, 0, 1), zero, zero, true);
+  std::vector<btVector3> centres;
+  chains_.resize(links);
+  for (int i = 0; i < links; ++i) {
+    const PlanarLink& link = model.links[i];
+    const double length = SegmentLength(link);
+    const CapsuleInertia capsule = Capsule(length, link.radius, model.density);
+    const btVector3 centre((link.from_x + link.to_x) / 2.0, 0,
+                           (link.from_z + link.to_z) / 2.0);
+    centres.push_back(centre);
+    btVector3 inertia = AlongX(link)
+                            ? btVector3(capsule.axial, capsule.perpendicular,
+                                        capsule.perpendicular)
+                            : btVector3(capsule.perpendicular,
+                                        capsule.perpendicular, capsule.axial);
+    if (i == 0) {
+      body_->setupRevolute(LinkIndex(0), capsule.mass, inertia, 1, identity,
+                           btVector3(0, 1, 0), zero,
+                           centre - btVector3(0, 0, model.root_z), true);
+    } else {
+      const btVector3 joint(link.joint_x, 0, link.joint_z);
+      body_->setupRevolute(LinkIndex(i), capsule.mass, inertia,
+                           LinkIndex(link.parent), identity,
+                           btVector3(0, link.axis, 0),
+                           joint - centres[link.parent], centre - joint, true);
+      damping_.push_back(link.damping);
+      axes_.push_back(link.axis);
+      chains_[i] = chains_[link.parent];
+      chains_[i].push_back(i - 1);
+      if (rotors_[i - 1] >= 0) {
+        // Spinning about its centre on the fixed base: only the gear
+        // constraint moves it, and the base takes its reaction.
+        body_->setupRevolute(
+            rotors_[i - 1], kSlideMass,
+            btVector3(link.armature, link.armature, link.armature), -1,
+            identity, btVector3(0, link.axis, 0), zero, zero, true);
+      }
+    }
+    if (AlongX(link)) {
+      shapes_.push_back(std::make_unique<btCapsuleShapeX>(link.radius, length));
+    } else {
+      shapes_.push_back(std::make_unique<btCapsuleShapeZ>(link.radius, length));
+    }
+  }
+  body_->finalizeMultiDof();
+  // MuJoCo's bodies have no drag; Bullet's default damps every link.
+  body_->setLinearDamping(0.0);
+  body_->setAngularDamping(0.0);
+  body_->setHasSelfCollision(false);
+  world_->addMultiBody(body_.get());
+
+  for (int i = 0; i < links; ++i) {
+    auto collider =
+        std::make_unique<btMultiBodyLinkCollider>(body_.get(), LinkIndex(i));
+    collider->setCollisionShape(shapes_[i].get());
+    collider->setFriction(model.links[i].friction);
+    collider->setRestitution(0.0);
+    world_->addCollisionObject(collider.get(), kBodyGroup, kGroundGroup);
+    body_->getLink(LinkIndex(i)).m_collider = collider.get();
+    colliders_.push_back(std::move(collider));
+  }
+  for (int i = 1; i < links; ++i) {
+    const PlanarLink& link = model.links[i];
+    limits_.push_back(std::make_unique<btMultiBodyJointLimitConstraint>(
+        body_.get(), LinkIndex(i), link.lower, link.upper));
+    world_->addMultiBodyConstraint(limits_.back().get());
+  }
+  const btMatrix3x3 frame = btMatrix3x3::getIdentity();
+  for (int j = 0; j < links - 1; ++j) {
+    if (rotors_[j] < 0) continue;
+    // Rows: qdot(hinge) + ratio * qdot(rotor) = 0.
+    gears_.push_back(std::make_unique<btMultiBodyGearConstraint>(
+        body_.get(), LinkIndex(j + 1), body_.get(), rotors_[j], zero, zero,
+        frame, frame));
+    gears_.back()->setGearRatio(-1.0);
+    world_->addMultiBodyConstraint(gears_.back().get());
+  }
+
+  std::vector<double> q(num_dofs_, 0.0);
+  const std::vector<double> qd(num_dofs_, 0.0);
+  q[1] = model.root_z;
+  SetState(q, qd);
+}
+
+BulletWorld::~BulletWorld() {
+  for (auto& gear : gears_) world_->removeMultiBodyConstraint(gear.get());
+  for (auto& limit : limits_) world_->removeMultiBodyConstraint(limit.get());
+  for (auto& collider : colliders_) {
+    world_->removeCollisionObject(collider.get());
+  }
+  world_->removeMultiBody(body_.get());
+  world_->removeRigidBody(ground_.get());
+  world_.reset();
+}
+
+double BulletWorld::q(int i) const { return body_->getJointPos(DofLink(i)); }
+
+double BulletWorld::qd(int i) const { return body_->getJointVel(DofLink(i)); }
+
+void BulletWorld::SetState(absl::Span<const double> q,
+                           absl::Span<const double> qd) {
+  for (int i = 0; i < num_dofs_; ++i) {
+    body_->setJointPos(DofLink(i), q[i]);
+    body_->setJointVel(DofLink(i), qd[i]);
+  }
+  for (size_t j = 0; j < rotors_.size(); ++j) {
+    if (rotors_[j] >= 0) body_->setJointVel(rotors_[j], qd[3 + j]);
+  }
+  btAlignedObjectArray<btQuaternion> world_to_local;
+  btAlignedObjectArray<btVector3> local_origin;
+  body_->forwardKinematics(world_to_local, local_origin);
+  body_->updateCollisionObjectWorldTransforms(world_to_local, local_origin);
+}
+
+void BulletWorld::Step(absl::Span<const double> torques, int substeps) {
+  const int hinges = num_dofs_ - 3;
+  for (int s = 0; s < substeps; ++s) {
+    body_->clearForcesAndTorques();
+    for (int j = 0; j < hinges; ++j) {
+      const int link = DofLink(3 + j);
+      body_->addJointTorque(
+          link, torques[j] - damping_[j] * body_->getJointVel(link));
+    }
+    // maxSubSteps 0: exactly one step of timestep_, no interpolation.
+    world_->stepSimulation(timestep_, 0, timestep_);
+  }
+}
+
+double BulletWorld::LinkPitch(int link) const {
+  double pitch = q(2);
+  for (int hinge : chains_[link]) pitch += axes_[hinge] * q(3 + hinge);
+  return pitch;
+}
+
+bool BulletWorld::TouchesGround(int link) const {
+  const btCollisionObject* collider = colliders_[link].get();
+  const int manifolds = dispatcher_->getNumManifolds();
+  for (int m = 0; m < manifolds; ++m) {
+    const btPersistentManifold* manifold =
+        dispatcher_->getInternalManifoldPointer()[m];
+    if (manifold->getBody0() != collider && manifold->getBody1() != collider) {
+      continue;
+    }
+    for (int c = 0; c < manifold->getNumContacts(); ++c) {
+      if (manifold->getContactPoint(c).getDistance() < kTouchDistance) {
+        return true;
+      }
+    }
+  }
+  return false;
+}
+
+bool BulletWorld::IsFinite() const {
+  for (int i = 0; i < num_dofs_; ++i) {
+    if (!std::isfinite(q(i)) || !std::isfinite(qd(i))) return false;
+  }
+  return true;
+}
+
+double BulletWorld::LinkMass(int link) const {
+  return body_->getLinkMass(LinkIndex(link));
+}
+
+}  // namespace vantage
