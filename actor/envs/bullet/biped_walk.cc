@@ -40,14 +40,13 @@ struct HingeSpec {
 };
 
 // Gears sized for a 36 kg body: legs strong enough to stand on one, the
-// toes and arms light.
+// toes and arms light. No armature: its rotors would cost 3x the step time.
 constexpr HingeSpec kWaist = {60.0, -0.5, 1.0, 1.0};
 constexpr HingeSpec kHip = {100.0, -0.6, 2.0, 1.0};
 constexpr HingeSpec kKnee = {100.0, -0.05, 2.5, 1.0};
 constexpr HingeSpec kAnkle = {50.0, -0.8, 0.8, 0.5};
 constexpr HingeSpec kToe = {15.0, -0.4, 1.0, 0.05};
 constexpr HingeSpec kShoulder = {30.0, -1.0, 2.5, 0.2};
-constexpr double kArmature = 0.01;
 
 PlanarLink Capsule(const char* name, double from_x, double from_z, double to_x,
                    double to_z, double radius) {
@@ -70,7 +69,6 @@ PlanarLink Hinged(PlanarLink link, int parent, double joint_x, double joint_z,
   link.lower = hinge.lower;
   link.upper = hinge.upper;
   link.damping = hinge.damping;
-  link.armature = kArmature;
   return link;
 }
 
