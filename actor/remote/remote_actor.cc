@@ -149,19 +149,33 @@ class Session {
     std::unique_ptr<grpc::ClientWriter<pb::Segment>> writer =
         stub_->StreamSegments(&stream_context, &ack);
     StreamSink sink(*writer, metrics_);
-    const int64_t rounds_per_version =
-        run.sync() ? run.horizon() / run.segment_length() : 0;
+    // Pacing: horizon h (counted from this registration) may start once
+    // the learner has published h - ahead versions since then. A sync run
+    // (ahead 0) acts one horizon per version, exactly on-policy; an async
+    // actor acts up to two horizons ahead (no more than the allowed policy
+    // lag), during the learner's updates, which is how acting hides behind
+    // learning (one horizon ahead leaves the learner waiting whenever an
+    // actor is slowed down), and never so far ahead that its segments
+    // would grow stale or memory would grow.
+    const int64_t rounds_per_horizon =
+        std::max<int64_t>(1, run.horizon() / run.segment_length());
+    const int64_t ahead =
+        run.sync() ? 0 : std::min<int64_t>(2, run.max_policy_lag());
+    const int64_t first_version = actor->policy_version();
     int64_t rounds = 0;
     absl::Status status;
     while (!stop && status.ok()) {
-      if (run.sync() && rounds == rounds_per_version) {
-        // One horizon per version: wait for the next one.
-        while (!stop && !slot.ended() &&
-               (slot.Get() == nullptr ||
-                slot.Get()->version() <= actor->policy_version())) {
+      if (rounds % rounds_per_horizon == 0) {
+        const int64_t needed =
+            first_version + rounds / rounds_per_horizon - ahead;
+        auto known = [&] {
+          std::shared_ptr<const pb::Weights> newest = slot.Get();
+          return std::max(actor->policy_version(),
+                          newest == nullptr ? -1 : newest->version());
+        };
+        while (!stop && !slot.ended() && known() < needed) {
           std::this_thread::sleep_for(std::chrono::milliseconds(2));
         }
-        rounds = 0;
         if (stop) break;
       }
       if (std::shared_ptr<const pb::Weights> newest = slot.Get();
