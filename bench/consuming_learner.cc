@@ -11,22 +11,28 @@ GatewayConfig MakeGatewayConfig(const pb::RunConfig& run_config) {
   config.run_config = run_config;
   config.run_config.set_sync(false);
   config.max_segment_steps = run_config.segment_length();
-  config.max_policy_lag = -1;
+  config.max_policy_lag = -1;  // nothing is too stale to be ingested
   return config;
 }
 
 }  // namespace
 
-ConsumingLearner::ConsumingLearner(const pb::RunConfig& run_config)
+ConsumingLearner::ConsumingLearner(const pb::RunConfig& run_config,
+                                   PolicyWeights weights,
+                                   int64_t steps_per_version)
     : queue_(64),
       gateway_(MakeGatewayConfig(run_config), queue_),
       service_(gateway_),
-      stitcher_(run_config.horizon()) {}
+      stitcher_(run_config.horizon()),
+      weights_(std::move(weights)),
+      steps_per_version_(steps_per_version) {}
 
 absl::StatusOr<std::unique_ptr<ConsumingLearner>> ConsumingLearner::Start(
-    const pb::RunConfig& run_config, const PolicyWeights& weights) {
-  std::unique_ptr<ConsumingLearner> learner(new ConsumingLearner(run_config));
-  learner->gateway_.Publish(weights);
+    const pb::RunConfig& run_config, const PolicyWeights& weights,
+    int64_t steps_per_version) {
+  std::unique_ptr<ConsumingLearner> learner(
+      new ConsumingLearner(run_config, weights, steps_per_version));
+  learner->gateway_.Publish(learner->weights_);
   absl::StatusOr<RunningServer> server =
       StartServer(ServerOptions(), learner->service_);
   if (!server.ok()) return server.status();
@@ -51,9 +57,15 @@ void ConsumingLearner::Consume() {
     absl::StatusOr<Segment> segment = queue_.Receive();
     if (!segment.ok()) return;
     const int64_t steps = segment->steps();
-    if (stitcher_.Add(*std::move(segment)).ok()) consumed_steps_ += steps;
+    if (!stitcher_.Add(*std::move(segment)).ok()) continue;
+    const int64_t before = consumed_steps_.fetch_add(steps);
     // Finished rollouts would go to an update; here they are dropped.
     (void)stitcher_.TakeReady();
+    if (steps_per_version_ > 0 &&
+        (before + steps) / steps_per_version_ > before / steps_per_version_) {
+      ++weights_.version;
+      gateway_.Publish(weights_);
+    }
   }
 }
 

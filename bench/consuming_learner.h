@@ -21,9 +21,12 @@ class ConsumingLearner {
  public:
   // Serves on 127.0.0.1 (a free port) an asynchronous run of `run_config`
   // (its horizon and segment length) whose version 0 is `weights`; the
-  // first registration fixes the spec.
+  // first registration fixes the spec. Every `steps_per_version` steps
+  // stitched (0: never) it publishes the same weights as the next version,
+  // as a learner's updates would, so paced actors go on acting.
   static absl::StatusOr<std::unique_ptr<ConsumingLearner>> Start(
-      const pb::RunConfig& run_config, const PolicyWeights& weights);
+      const pb::RunConfig& run_config, const PolicyWeights& weights,
+      int64_t steps_per_version);
   ~ConsumingLearner();
 
   int port() const { return port_; }
@@ -32,13 +35,16 @@ class ConsumingLearner {
   GatewayCounters counters() const { return gateway_.counters(); }
 
  private:
-  ConsumingLearner(const pb::RunConfig& run_config);
+  ConsumingLearner(const pb::RunConfig& run_config, PolicyWeights weights,
+                   int64_t steps_per_version);
   void Consume();
 
   SegmentQueue queue_;
   ActorGateway gateway_;
   LearnerService service_;
   RolloutStitcher stitcher_;
+  PolicyWeights weights_;
+  const int64_t steps_per_version_;
   RunningServer server_;
   int port_ = 0;
   std::atomic<int64_t> consumed_steps_{0};

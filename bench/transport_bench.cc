@@ -1,6 +1,7 @@
 #include "bench/transport_bench.h"
 
 #include <ATen/Parallel.h>
+#include <benchmark/benchmark.h>
 #include <grpcpp/grpcpp.h>
 
 #include <algorithm>
@@ -13,7 +14,10 @@
 #include "absl/strings/str_cat.h"
 #include "actor/actor_core.h"
 #include "actor/envs/env_registry.h"
+#include "actor/remote/remote_actor.h"
 #include "bench/consuming_learner.h"
+#include "bench/fastest.h"
+#include "bench/raw_physics.h"
 #include "common/nn/networks.h"
 #include "proto/vantage.grpc.pb.h"
 #include "proto/wire_format.h"
@@ -45,6 +49,8 @@ pb::RunConfig BenchRunConfig(const std::string& env) {
   run.set_env(env);
   run.set_horizon(2048);
   run.set_segment_length(kSegmentLength);
+  run.set_sync(false);
+  run.set_max_policy_lag(4);
   run.add_hidden(64);
   run.add_hidden(64);
   return run;
@@ -176,7 +182,8 @@ int RunIngestBenchmark(int clients, double seconds) {
   }
 
   absl::StatusOr<std::unique_ptr<ConsumingLearner>> learner =
-      ConsumingLearner::Start(BenchRunConfig(kEnv), weights);
+      ConsumingLearner::Start(BenchRunConfig(kEnv), weights,
+                              /*steps_per_version=*/0);
   if (!learner.ok()) return Fail("ingest", learner.status());
   std::atomic<bool> stop{false};
   std::vector<absl::Status> results(clients);
@@ -214,6 +221,68 @@ int RunIngestBenchmark(int clients, double seconds) {
       "actors_fed=%.1f\n",
       clients, ingested, actor->steps_per_second,
       ingested / actor->steps_per_second);
+  return 0;
+}
+
+int RunActorBenchmark(const std::string& env_name, int envs, double seconds) {
+  at::set_num_threads(1);
+  absl::StatusOr<std::unique_ptr<Environment>> probe =
+      MakeEnvironment(env_name);
+  if (!probe.ok()) return Fail("actor", probe.status());
+  std::unique_ptr<RawPhysics> physics = MakeRawPhysics(**probe);
+  if (physics == nullptr) {
+    return Fail("actor", absl::InvalidArgumentError(
+                             absl::StrCat(env_name,
+                                          " has no MuJoCo or Bullet model to "
+                                          "compare with")));
+  }
+  absl::StatusOr<int64_t> episode_length = FixedActionEpisodeLength(**probe);
+  if (!episode_length.ok()) return Fail("actor", episode_length.status());
+  RegisterRawBenchmark("raw", *physics, *episode_length);
+  FastestCollector collector;
+  benchmark::RunSpecifiedBenchmarks(&collector);
+  const double raw = 1.0 / collector.Seconds("raw");
+
+  // The `vantage actor` loop itself, paced by a learner that publishes a
+  // version per batch of its data and otherwise only ingests.
+  const EnvSpec spec = (*probe)->spec();
+  const pb::RunConfig run = BenchRunConfig(env_name);
+  absl::StatusOr<std::unique_ptr<ConsumingLearner>> learner =
+      ConsumingLearner::Start(run, FreshWeights(spec),
+                              /*steps_per_version=*/run.horizon() * envs);
+  if (!learner.ok()) return Fail("actor", learner.status());
+  RemoteActorConfig config;
+  config.learner = absl::StrCat("127.0.0.1:", (*learner)->port());
+  config.env = env_name;
+  config.num_envs = envs;
+  config.max_reconnects = 0;
+  std::atomic<bool> stop{false};
+  absl::Status acted;
+  std::thread actor([&] { acted = RunRemoteActor(config, stop); });
+  // Registration and the first segments, then the windows.
+  std::this_thread::sleep_for(std::chrono::seconds(1));
+  double streamed = 0.0;
+  for (int window = 0; window < kWindows; ++window) {
+    const int64_t before = (*learner)->consumed_steps();
+    const double start = Now();
+    std::this_thread::sleep_for(
+        std::chrono::duration<double>(seconds / kWindows));
+    streamed = std::max(
+        streamed, ((*learner)->consumed_steps() - before) / (Now() - start));
+  }
+  stop = true;
+  actor.join();
+  learner->reset();
+  if (!acted.ok()) return Fail("actor", acted);
+  std::printf(
+      "actor: `vantage actor` with %d %s envs (batched inference, one "
+      "thread) streaming %ld-step segments over loopback gRPC into a "
+      "learner that only ingests, against bare physics stepping\n",
+      envs, env_name.c_str(), static_cast<long>(kSegmentLength));
+  std::printf(
+      "RESULT actor env=%s envs=%d raw_steps_per_s=%.0f "
+      "actor_steps_per_s=%.0f ratio=%.3f\n",
+      env_name.c_str(), envs, raw, streamed, streamed / raw);
   return 0;
 }
 

@@ -4,6 +4,8 @@
 // Benchmarks of the actor-learner data path over loopback gRPC, each
 // against a baseline measured in the same run.
 
+#include <string>
+
 namespace vantage {
 
 // `vantage bench ingest`: K clients stream HalfCheetah-sized segments (128
@@ -15,6 +17,16 @@ namespace vantage {
 // Ends with `RESULT ingest clients=K steps_per_s=<x> actor_steps_per_s=<y>
 // actors_fed=<x/y>`. Returns the exit code.
 int RunIngestBenchmark(int clients, double seconds);
+
+// `vantage bench actor --env=NAME --envs=M`: the env steps/s of the
+// `vantage actor` loop (M envs, batched inference on one thread, segments
+// of 128 steps streamed over loopback gRPC to a learner that only ingests
+// and publishes a version per horizon of its data), over `seconds` split
+// into windows, the fastest kept, against the bare physics of the env's
+// model on one core (`bench env`'s raw figure, measured in the same run).
+// Ends with `RESULT actor env=NAME envs=M raw_steps_per_s=<x>
+// actor_steps_per_s=<y> ratio=<y/x>`. Returns the exit code.
+int RunActorBenchmark(const std::string& env_name, int envs, double seconds);
 
 }  // namespace vantage
 

@@ -350,6 +350,21 @@ int RunBench(const std::vector<std::string>& args) {
          }
          return RunAdvantageBenchmark(steps, streams);
        }},
+      {"actor",
+       [] {
+         // The setting unless told otherwise.
+         const std::string env =
+             Given("env") ? absl::GetFlag(FLAGS_env) : "HalfCheetah";
+         const int envs = Given("envs") ? absl::GetFlag(FLAGS_envs) : 16;
+         const double seconds = absl::GetFlag(FLAGS_bench_seconds);
+         if (envs < 1 || !(seconds > 0)) {
+           std::fprintf(stderr,
+                        "vantage bench actor: --envs must be >= 1 and "
+                        "--bench_seconds > 0\n");
+           return kUsageExitCode;
+         }
+         return RunActorBenchmark(env, envs, seconds);
+       }},
       {"env", [] { return RunEnvBenchmark(absl::GetFlag(FLAGS_env)); }},
       {"ingest",
        [] {
@@ -428,7 +443,8 @@ int main(int argc, char** argv) {
       "  bench advantages               path ensemble vs GAE benchmark\n"
       "  bench env --env=NAME           env layer vs raw physics benchmark\n"
       "  bench learner                  PPO update vs a bare LibTorch loop\n"
-      "  bench ingest                   learner ingest capacity in actors\n");
+      "  bench ingest                   learner ingest capacity in actors\n"
+      "  bench actor --env=N --envs=M   streaming actor vs raw physics\n");
   vantage::RecordGivenFlags(argc, argv);
   const std::vector<char*> positional = absl::ParseCommandLine(argc, argv);
   if (positional.size() < 2) {

@@ -54,10 +54,28 @@ TEST(BenchCommandsTest, IngestStreamsIntoALearnerAndCountsActorsFed) {
               0.06 + 0.001 * ingested / actor);
 }
 
-TEST(BenchCommandsTest, IngestRefusesBadFlags) {
+TEST(BenchCommandsTest, ActorStreamsIntoALearnerAgainstRawPhysics) {
+  const Outcome outcome =
+      RunVantage("bench actor --env=Hopper --envs=2 --bench_seconds=0.5");
+  ASSERT_EQ(outcome.exit_code, 0) << outcome.err;
+  const auto fields = ResultFields(outcome.out, "RESULT actor ");
+  EXPECT_EQ(fields.at("env"), "Hopper");
+  EXPECT_EQ(fields.at("envs"), "2");
+  const double raw = Number(fields, "raw_steps_per_s");
+  const double actor = Number(fields, "actor_steps_per_s");
+  EXPECT_GT(raw, 0);
+  EXPECT_GT(actor, 0);
+  EXPECT_NEAR(Number(fields, "ratio"), actor / raw, 0.002);
+}
+
+TEST(BenchCommandsTest, BadFlagsAreClearErrors) {
   const Outcome outcome = RunVantage("bench ingest --bench_clients=0");
   EXPECT_EQ(outcome.exit_code, 2);
   EXPECT_THAT(outcome.err, HasSubstr("--bench_clients must be >= 1"));
+  EXPECT_THAT(RunVantage("bench actor --envs=0").err,
+              HasSubstr("--envs must be >= 1"));
+  EXPECT_THAT(RunVantage("bench actor --env=Nope").err,
+              HasSubstr("unknown environment 'Nope'"));
 }
 
 }  // namespace

@@ -1,0 +1,46 @@
+#ifndef VANTAGE_BENCH_RAW_PHYSICS_H_
+#define VANTAGE_BENCH_RAW_PHYSICS_H_
+
+// The baseline of the environment and actor benchmarks: the bare physics
+// engine under an environment, with nothing of the task around it.
+
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include "absl/status/statusor.h"
+#include "common/env/environment.h"
+
+namespace vantage {
+
+// A fixed, in-bounds action for every actuator: the same work each step.
+inline constexpr double kBenchAction = 0.2;
+
+class RawPhysics {
+ public:
+  virtual ~RawPhysics() = default;
+  virtual int frame_skip() const = 0;
+  // Back to the model's initial state.
+  virtual void Restart() = 0;
+  // One environment step's worth of physics.
+  virtual void Step() = 0;
+};
+
+// The bare physics of `env`'s model (inside its time limit): MuJoCo's
+// mj_step or the env's Bullet world, kBenchAction on every actuator, frame
+// skip included. nullptr if the environment has no engine this knows.
+std::unique_ptr<RawPhysics> MakeRawPhysics(const Environment& env);
+
+// How many steps `env`'s episodes last under kBenchAction (a baseline
+// restarts its physics as often, so both sides simulate the same kind of
+// states: a fallen body in permanent contact steps at another speed).
+absl::StatusOr<int64_t> FixedActionEpisodeLength(Environment& env);
+
+// Registers Google benchmark `name`: one bare physics step per iteration,
+// restarted every `episode_length` steps. `physics` must outlive the run.
+void RegisterRawBenchmark(const std::string& name, RawPhysics& physics,
+                          int64_t episode_length);
+
+}  // namespace vantage
+
+#endif  // VANTAGE_BENCH_RAW_PHYSICS_H_
