@@ -123,6 +123,14 @@ absl::Status RunLearnerServer(
                  static_cast<long>(learner->env_steps()));
   }
 
+  // A new run's directory before serving: a taken one fails fast.
+  if (!training.resume && !training.run_dir.empty()) {
+    absl::StatusOr<RunDirectory> made =
+        RunDirectory::Create(training.run_dir, training.config_json);
+    if (!made.ok()) return made.status();
+    run = *std::move(made);
+  }
+
   // Room for two whole batches: asynchronous actors keep acting for the
   // next batch while an update runs (which is how acting hides behind
   // learning), and actors that outpace the learner beyond that block on
@@ -199,12 +207,6 @@ absl::Status RunLearnerServer(
         LearnerCore::Create(learner_config_for(*spec));
     if (!created.ok()) return finish(created.status());
     learner = *std::move(created);
-    if (!training.run_dir.empty()) {
-      absl::StatusOr<RunDirectory> made =
-          RunDirectory::Create(training.run_dir, training.config_json);
-      if (!made.ok()) return finish(made.status());
-      run = *std::move(made);
-    }
   }
   RecorderConfig recorder_config;
   recorder_config.config_json = training.config_json;

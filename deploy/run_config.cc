@@ -21,11 +21,8 @@ absl::Status Invalid(absl::string_view flag, absl::string_view rule) {
 
 absl::StatusOr<pb::RunConfig> ResolveRunConfig(const pb::RunConfig& given) {
   pb::RunConfig c = given;
-  // Asking for actor processes means a distributed run.
-  if (!c.has_mode()) {
-    c.set_mode(c.has_actors() || c.has_envs_per_actor() ? "distributed"
-                                                        : "local");
-  }
+  // The main job is the distributed one; --mode=local keeps one process.
+  if (!c.has_mode()) c.set_mode("distributed");
   if (!c.has_env()) c.set_env("InvertedPendulum");
   if (!c.has_algo()) c.set_algo("ppo");
   if (!c.has_estimator()) c.set_estimator("maxabs");
@@ -35,9 +32,26 @@ absl::StatusOr<pb::RunConfig> ResolveRunConfig(const pb::RunConfig& given) {
   }
   if (!c.has_steps()) c.set_steps(150000);
   if (!c.has_seed()) c.set_seed(0);
+  if (c.has_envs() && (c.envs() < 1 || c.envs() > 4096)) {
+    return Invalid("envs", "must be in [1, 4096]");
+  }
   if (c.mode() == "distributed") {
-    if (!c.has_actors()) c.set_actors(2);
-    if (!c.has_envs_per_actor()) c.set_envs_per_actor(1);
+    // Two actor processes by default; a batch given as --envs alone is
+    // split over them (over one actor if it does not split evenly).
+    if (!c.has_actors()) {
+      const int64_t per_actor = c.has_envs_per_actor() ? c.envs_per_actor() : 0;
+      if (c.has_envs() && per_actor > 0) {
+        c.set_actors(static_cast<int32_t>(c.envs() / per_actor));
+      } else {
+        c.set_actors(c.has_envs() && c.envs() % 2 != 0 ? 1 : 2);
+      }
+    }
+    if (!c.has_envs_per_actor()) {
+      c.set_envs_per_actor(
+          c.has_envs()
+              ? static_cast<int32_t>(c.envs() / std::max(1, c.actors()))
+              : 1);
+    }
     if (c.actors() < 1 || c.actors() > 256) {
       return Invalid("actors", "must be in [1, 256]");
     }

@@ -55,19 +55,24 @@ std::string FormatProgressRow(const ProgressRow& row) {
       ",");
 }
 
+absl::Status RunDirectory::CheckFree(const std::string& path) {
+  if (std::filesystem::exists(RunDirectory(path).config_path())) {
+    return absl::AlreadyExistsError(absl::StrCat(
+        path, " already holds a run; continue it with --resume=", path,
+        " or choose another --run_dir"));
+  }
+  return absl::OkStatus();
+}
+
 absl::StatusOr<RunDirectory> RunDirectory::Create(
     const std::string& path, const std::string& config_json) {
+  if (absl::Status status = CheckFree(path); !status.ok()) return status;
   RunDirectory run(path);
   std::error_code error;
   std::filesystem::create_directories(run.checkpoint_directory(), error);
   if (error) {
     return absl::InvalidArgumentError(absl::StrCat(
         "cannot create run directory ", path, ": ", error.message()));
-  }
-  if (std::filesystem::exists(run.config_path())) {
-    return absl::AlreadyExistsError(absl::StrCat(
-        path, " already holds a run; continue it with --resume=", path,
-        " or choose another --run_dir"));
   }
   if (absl::Status status = WriteFileAtomically(
           run.progress_path(), absl::StrCat(kProgressColumns, "\n"));

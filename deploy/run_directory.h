@@ -39,6 +39,9 @@ class RunDirectory {
   // already holds a run is refused: continue it with --resume.
   static absl::StatusOr<RunDirectory> Create(const std::string& path,
                                              const std::string& config_json);
+  // AlreadyExists if `path` holds a run (what Create refuses); creates
+  // nothing.
+  static absl::Status CheckFree(const std::string& path);
   // An existing run, to resume.
   static absl::StatusOr<RunDirectory> Open(const std::string& path);
 

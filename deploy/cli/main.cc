@@ -33,9 +33,9 @@ ABSL_FLAG(bool, example, false,
 ABSL_FLAG(std::string, env, "",
           "rollout, bench env, train: environment name (see `vantage envs`) "
           "or mjcf:PATH; train defaults to InvertedPendulum");
-ABSL_FLAG(std::string, mode, "local",
-          "train: local (one process) | distributed (a learner and --actors "
-          "actor processes over gRPC; implied by --actors)");
+ABSL_FLAG(std::string, mode, "distributed",
+          "train: distributed (a learner and --actors actor processes over "
+          "gRPC on this machine) | local (one process)");
 ABSL_FLAG(int, actors, 2, "train --mode=distributed: actor processes");
 ABSL_FLAG(int, envs_per_actor, 1,
           "train --mode=distributed: environments per actor");

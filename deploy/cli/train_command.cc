@@ -10,11 +10,13 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_join.h"
+#include "actor/envs/env_registry.h"
 #include "deploy/cli/stop_signal.h"
 #include "deploy/launcher.h"
 #include "deploy/learner_server.h"
 #include "deploy/local_training.h"
 #include "deploy/run_config.h"
+#include "deploy/run_directory.h"
 
 namespace vantage {
 namespace {
@@ -118,6 +120,18 @@ void PrintResult(const pb::RunConfig& config, const ProgressRow& last) {
 
 // One learner and --actors actor processes (deploy/launcher.h).
 int RunDistributed(const TrainRequest& request, const ResolvedRun& run) {
+  // What the child processes would each refuse, refused once here.
+  if (absl::StatusOr<std::unique_ptr<Environment>> env =
+          MakeEnvironment(run.config.env());
+      !env.ok()) {
+    return Fail(env.status().message());
+  }
+  if (!run.local.resume && !run.local.run_dir.empty()) {
+    if (absl::Status status = RunDirectory::CheckFree(run.local.run_dir);
+        !status.ok()) {
+      return Fail(status.message());
+    }
+  }
   LaunchConfig launch;
   launch.resume = run.local.resume;
   launch.run_config = run.config;

@@ -66,7 +66,8 @@ constexpr char kRun[] = "--steps=3072 --horizon=256 --envs=2 --seed=5";
 TEST(DistributedTest, SyncWithOneActorReproducesLocalMode) {
   const std::string local = FreshDirectory("local");
   const std::string remote = FreshDirectory("remote");
-  ASSERT_EQ(RunVantage(std::string("train ") + kRun + " --run_dir=" + local)
+  ASSERT_EQ(RunVantage(std::string("train --mode=local ") + kRun +
+                       " --run_dir=" + local)
                 .exit_code,
             0);
   const Learner learner =

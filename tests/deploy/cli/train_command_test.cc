@@ -20,8 +20,8 @@ std::string FreshDirectory(const std::string& name) {
 TEST(TrainCommandTest, ShortRunWritesARunDirectory) {
   const std::string run = FreshDirectory("cli_run");
   const Outcome outcome = RunVantage(
-      "train --steps=512 --horizon=128 --envs=2 --seed=3 --checkpoint_every=1 "
-      "--run_dir=" +
+      "train --mode=local --steps=512 --horizon=128 --envs=2 --seed=3 "
+      "--checkpoint_every=1 --run_dir=" +
       run);
   ASSERT_EQ(outcome.exit_code, 0) << outcome.err;
   EXPECT_THAT(outcome.out, HasSubstr("RESULT train env=InvertedPendulum "
@@ -66,7 +66,8 @@ TEST(TrainCommandTest, ResumeContinuesTheRun) {
   const std::string run = FreshDirectory("cli_resume");
   const std::string config =
       WriteTemp("resume.json",
-                R"({"steps": 768, "horizon": 128, "envs": 2, "algo": "trpo"})");
+                R"({"mode": "local", "steps": 768, "horizon": 128, "envs": 2,
+                    "algo": "trpo"})");
   ASSERT_EQ(RunVantage("train --checkpoint_every=1 --config=" + config +
                        " --run_dir=" + run)
                 .exit_code,
@@ -83,9 +84,13 @@ TEST(TrainCommandTest, ResumeContinuesTheRun) {
 
 TEST(TrainCommandTest, BadFlagsAreOneLineErrors) {
   const std::string taken = FreshDirectory("cli_taken");
-  ASSERT_EQ(
-      RunVantage("train --steps=10 --horizon=10 --run_dir=" + taken).exit_code,
-      0);
+  // With no --mode the main job runs: a learner and two actor processes.
+  const Outcome defaults =
+      RunVantage("train --steps=10 --horizon=10 --run_dir=" + taken);
+  ASSERT_EQ(defaults.exit_code, 0) << defaults.err;
+  EXPECT_THAT(defaults.out, HasSubstr("1 learner + 2 actors x 1 envs"));
+  EXPECT_THAT(ReadFile(taken + "/config.json"),
+              HasSubstr("\"mode\": \"distributed\""));
   const std::pair<std::string, std::string> cases[] = {
       {"train --algo=sac",
        "--algo: unknown algorithm 'sac'; available: a2c, ppo, trpo"},
