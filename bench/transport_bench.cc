@@ -122,6 +122,21 @@ absl::StatusOr<ActorRate> MeasureActorCore(const PolicyWeights& weights,
   return rate;
 }
 
+// The learner's steps stitched per second over `seconds` split into
+// kWindows windows, the fastest kept.
+double FastestIngestRate(const ConsumingLearner& learner, double seconds) {
+  double fastest = 0.0;
+  for (int window = 0; window < kWindows; ++window) {
+    const int64_t before = learner.consumed_steps();
+    const double start = Now();
+    std::this_thread::sleep_for(
+        std::chrono::duration<double>(seconds / kWindows));
+    fastest = std::max(fastest,
+                       (learner.consumed_steps() - before) / (Now() - start));
+  }
+  return fastest;
+}
+
 // One client: registers, then streams copies of `segments` (renumbered as
 // its own consecutive streams) until `stop`.
 absl::Status StreamCopies(int port, int client, const EnvSpec& spec,
@@ -195,15 +210,7 @@ int RunIngestBenchmark(int clients, double seconds) {
   }
   // A second to connect and fill the pipes, then the window.
   std::this_thread::sleep_for(std::chrono::seconds(1));
-  double ingested = 0.0;
-  for (int window = 0; window < kWindows; ++window) {
-    const int64_t before = (*learner)->consumed_steps();
-    const double start = Now();
-    std::this_thread::sleep_for(
-        std::chrono::duration<double>(seconds / kWindows));
-    ingested = std::max(
-        ingested, ((*learner)->consumed_steps() - before) / (Now() - start));
-  }
+  const double ingested = FastestIngestRate(**learner, seconds);
   stop = true;
   learner->reset();  // ends the streams
   for (std::thread& thread : threads) thread.join();
@@ -261,15 +268,7 @@ int RunActorBenchmark(const std::string& env_name, int envs, double seconds) {
   std::thread actor([&] { acted = RunRemoteActor(config, stop); });
   // Registration and the first segments, then the windows.
   std::this_thread::sleep_for(std::chrono::seconds(1));
-  double streamed = 0.0;
-  for (int window = 0; window < kWindows; ++window) {
-    const int64_t before = (*learner)->consumed_steps();
-    const double start = Now();
-    std::this_thread::sleep_for(
-        std::chrono::duration<double>(seconds / kWindows));
-    streamed = std::max(
-        streamed, ((*learner)->consumed_steps() - before) / (Now() - start));
-  }
+  const double streamed = FastestIngestRate(**learner, seconds);
   stop = true;
   actor.join();
   learner->reset();

@@ -42,4 +42,22 @@ absl::Status CheckAction(const EnvSpec& spec, absl::Span<const double> action) {
   return absl::OkStatus();
 }
 
+absl::Status CheckStep(const EnvSpec& spec, bool needs_reset,
+                       absl::Span<const double> action,
+                       absl::Span<double> observation) {
+  if (needs_reset) {
+    return absl::FailedPreconditionError(
+        absl::StrCat(spec.name, ": Reset before stepping"));
+  }
+  if (absl::Status status = CheckAction(spec, action); !status.ok()) {
+    return status;
+  }
+  if (observation.size() != static_cast<size_t>(spec.observation_size)) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        spec.name, ": observation buffer holds ", observation.size(),
+        " values, expected ", spec.observation_size));
+  }
+  return absl::OkStatus();
+}
+
 }  // namespace vantage

@@ -77,6 +77,13 @@ class Environment {
 // discrete, that it is an integer in range); the message names the entry.
 absl::Status CheckAction(const EnvSpec& spec, absl::Span<const double> action);
 
+// What every Step checks before touching its physics: an episode is under
+// way (FailedPrecondition otherwise), the action passes CheckAction and the
+// observation buffer has the spec's size.
+absl::Status CheckStep(const EnvSpec& spec, bool needs_reset,
+                       absl::Span<const double> action,
+                       absl::Span<double> observation);
+
 }  // namespace vantage
 
 #endif  // VANTAGE_COMMON_ENV_ENVIRONMENT_H_

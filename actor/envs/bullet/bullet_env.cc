@@ -87,17 +87,9 @@ absl::Status BulletEnv::Advance(absl::Span<const double> clipped,
 
 absl::StatusOr<StepResult> BulletEnv::Step(absl::Span<const double> action,
                                            absl::Span<double> observation) {
-  if (needs_reset_) {
-    return absl::FailedPreconditionError(
-        absl::StrCat(spec_.name, ": Reset before stepping"));
-  }
-  if (absl::Status status = CheckAction(spec_, action); !status.ok()) {
+  if (absl::Status status = CheckStep(spec_, needs_reset_, action, observation);
+      !status.ok()) {
     return status;
-  }
-  if (observation.size() != static_cast<size_t>(spec_.observation_size)) {
-    return absl::InvalidArgumentError(absl::StrCat(
-        spec_.name, ": observation buffer holds ", observation.size(),
-        " values, expected ", spec_.observation_size));
   }
   for (size_t j = 0; j < clipped_.size(); ++j) {
     clipped_[j] =
