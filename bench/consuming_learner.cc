@@ -6,9 +6,11 @@
 namespace vantage {
 namespace {
 
-GatewayConfig MakeGatewayConfig(const pb::RunConfig& run_config) {
+GatewayConfig MakeGatewayConfig(const pb::RunConfig& run_config,
+                                const EnvSpec& spec) {
   GatewayConfig config;
   config.run_config = run_config;
+  config.spec = spec;
   config.run_config.set_sync(false);
   config.max_segment_steps = run_config.segment_length();
   config.max_policy_lag = -1;  // nothing is too stale to be ingested
@@ -18,20 +20,20 @@ GatewayConfig MakeGatewayConfig(const pb::RunConfig& run_config) {
 }  // namespace
 
 ConsumingLearner::ConsumingLearner(const pb::RunConfig& run_config,
-                                   PolicyWeights weights,
+                                   const EnvSpec& spec, PolicyWeights weights,
                                    int64_t steps_per_version)
     : queue_(64),
-      gateway_(MakeGatewayConfig(run_config), queue_),
+      gateway_(MakeGatewayConfig(run_config, spec), queue_),
       service_(gateway_),
       stitcher_(run_config.horizon()),
       weights_(std::move(weights)),
       steps_per_version_(steps_per_version) {}
 
 absl::StatusOr<std::unique_ptr<ConsumingLearner>> ConsumingLearner::Start(
-    const pb::RunConfig& run_config, const PolicyWeights& weights,
-    int64_t steps_per_version) {
+    const pb::RunConfig& run_config, const EnvSpec& spec,
+    const PolicyWeights& weights, int64_t steps_per_version) {
   std::unique_ptr<ConsumingLearner> learner(
-      new ConsumingLearner(run_config, weights, steps_per_version));
+      new ConsumingLearner(run_config, spec, weights, steps_per_version));
   learner->gateway_.Publish(learner->weights_);
   absl::StatusOr<RunningServer> server =
       StartServer(ServerOptions(), learner->service_);

@@ -20,13 +20,13 @@ namespace vantage {
 class ConsumingLearner {
  public:
   // Serves on 127.0.0.1 (a free port) an asynchronous run of `run_config`
-  // (its horizon and segment length) whose version 0 is `weights`; the
-  // first registration fixes the spec. Every `steps_per_version` steps
+  // (its horizon and segment length) of `spec` whose version 0 is
+  // `weights`. Every `steps_per_version` steps
   // stitched (0: never) it publishes the same weights as the next version,
   // as a learner's updates would, so paced actors go on acting.
   static absl::StatusOr<std::unique_ptr<ConsumingLearner>> Start(
-      const pb::RunConfig& run_config, const PolicyWeights& weights,
-      int64_t steps_per_version);
+      const pb::RunConfig& run_config, const EnvSpec& spec,
+      const PolicyWeights& weights, int64_t steps_per_version);
   ~ConsumingLearner();
 
   int port() const { return port_; }
@@ -35,8 +35,8 @@ class ConsumingLearner {
   GatewayCounters counters() const { return gateway_.counters(); }
 
  private:
-  ConsumingLearner(const pb::RunConfig& run_config, PolicyWeights weights,
-                   int64_t steps_per_version);
+  ConsumingLearner(const pb::RunConfig& run_config, const EnvSpec& spec,
+                   PolicyWeights weights, int64_t steps_per_version);
   void Consume();
 
   SegmentQueue queue_;

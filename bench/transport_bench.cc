@@ -164,6 +164,7 @@ absl::Status StreamCopies(int port, int client, const EnvSpec& spec,
   std::vector<pb::Segment> copies = segments;
   for (pb::Segment& copy : copies) copy.set_actor_id(response.actor_id());
   grpc::ClientContext stream_context;
+  stream_context.AddMetadata(kSessionMetadataKey, response.session());
   pb::SegmentAck ack;
   std::unique_ptr<grpc::ClientWriter<pb::Segment>> writer =
       stub->StreamSegments(&stream_context, &ack);
@@ -197,7 +198,7 @@ int RunIngestBenchmark(int clients, double seconds) {
   }
 
   absl::StatusOr<std::unique_ptr<ConsumingLearner>> learner =
-      ConsumingLearner::Start(BenchRunConfig(kEnv), weights,
+      ConsumingLearner::Start(BenchRunConfig(kEnv), spec, weights,
                               /*steps_per_version=*/0);
   if (!learner.ok()) return Fail("ingest", learner.status());
   std::atomic<bool> stop{false};
@@ -255,7 +256,7 @@ int RunActorBenchmark(const std::string& env_name, int envs, double seconds) {
   const EnvSpec spec = (*probe)->spec();
   const pb::RunConfig run = BenchRunConfig(env_name);
   absl::StatusOr<std::unique_ptr<ConsumingLearner>> learner =
-      ConsumingLearner::Start(run, FreshWeights(spec),
+      ConsumingLearner::Start(run, spec, FreshWeights(spec),
                               /*steps_per_version=*/run.horizon() * envs);
   if (!learner.ok()) return Fail("actor", learner.status());
   RemoteActorConfig config;

@@ -1,9 +1,12 @@
 #include "deploy/learner_server.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <fstream>
+#include <mutex>
 #include <thread>
+#include <vector>
 
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
@@ -84,13 +87,17 @@ absl::Status RunLearnerServer(
   auto learner_config_for = [&](const EnvSpec& spec) {
     LearnerConfig learner_config = MakeLearnerConfig(training, spec);
     learner_config.max_segment_steps = config.run_config.segment_length();
+    learner_config.value_limits = config.limits.values;
     return learner_config;
   };
-  // A resumed run knows its spec, its learner and the actor ids it handed
-  // out before any actor registers.
+  if (absl::Status status = config.limits.Validate(); !status.ok()) {
+    return status;
+  }
+  const EnvSpec& spec = config.spec;
+  // A resumed run knows its learner and the actor ids it handed out before
+  // any actor registers.
   std::optional<RunDirectory> run;
   std::unique_ptr<LearnerCore> learner;
-  std::optional<EnvSpec> spec;
   int64_t first_actor_id = 0;
   double elapsed_before = 0.0;
   if (training.resume) {
@@ -104,12 +111,15 @@ absl::Status RunLearnerServer(
           absl::StatusOr<ServerCheckpointState> state =
               ReadServerState(path, extras);
           if (!state.ok()) return state.status();
-          absl::StatusOr<std::unique_ptr<LearnerCore>> loaded =
-              ReadCheckpoint(path, learner_config_for(state->spec));
-          if (loaded.ok()) {
-            spec = state->spec;
-            first_actor_id = state->next_actor_id;
+          if (absl::Status same = CheckSameSpec(spec, state->spec);
+              !same.ok()) {
+            return absl::InvalidArgumentError(
+                absl::StrCat(path, " was written for another version of ",
+                             spec.name, ": ", same.message()));
           }
+          absl::StatusOr<std::unique_ptr<LearnerCore>> loaded =
+              ReadCheckpoint(path, learner_config_for(spec));
+          if (loaded.ok()) first_actor_id = state->next_actor_id;
           return loaded;
         });
     if (!resumed.ok()) return resumed.status();
@@ -146,12 +156,22 @@ absl::Status RunLearnerServer(
   gateway_config.max_segment_steps = config.run_config.segment_length();
   gateway_config.max_policy_lag = config.run_config.max_policy_lag();
   gateway_config.first_actor_id = first_actor_id;
+  gateway_config.spec = spec;
+  gateway_config.limits = config.limits;
   ActorGateway gateway(gateway_config, queue);
-  if (spec.has_value()) gateway.SetSpec(*spec);
-  LearnerService service(gateway);
+  // Nothing larger than the run's largest valid segment is ever read.
+  ServiceLimits service_limits = config.service_limits;
+  service_limits.max_segment_message_bytes =
+      MaxSegmentMessageBytes(spec, config.run_config.segment_length());
+  LearnerService service(gateway, service_limits);
   ServerOptions options;
   options.listen = config.listen;
   options.security = config.security;
+  options.max_receive_message_bytes =
+      std::max(service_limits.max_segment_message_bytes,
+               service_limits.max_request_bytes);
+  options.max_threads = config.max_server_threads;
+  options.max_memory_bytes = config.max_grpc_memory_bytes;
   absl::StatusOr<RunningServer> server = StartServer(options, service);
   if (!server.ok()) return server.status();
   std::fprintf(stderr, "learner: serving on port %d\n", server->port);
@@ -172,19 +192,33 @@ absl::Status RunLearnerServer(
     metrics = *std::move(started);
     std::fprintf(stderr, "learner: metrics on port %d\n", metrics->port());
   }
+  std::atomic<int64_t> buffered_steps{0};
   auto record_gateway = [&] {
     if (metrics == nullptr) return;
     const GatewayCounters counters = gateway.counters();
     metrics->RecordSegmentsAccepted(counters.accepted_segments);
     metrics->RecordRejected(counters.rejected);
-    metrics->SetActorsRegistered(counters.registrations);
-    metrics->SetQueueDepth(static_cast<int64_t>(queue.size()), 0);
+    metrics->RecordActors({counters.live_actors, service.open_streams(),
+                           counters.registrations, counters.expirations});
+    metrics->SetQueueDepth(static_cast<int64_t>(queue.size()),
+                           buffered_steps.load());
   };
+  // Registrations that expired, for the update loop to free (the stitcher
+  // belongs to that thread).
+  std::mutex expired_mutex;
+  std::vector<int64_t> expired;
   // Closing the queue is how a stop request reaches a blocked update; the
-  // same thread keeps the ingest metrics fresh while updates block.
+  // same thread ends idle streams, expires registrations and keeps the
+  // ingest metrics fresh while updates block.
   std::thread watcher([&] {
     while (!stop && !gateway.closed()) {
       std::this_thread::sleep_for(std::chrono::milliseconds(50));
+      service.CancelIdleStreams();
+      std::vector<int64_t> gone = gateway.ExpireIdle();
+      if (!gone.empty()) {
+        std::lock_guard<std::mutex> lock(expired_mutex);
+        expired.insert(expired.end(), gone.begin(), gone.end());
+      }
       record_gateway();
     }
     queue.Close();
@@ -199,12 +233,8 @@ absl::Status RunLearnerServer(
   };
 
   if (learner == nullptr) {
-    while (!spec.has_value() && !stop) {
-      spec = gateway.WaitForSpec(absl::Milliseconds(200));
-    }
-    if (!spec.has_value()) return finish(absl::OkStatus());
     absl::StatusOr<std::unique_ptr<LearnerCore>> created =
-        LearnerCore::Create(learner_config_for(*spec));
+        LearnerCore::Create(learner_config_for(spec));
     if (!created.ok()) return finish(created.status());
     learner = *std::move(created);
   }
@@ -217,7 +247,7 @@ absl::Status RunLearnerServer(
   recorder_config.steps_before = learner->env_steps();
   RunRecorder recorder(std::move(run), recorder_config);
   auto server_state = [&]() -> absl::StatusOr<CheckpointExtras> {
-    return ServerStateExtras(*spec, gateway.next_actor_id());
+    return ServerStateExtras(spec, gateway.next_actor_id());
   };
 
   gateway.Publish(learner->CurrentWeights());
@@ -226,6 +256,12 @@ absl::Status RunLearnerServer(
     if (!stats.ok() && stop) break;
     if (!stats.ok()) return finish(stats.status());
     gateway.Publish(learner->CurrentWeights());
+    {
+      std::lock_guard<std::mutex> lock(expired_mutex);
+      for (int64_t actor_id : expired) learner->ForgetActor(actor_id);
+      expired.clear();
+    }
+    buffered_steps = learner->buffered_steps();
     absl::StatusOr<ProgressRow> row =
         recorder.Record(*learner, *stats, server_state);
     if (!row.ok()) return finish(row.status());
@@ -236,6 +272,7 @@ absl::Status RunLearnerServer(
       metrics->RecordUpdate(stats->policy_version, stats->env_steps,
                             stats->episodes, stats->update_seconds,
                             row->mean_return, row->steps_per_second);
+      metrics->RecordRolledBackUpdates(stats->rolled_back_updates);
       record_gateway();
     }
     on_update(*row);

@@ -6,7 +6,9 @@
 #include <string>
 
 #include "absl/status/status.h"
+#include "common/env/environment.h"
 #include "deploy/local_training.h"
+#include "learner/service/actor_gateway.h"
 #include "learner/service/security.h"
 #include "proto/run_config.pb.h"
 
@@ -17,6 +19,16 @@ struct LearnerServerConfig {
   // steps), the run length and the run directory, as in local mode.
   LocalTrainingConfig training;
   pb::RunConfig run_config;  // resolved; actors receive it
+  // The run's environment, from the learner's own configuration: actors
+  // must register exactly this spec (a resumed run checks that its
+  // checkpoint has it too).
+  EnvSpec spec;
+  // What clients may make the learner hold (actors, env slots, value
+  // magnitudes, idle streams, gRPC threads and memory).
+  GatewayLimits limits;
+  ServiceLimits service_limits;
+  int max_server_threads = 600;
+  int64_t max_grpc_memory_bytes = int64_t{1} << 30;
   std::string listen = "127.0.0.1:0";
   std::string port_file;     // written with the bound port once serving
   SecurityOptions security;  // TLS and the token every actor must send
@@ -26,7 +38,7 @@ struct LearnerServerConfig {
 
 // `vantage learner`: serves actors over gRPC, trains on their segments and
 // publishes every new version until the run's steps are done or `stop` is
-// set. The environment spec comes with the first actor's registration.
+// set.
 absl::Status RunLearnerServer(
     const LearnerServerConfig& config, const std::atomic<bool>& stop,
     const std::function<void(const ProgressRow&)>& on_update);

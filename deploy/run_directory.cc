@@ -50,6 +50,7 @@ std::string FormatProgressRow(const ProgressRow& row) {
        Number(s.algorithm.approx_kl), Number(s.algorithm.clip_fraction),
        Number(s.explained_variance), Number(s.biased_fraction),
        Number(s.mean_abs_bias), absl::StrCat(s.rejected_segments),
+       absl::StrCat(s.rolled_back_updates),
        absl::StrFormat("%.3f", row.elapsed_seconds),
        absl::StrFormat("%.1f", row.steps_per_second)},
       ",");

@@ -21,7 +21,8 @@ namespace vantage {
 inline constexpr char kProgressColumns[] =
     "env_steps,updates,policy_version,episodes,mean_return,policy_loss,"
     "value_loss,entropy,approx_kl,clip_fraction,explained_variance,"
-    "biased_fraction,mean_abs_bias,rejected_segments,elapsed_s,sps";
+    "biased_fraction,mean_abs_bias,rejected_segments,rolled_back_updates,"
+    "elapsed_s,sps";
 
 struct ProgressRow {
   UpdateStats stats;

@@ -5,6 +5,8 @@
 #include <torch/serialize/archive.h>
 
 #include <chrono>
+#include <cmath>
+#include <cstdio>
 #include <limits>
 #include <numeric>
 #include <sstream>
@@ -29,6 +31,13 @@ absl::Status LearnerConfig::Validate() const {
   if (!(observation_clip > 0) || !(reward_clip > 0)) {
     return absl::InvalidArgumentError(
         "observation_clip and reward_clip must be > 0");
+  }
+  if (!(rollback_gradient_norm > 0)) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "rollback_gradient_norm must be > 0, got ", rollback_gradient_norm));
+  }
+  if (absl::Status status = value_limits.Validate(); !status.ok()) {
+    return status;
   }
   if (absl::Status status = advantage.Validate(); !status.ok()) return status;
   if (absl::Status status = algorithm.Validate(); !status.ok()) return status;
@@ -88,7 +97,8 @@ absl::StatusOr<UpdateStats> LearnerCore::RunUpdate(SegmentSource& source) {
   while (static_cast<int64_t>(pending_.size()) < config_.rollouts_per_batch) {
     absl::StatusOr<Segment> segment = source.Receive();
     if (!segment.ok()) return segment.status();
-    if (!ValidateSegment(*segment, config_.spec, config_.max_segment_steps)
+    if (!ValidateSegment(*segment, config_.spec, config_.max_segment_steps,
+                         config_.value_limits)
              .ok() ||
         segment->policy_version > version_) {
       ++rejected_;
@@ -132,6 +142,7 @@ absl::StatusOr<UpdateStats> LearnerCore::RunUpdate(SegmentSource& source) {
         return value_->forward(normalizer_.Normalize(observations, clip));
       });
   if (!batch.ok()) return batch.status();
+  const Snapshot before = TakeSnapshot();
   if (config_.scale_rewards) {
     if (absl::Status status = reward_scaler_.Observe(rollouts); !status.ok()) {
       return status;
@@ -151,13 +162,27 @@ absl::StatusOr<UpdateStats> LearnerCore::RunUpdate(SegmentSource& source) {
       static_cast<double>(env_steps_) / config_.total_env_steps;
   UpdateStats stats;
   stats.algorithm = updater_->Update(update, progress, rng_);
-  for (const Rollout& rollout : rollouts) {
-    if (absl::Status status = normalizer_.Update(
-            rollout.observations.slice(0, 0, config_.horizon));
-        !status.ok()) {
-      return status;
+  stats.rollback_reason = UpdateFault(stats.algorithm);
+  if (!stats.rollback_reason.empty()) {
+    Restore(before);
+    stats.rolled_back = true;
+    ++rolled_back_updates_;
+    std::fprintf(stderr,
+                 "learner: warning: update to version %ld rolled back (%s); "
+                 "its batch of %ld steps is dropped\n",
+                 static_cast<long>(version_ + 1), stats.rollback_reason.c_str(),
+                 static_cast<long>(samples));
+  } else {
+    // A dropped batch must not move the statistics either.
+    for (const Rollout& rollout : rollouts) {
+      if (absl::Status status = normalizer_.Update(
+              rollout.observations.slice(0, 0, config_.horizon));
+          !status.ok()) {
+        return status;
+      }
     }
   }
+  stats.rolled_back_updates = rolled_back_updates_;
   for (const Rollout& rollout : rollouts) {
     stats.rollout_policy_lags.push_back(
         version_ - rollout.policy_versions.min().item<int64_t>());
@@ -181,6 +206,79 @@ absl::StatusOr<UpdateStats> LearnerCore::RunUpdate(SegmentSource& source) {
                              std::chrono::steady_clock::now() - update_start)
                              .count();
   return stats;
+}
+
+LearnerCore::Snapshot LearnerCore::TakeSnapshot() const {
+  Snapshot snapshot;
+  for (const at::Tensor& p : policy_->parameters()) {
+    snapshot.parameters.push_back(p.detach().clone());
+  }
+  for (const at::Tensor& p : value_->parameters()) {
+    snapshot.parameters.push_back(p.detach().clone());
+  }
+  // The optimisers' state is reached only through their archives.
+  torch::serialize::OutputArchive updater, scaler;
+  updater_->Save(updater);
+  std::ostringstream updater_bytes;
+  updater.save_to(updater_bytes);
+  snapshot.updater = updater_bytes.str();
+  if (config_.scale_rewards) {
+    reward_scaler_.Save(scaler);
+    std::ostringstream scaler_bytes;
+    scaler.save_to(scaler_bytes);
+    snapshot.reward_scaler = scaler_bytes.str();
+  }
+  return snapshot;
+}
+
+void LearnerCore::Restore(const Snapshot& snapshot) {
+  {
+    at::NoGradGuard no_grad;
+    size_t i = 0;
+    for (at::Tensor& p : policy_->parameters()) {
+      p.copy_(snapshot.parameters[i++]);
+    }
+    for (at::Tensor& p : value_->parameters()) {
+      p.copy_(snapshot.parameters[i++]);
+    }
+  }
+  // The state was saved by these very objects a moment ago, so failing to
+  // load it back is a programmer error.
+  torch::serialize::InputArchive updater;
+  std::istringstream updater_bytes(snapshot.updater);
+  updater.load_from(updater_bytes);
+  const absl::Status loaded = updater_->Load(updater);
+  TORCH_CHECK(loaded.ok(), "rollback: ", loaded.ToString());
+  if (config_.scale_rewards) {
+    torch::serialize::InputArchive scaler;
+    std::istringstream scaler_bytes(snapshot.reward_scaler);
+    scaler.load_from(scaler_bytes);
+    const absl::Status scaler_loaded = reward_scaler_.Load(scaler);
+    TORCH_CHECK(scaler_loaded.ok(), "rollback: ", scaler_loaded.ToString());
+  }
+}
+
+std::string LearnerCore::UpdateFault(const AlgorithmStats& stats) const {
+  if (!std::isfinite(stats.policy_loss) || !std::isfinite(stats.value_loss)) {
+    return absl::StrCat("non-finite loss: policy ", stats.policy_loss,
+                        ", value ", stats.value_loss);
+  }
+  // NaN (no gradient step of this kind) never exceeds the limit.
+  if (stats.max_gradient_norm > config_.rollback_gradient_norm) {
+    return absl::StrCat("gradient norm ", stats.max_gradient_norm,
+                        " above the limit of ", config_.rollback_gradient_norm);
+  }
+  for (const auto& item : policy_->named_parameters()) {
+    if (!at::isfinite(item.value()).all().item<bool>()) {
+      return absl::StrCat("non-finite policy parameter ", item.key());
+    }
+  }
+  for (const auto& item : value_->named_parameters()) {
+    if (!at::isfinite(item.value()).all().item<bool>()) {
+      return absl::StrCat("non-finite value parameter ", item.key());
+    }
+  }
+  return "";
 }
 
 namespace {
@@ -209,10 +307,10 @@ void LearnerCore::Save(torch::serialize::OutputArchive& archive) const {
   std::ostringstream rng;
   rng << rng_;
   WriteBytes(archive, "rng", rng.str());
-  archive.write("counters",
-                at::tensor({version_, env_steps_, rejected_, episodes_,
-                            stale_segments_, stale_steps_},
-                           at::kLong));
+  archive.write("counters", at::tensor({version_, env_steps_, rejected_,
+                                        episodes_, stale_segments_,
+                                        stale_steps_, rolled_back_updates_},
+                                       at::kLong));
   archive.write("recent_returns",
                 at::tensor(std::vector<double>(recent_returns_.begin(),
                                                recent_returns_.end()),
@@ -275,7 +373,9 @@ absl::StatusOr<std::unique_ptr<LearnerCore>> LearnerCore::Load(
                               ReadTensor(archive, "recent_returns", returns)}) {
     if (!status.ok()) return status;
   }
-  if (counters.scalar_type() != at::kLong || counters.numel() != 6 ||
+  // Checkpoints written before rollbacks existed hold 6 counters.
+  if (counters.scalar_type() != at::kLong ||
+      (counters.numel() != 6 && counters.numel() != 7) ||
       returns.scalar_type() != at::kDouble || returns.dim() != 1 ||
       returns.numel() > 100) {
     return absl::InvalidArgumentError(
@@ -287,6 +387,9 @@ absl::StatusOr<std::unique_ptr<LearnerCore>> LearnerCore::Load(
   core.episodes_ = counters[3].item<int64_t>();
   core.stale_segments_ = counters[4].item<int64_t>();
   core.stale_steps_ = counters[5].item<int64_t>();
+  if (counters.numel() == 7) {
+    core.rolled_back_updates_ = counters[6].item<int64_t>();
+  }
   for (int64_t i = 0; i < returns.numel(); ++i) {
     core.recent_returns_.push_back(returns[i].item<double>());
   }

@@ -3,8 +3,10 @@
 
 #include <cstdint>
 #include <deque>
+#include <limits>
 #include <memory>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "absl/status/statusor.h"
@@ -13,6 +15,7 @@
 #include "common/nn/networks.h"
 #include "common/nn/policy_weights.h"
 #include "common/nn/running_mean_std.h"
+#include "common/rollout/segment.h"
 #include "common/rollout/segment_queue.h"
 #include "learner/algorithms/algorithm.h"
 #include "learner/ingest/reward_scaler.h"
@@ -34,6 +37,12 @@ struct LearnerConfig {
   // Divide rewards by the running std of discounted returns (then clip).
   bool scale_rewards = false;
   double reward_clip = 10.0;
+  // An update with a larger global gradient norm (before clipping) in any
+  // of its gradient steps is rolled back like one that produced non-finite
+  // numbers; infinite: only non-finite numbers roll back.
+  double rollback_gradient_norm = std::numeric_limits<double>::infinity();
+  // What a segment's values must stay within (see ValidateSegment).
+  ValueLimits value_limits;
   AdvantageConfig advantage;
   AlgorithmConfig algorithm;
   NetworkConfig network;
@@ -52,6 +61,13 @@ struct UpdateStats {
   int64_t rejected_segments = 0;  // so far, any reason (stale included)
   int64_t stale_segments = 0;     // so far, too old a policy version
   int64_t stale_steps = 0;        // so far, dropped for their version
+  // This update produced a non-finite loss or parameter (or too large a
+  // gradient) and was undone: the networks, the optimiser state and the
+  // reward scaler are as before it, the batch is dropped, the version still
+  // advances (with unchanged weights) so that synchronous actors go on.
+  bool rolled_back = false;
+  std::string rollback_reason;      // why, if rolled_back
+  int64_t rolled_back_updates = 0;  // so far
   // Wall-clock seconds of this update once its batch was complete (not
   // reproducible, so not in progress.csv).
   double update_seconds = 0.0;
@@ -74,6 +90,17 @@ class LearnerCore {
   PolicyWeights CurrentWeights();
   // Blocks on `source` until a batch is complete, then updates.
   absl::StatusOr<UpdateStats> RunUpdate(SegmentSource& source);
+
+  // Frees the stitching state of an actor that is gone (its registration
+  // expired); rollouts it already completed still train.
+  void ForgetActor(int64_t actor_id) { stitcher_.ForgetActor(actor_id); }
+  const RolloutStitcher& stitcher() const { return stitcher_; }
+  // Steps held for later batches: partial rollouts and complete ones that
+  // wait for their batch.
+  int64_t buffered_steps() const {
+    return stitcher_.buffered_steps() +
+           static_cast<int64_t>(pending_.size()) * config_.horizon;
+  }
 
   // Returns of the episodes reported by consumed segments, newest last
   // (at most 100 kept).
@@ -98,6 +125,17 @@ class LearnerCore {
  private:
   explicit LearnerCore(const LearnerConfig& config);
 
+  // What an update may change and a rollback restores.
+  struct Snapshot {
+    std::vector<at::Tensor> parameters;  // policy's then value's
+    std::string updater;                 // the optimisers' state
+    std::string reward_scaler;
+  };
+  Snapshot TakeSnapshot() const;
+  void Restore(const Snapshot& snapshot);
+  // Why the networks may not be published after an update; empty if fine.
+  std::string UpdateFault(const AlgorithmStats& stats) const;
+
   const LearnerConfig config_;
   PolicyNetwork policy_;
   ValueNetwork value_;
@@ -113,6 +151,7 @@ class LearnerCore {
   int64_t stale_segments_ = 0;
   int64_t stale_steps_ = 0;
   int64_t episodes_ = 0;
+  int64_t rolled_back_updates_ = 0;
   std::deque<double> recent_returns_;
 };
 

@@ -2,6 +2,7 @@
 
 #include <ATen/ATen.h>
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <cstring>
@@ -278,6 +279,19 @@ absl::StatusOr<Segment> SegmentFromProto(const pb::Segment& proto,
   return segment;
 }
 
+int64_t MaxSegmentMessageBytes(const EnvSpec& spec, int64_t max_steps) {
+  const int64_t t = std::max<int64_t>(1, max_steps);
+  const int64_t act = spec.discrete ? 1 : spec.action_size;
+  // observations [T+1, obs] and at most T final observations, float32;
+  // actions [T, act], rewards and log-probs [T] float32; two bool [T];
+  // at most T episodes of a double and a varint (<= 10 bytes) each.
+  const int64_t payload = 4 * spec.observation_size * (2 * t + 1) +
+                          4 * act * t + 8 * t + 2 * t + 18 * t;
+  // Tags, lengths, shapes and the four integers, generously.
+  constexpr int64_t kFraming = 4096;
+  return payload + kFraming;
+}
+
 void WeightsToProto(const PolicyWeights& weights, pb::Weights* proto) {
   proto->Clear();
   proto->set_version(weights.version);
@@ -337,7 +351,29 @@ void EnvSpecToProto(const EnvSpec& spec, pb::EnvSpec* proto) {
   proto->set_control_dt(spec.control_dt);
 }
 
-absl::StatusOr<EnvSpec> EnvSpecFromProto(const pb::EnvSpec& proto) {
+absl::StatusOr<EnvSpec> EnvSpecFromProto(const pb::EnvSpec& proto,
+                                         const SpecLimits& limits) {
+  // Checked before anything is copied out of the message.
+  if (static_cast<int64_t>(proto.name().size()) > limits.max_name_bytes) {
+    return Invalid("spec.name", absl::StrCat(proto.name().size(),
+                                             " bytes, expected at most ",
+                                             limits.max_name_bytes));
+  }
+  if (proto.observation_size() > limits.max_observation_size) {
+    return Invalid("spec.observation_size",
+                   absl::StrCat(proto.observation_size(),
+                                ", expected <= ", limits.max_observation_size));
+  }
+  if (proto.action_size() > limits.max_action_size) {
+    return Invalid("spec.action_size",
+                   absl::StrCat(proto.action_size(),
+                                ", expected <= ", limits.max_action_size));
+  }
+  if (proto.max_episode_steps() > limits.max_episode_steps) {
+    return Invalid("spec.max_episode_steps",
+                   absl::StrCat(proto.max_episode_steps(),
+                                ", expected <= ", limits.max_episode_steps));
+  }
   EnvSpec spec;
   spec.name = proto.name();
   spec.observation_size = proto.observation_size();
@@ -375,10 +411,10 @@ absl::StatusOr<EnvSpec> EnvSpecFromProto(const pb::EnvSpec& proto) {
     const double low = spec.action_low[i];
     const double high = spec.action_high[i];
     // Also refuses NaN in either bound.
-    if (!(low <= high)) {
+    if (!(low < high)) {
       return Invalid(absl::StrCat("spec.action_low[", i, "]"),
                      absl::StrCat(Num(low), " with action_high[", i, "] ",
-                                  Num(high), ", expected low <= high"));
+                                  Num(high), ", expected low < high"));
     }
   }
   if (spec.max_episode_steps < 0) {

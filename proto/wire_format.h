@@ -42,6 +42,10 @@ absl::StatusOr<at::Tensor> TensorFromProto(const pb::Tensor& proto,
 void SegmentToProto(const Segment& segment, pb::Segment* proto);
 absl::StatusOr<Segment> SegmentFromProto(const pb::Segment& proto,
                                          int64_t max_bytes);
+// An upper bound on the serialised size of any segment of at most
+// `max_steps` steps that ValidateSegment accepts for `spec`: what a learner
+// must be willing to read, and no more.
+int64_t MaxSegmentMessageBytes(const EnvSpec& spec, int64_t max_steps);
 
 // Weight tensors must be float32 or float64 (ImportPolicyWeights converts
 // them to the policy's dtype). `max_bytes` bounds each tensor separately.
@@ -49,12 +53,24 @@ void WeightsToProto(const PolicyWeights& weights, pb::Weights* proto);
 absl::StatusOr<PolicyWeights> WeightsFromProto(const pb::Weights& proto,
                                                int64_t max_bytes);
 
+// How large a spec may be before anything is allocated for it: a learner's
+// networks, normaliser and buffers grow with these sizes.
+struct SpecLimits {
+  int64_t max_name_bytes = 4096;  // mjcf:PATH names are paths
+  int64_t max_observation_size = 1 << 16;
+  int64_t max_action_size = 1 << 12;
+  int64_t max_episode_steps = 100000000;
+};
+
 void EnvSpecToProto(const EnvSpec& spec, pb::EnvSpec* proto);
-// Refuses specs no environment can have: an empty name, sizes below 1,
-// bounds that are not action_size (low <= high, no NaN) pairs when
-// continuous or that are present when discrete, a negative time limit, a
-// negative or non-finite control_dt.
-absl::StatusOr<EnvSpec> EnvSpecFromProto(const pb::EnvSpec& proto);
+// Refuses specs no environment can have and specs beyond `limits`: an empty
+// or too long name, sizes below 1 or above the limits, bounds that are not
+// action_size (low < high, no NaN; an infinite bound means that side is
+// unbounded) pairs when continuous or that are present when discrete, a
+// time limit below 0 (0: none) or above the limit, a negative or
+// non-finite control_dt.
+absl::StatusOr<EnvSpec> EnvSpecFromProto(const pb::EnvSpec& proto,
+                                         const SpecLimits& limits = {});
 
 // OK if `got` equals `expected` in every field, else InvalidArgument naming
 // the first field that differs, with both values.

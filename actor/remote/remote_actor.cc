@@ -24,7 +24,12 @@ absl::Status FromGrpc(const grpc::Status& status, absl::string_view what) {
                       absl::StrCat(what, ": ", status.error_message()));
 }
 
-// Refusals that no retry can mend.
+// Where the registration's session travels (the learner's
+// kSessionMetadataKey; actors do not include the learner's headers).
+constexpr char kSessionKey[] = "vantage-session";
+
+// Refusals that no retry can mend (an expired registration, NOT_FOUND, is
+// mended by registering again).
 bool IsRefusal(const absl::Status& status) {
   return absl::IsInvalidArgument(status) || absl::IsUnauthenticated(status) ||
          absl::IsPermissionDenied(status);
@@ -132,6 +137,7 @@ class Session {
     WeightsSlot slot;
     grpc::ClientContext subscription_context;
     AddAuthToken(config_.security, subscription_context);
+    subscription_context.AddMetadata(kSessionKey, response.session());
     pb::WeightsRequest weights_request;
     weights_request.set_actor_id(response.actor_id());
     weights_request.set_known_version(actor->policy_version());
@@ -145,6 +151,7 @@ class Session {
 
     grpc::ClientContext stream_context;
     AddAuthToken(config_.security, stream_context);
+    stream_context.AddMetadata(kSessionKey, response.session());
     pb::SegmentAck ack;
     std::unique_ptr<grpc::ClientWriter<pb::Segment>> writer =
         stub_->StreamSegments(&stream_context, &ack);

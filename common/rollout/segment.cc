@@ -2,7 +2,9 @@
 
 #include <ATen/ATen.h>
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
 
 #include "absl/strings/str_cat.h"
@@ -15,8 +17,10 @@ std::string Shape(const at::Tensor& t) {
   return absl::StrCat("[", absl::StrJoin(t.sizes(), ", "), "]");
 }
 
+// `max_abs` bounds the magnitude of float32 fields (infinite: none).
 absl::Status Expect(const at::Tensor& t, const char* field,
-                    std::vector<int64_t> shape, at::ScalarType dtype) {
+                    std::vector<int64_t> shape, at::ScalarType dtype,
+                    double max_abs = std::numeric_limits<double>::infinity()) {
   if (!t.defined()) {
     return absl::InvalidArgumentError(
         absl::StrCat("segment field ", field, " is missing"));
@@ -41,7 +45,20 @@ absl::Status Expect(const at::Tensor& t, const char* field,
         return absl::InvalidArgumentError(
             absl::StrCat("segment field ", field, " holds non-finite values"));
       }
+      if (std::fabs(values[i]) > max_abs) {
+        return absl::InvalidArgumentError(absl::StrCat(
+            "segment field ", field, " holds ", values[i], " at element ", i,
+            ", beyond the limit of +-", max_abs));
+      }
     }
+  }
+  return absl::OkStatus();
+}
+
+absl::Status CheckLimit(double value, const char* name) {
+  if (!(value > 0)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(name, " must be > 0, got ", value));
   }
   return absl::OkStatus();
 }
@@ -66,10 +83,76 @@ bool AnyBoth(const at::Tensor& a, const at::Tensor& b) {
   return false;
 }
 
+// The episodes a segment reports against the episode ends it holds.
+absl::Status CheckEpisodes(const Segment& segment, const EnvSpec& spec,
+                           const ValueLimits& limits) {
+  const size_t reported = segment.episode_returns.size();
+  if (reported != segment.episode_lengths.size()) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("segment lists ", reported, " episode returns but ",
+                     segment.episode_lengths.size(), " episode lengths"));
+  }
+  const at::Tensor terminated = segment.terminated.contiguous();
+  const at::Tensor truncated = segment.truncated.contiguous();
+  const bool* term = terminated.data_ptr<bool>();
+  const bool* trunc = truncated.data_ptr<bool>();
+  size_t episode = 0;
+  int64_t previous_end = -1;
+  for (int64_t t = 0, n = segment.steps(); t < n; ++t) {
+    if (!term[t] && !trunc[t]) continue;
+    if (episode >= reported) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          "segment reports ", reported, " episodes but ends one at step ", t));
+    }
+    const int64_t length = segment.episode_lengths[episode];
+    const double value = segment.episode_returns[episode];
+    // A failed env step (an env error) is not counted in its episode's
+    // length, so a length may fall short of the steps between two ends.
+    const int64_t at_most = previous_end < 0
+                                ? std::numeric_limits<int64_t>::max()
+                                : t - previous_end;
+    if (length < 1 || length > at_most ||
+        (spec.max_episode_steps > 0 && length > spec.max_episode_steps)) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          "segment field episode_lengths[", episode, "] is ", length,
+          " for the episode ending at step ", t, ", expected 1..",
+          std::min(at_most, spec.max_episode_steps > 0
+                                ? spec.max_episode_steps
+                                : std::numeric_limits<int64_t>::max())));
+    }
+    if (!std::isfinite(value) ||
+        std::fabs(value) >
+            limits.max_abs_reward * static_cast<double>(length)) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          "segment field episode_returns[", episode, "] is ", value,
+          ", expected a finite return within +-max_abs_reward (",
+          limits.max_abs_reward, ") per step of its ", length, " steps"));
+    }
+    previous_end = t;
+    ++episode;
+  }
+  if (episode != reported) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "segment reports ", reported, " episodes but ends ", episode));
+  }
+  return absl::OkStatus();
+}
+
 }  // namespace
 
+absl::Status ValueLimits::Validate() const {
+  for (absl::Status status :
+       {CheckLimit(max_abs_observation, "max_abs_observation"),
+        CheckLimit(max_abs_action, "max_abs_action"),
+        CheckLimit(max_abs_reward, "max_abs_reward"),
+        CheckLimit(max_abs_log_prob, "max_abs_log_prob")}) {
+    if (!status.ok()) return status;
+  }
+  return absl::OkStatus();
+}
+
 absl::Status ValidateSegment(const Segment& segment, const EnvSpec& spec,
-                             int64_t max_steps) {
+                             int64_t max_steps, const ValueLimits& limits) {
   const int64_t steps = segment.steps();
   if (steps < 1 || steps > max_steps) {
     return absl::InvalidArgumentError(
@@ -83,20 +166,22 @@ absl::Status ValidateSegment(const Segment& segment, const EnvSpec& spec,
           ? CountSet(segment.truncated)
           : -1;
   for (absl::Status status : {
-           Expect(segment.rewards, "rewards", {steps}, at::kFloat),
+           Expect(segment.rewards, "rewards", {steps}, at::kFloat,
+                  limits.max_abs_reward),
            Expect(segment.observations, "observations", {steps + 1, obs},
-                  at::kFloat),
-           Expect(segment.actions, "actions", {steps, act}, at::kFloat),
+                  at::kFloat, limits.max_abs_observation),
+           Expect(segment.actions, "actions", {steps, act}, at::kFloat,
+                  limits.max_abs_action),
            Expect(segment.terminated, "terminated", {steps}, at::kBool),
            Expect(segment.truncated, "truncated", {steps}, at::kBool),
            Expect(segment.behaviour_log_probs, "behaviour_log_probs", {steps},
-                  at::kFloat),
+                  at::kFloat, limits.max_abs_log_prob),
        }) {
     if (!status.ok()) return status;
   }
   if (absl::Status status =
           Expect(segment.final_observations, "final_observations",
-                 {truncations, obs}, at::kFloat);
+                 {truncations, obs}, at::kFloat, limits.max_abs_observation);
       !status.ok()) {
     return status;
   }
@@ -114,11 +199,7 @@ absl::Status ValidateSegment(const Segment& segment, const EnvSpec& spec,
     return absl::InvalidArgumentError(
         "segment marks a step both terminated and truncated");
   }
-  if (segment.episode_returns.size() != segment.episode_lengths.size()) {
-    return absl::InvalidArgumentError(
-        "segment lists different numbers of episode returns and lengths");
-  }
-  return absl::OkStatus();
+  return CheckEpisodes(segment, spec, limits);
 }
 
 }  // namespace vantage

@@ -38,15 +38,39 @@ struct Segment {
   std::vector<double> episode_returns;
   std::vector<int64_t> episode_lengths;
 
-  int64_t steps() const { return rewards.defined() ? rewards.size(0) : 0; }
+  // 0 for a rewards tensor that is missing or has no time axis (which
+  // ValidateSegment refuses).
+  int64_t steps() const {
+    return rewards.defined() && rewards.dim() >= 1 ? rewards.size(0) : 0;
+  }
+};
+
+// Magnitudes no honest actor sends. Finite numbers this large would still
+// overflow the learner's sums and losses (a reward of 3e38 turns every
+// weight into NaN), so they are refused with the field's name. The
+// defaults are far above what any registered environment produces.
+struct ValueLimits {
+  double max_abs_observation = 1e6;
+  double max_abs_action = 1e6;
+  double max_abs_reward = 1e6;
+  // Gaussian log-densities can be positive; |log p| beyond this means a
+  // broken or hostile policy, not a confident one.
+  double max_abs_log_prob = 1e5;
+
+  // Every limit must be > 0 (and may be infinite: no limit).
+  absl::Status Validate() const;
 };
 
 // Everything a learner must check before a segment touches training data:
-// shapes against the spec, dtypes, finite numbers, T in [1, max_steps],
-// one final observation per truncated step, no step both terminated and
-// truncated. The message names the field.
+// shapes against the spec, dtypes, finite numbers within `limits`, T in
+// [1, max_steps], one final observation per truncated step, no step both
+// terminated and truncated, and one finite episode return and length per
+// episode end (terminated or truncated step), each length >= 1, no longer
+// than the steps since the previous end in the segment (the first may have
+// begun in an earlier segment) nor than spec.max_episode_steps, each return
+// within max_abs_reward * length. The message names the field.
 absl::Status ValidateSegment(const Segment& segment, const EnvSpec& spec,
-                             int64_t max_steps);
+                             int64_t max_steps, const ValueLimits& limits = {});
 
 }  // namespace vantage
 

@@ -24,6 +24,8 @@
 #include "deploy/cli/advantages_command.h"
 #include "deploy/cli/env_commands.h"
 #include "deploy/cli/train_command.h"
+#include "deploy/learner_server.h"
+#include "learner/service/actor_gateway.h"
 #include "learner/service/security.h"
 
 ABSL_FLAG(std::string, input, "",
@@ -94,6 +96,37 @@ ABSL_FLAG(std::string, listen, "127.0.0.1:0",
 ABSL_FLAG(std::string, port_file, "",
           "learner: write the bound port here once serving");
 ABSL_FLAG(std::string, learner, "", "actor: the learner's HOST:PORT");
+// What clients can make a learner hold; defaults from the structs that use
+// them (docs/security.md explains each).
+ABSL_FLAG(int64_t, max_live_actors, vantage::GatewayLimits().max_live_actors,
+          "learner: registrations held at once (more: RESOURCE_EXHAUSTED)");
+ABSL_FLAG(int64_t, max_envs_per_actor,
+          vantage::GatewayLimits().max_envs_per_actor,
+          "learner: env slots one registration may claim");
+ABSL_FLAG(int64_t, max_live_env_slots,
+          vantage::GatewayLimits().max_live_env_slots,
+          "learner: env slots over all live registrations");
+ABSL_FLAG(double, actor_expiry_s,
+          absl::ToDoubleSeconds(vantage::GatewayLimits().actor_expiry),
+          "learner: a registration with no open call for this long expires");
+ABSL_FLAG(double, idle_stream_timeout_s,
+          absl::ToDoubleSeconds(vantage::ServiceLimits().idle_stream_timeout),
+          "learner: a segment stream silent for this long is cancelled");
+ABSL_FLAG(double, max_abs_observation,
+          vantage::ValueLimits().max_abs_observation,
+          "learner: segments with a larger |observation| are refused");
+ABSL_FLAG(double, max_abs_action, vantage::ValueLimits().max_abs_action,
+          "learner: segments with a larger |action| are refused");
+ABSL_FLAG(double, max_abs_reward, vantage::ValueLimits().max_abs_reward,
+          "learner: segments with a larger |reward| are refused");
+ABSL_FLAG(double, max_abs_log_prob, vantage::ValueLimits().max_abs_log_prob,
+          "learner: segments with a larger |behaviour log-prob| are refused");
+ABSL_FLAG(int, max_server_threads,
+          vantage::LearnerServerConfig().max_server_threads,
+          "learner: gRPC server threads (each open call holds one)");
+ABSL_FLAG(int64_t, max_grpc_memory_mb,
+          vantage::LearnerServerConfig().max_grpc_memory_bytes >> 20,
+          "learner: memory gRPC may use for its buffers, MiB");
 ABSL_FLAG(std::string, metrics, "",
           "learner, actor: serve Prometheus metrics on HOST:PORT (port 0: a "
           "free one, printed on stderr); empty: none");
@@ -314,6 +347,30 @@ int RunLearner(const std::vector<std::string>& args) {
   request.listen = absl::GetFlag(FLAGS_listen);
   request.port_file = absl::GetFlag(FLAGS_port_file);
   request.metrics = absl::GetFlag(FLAGS_metrics);
+  GatewayLimits& limits = request.limits;
+  limits.max_live_actors = absl::GetFlag(FLAGS_max_live_actors);
+  limits.max_envs_per_actor = absl::GetFlag(FLAGS_max_envs_per_actor);
+  limits.max_live_env_slots = absl::GetFlag(FLAGS_max_live_env_slots);
+  limits.actor_expiry = absl::Seconds(absl::GetFlag(FLAGS_actor_expiry_s));
+  limits.values.max_abs_observation = absl::GetFlag(FLAGS_max_abs_observation);
+  limits.values.max_abs_action = absl::GetFlag(FLAGS_max_abs_action);
+  limits.values.max_abs_reward = absl::GetFlag(FLAGS_max_abs_reward);
+  limits.values.max_abs_log_prob = absl::GetFlag(FLAGS_max_abs_log_prob);
+  request.service_limits.idle_stream_timeout =
+      absl::Seconds(absl::GetFlag(FLAGS_idle_stream_timeout_s));
+  request.max_server_threads = absl::GetFlag(FLAGS_max_server_threads);
+  request.max_grpc_memory_bytes = absl::GetFlag(FLAGS_max_grpc_memory_mb) << 20;
+  if (absl::Status status = limits.Validate();
+      !status.ok() ||
+      !(request.service_limits.idle_stream_timeout > absl::ZeroDuration()) ||
+      request.max_server_threads < 8 || request.max_grpc_memory_bytes < 1) {
+    std::fprintf(stderr, "vantage learner: %s\n",
+                 status.ok() ? "--idle_stream_timeout_s must be > 0, "
+                               "--max_server_threads >= 8 and "
+                               "--max_grpc_memory_mb >= 1"
+                             : std::string(status.message()).c_str());
+    return kUsageExitCode;
+  }
   if (!BuildSecurity("learner", /*server=*/true, request.security)) {
     return kUsageExitCode;
   }

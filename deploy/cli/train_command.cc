@@ -171,9 +171,19 @@ int RunLearnerCommand(const LearnerRequest& request) {
   absl::StatusOr<ResolvedRun> resolved = ResolveRequest(request.train);
   if (!resolved.ok()) return Fail(resolved.status().message());
   at::set_num_threads(1);
+  // The learner's own configuration pins the environment; no actor's
+  // registration decides it.
+  absl::StatusOr<std::unique_ptr<Environment>> env =
+      MakeEnvironment(resolved->config.env());
+  if (!env.ok()) return Fail(env.status().message());
   LearnerServerConfig server;
   server.training = resolved->local;
   server.run_config = resolved->config;
+  server.spec = (*env)->spec();
+  server.limits = request.limits;
+  server.service_limits = request.service_limits;
+  server.max_server_threads = request.max_server_threads;
+  server.max_grpc_memory_bytes = request.max_grpc_memory_bytes;
   server.listen = request.listen;
   server.port_file = request.port_file;
   server.security = request.security;

@@ -3,6 +3,7 @@
 
 #include <string>
 
+#include "learner/service/actor_gateway.h"
 #include "learner/service/security.h"
 #include "proto/run_config.pb.h"
 
@@ -32,6 +33,10 @@ struct LearnerRequest {
   std::string port_file;     // the bound port is written here
   std::string metrics;       // Prometheus HOST:PORT; empty: none
   SecurityOptions security;  // TLS and the token actors must send
+  GatewayLimits limits;      // what clients may make the learner hold
+  ServiceLimits service_limits;
+  int max_server_threads = 600;
+  int64_t max_grpc_memory_bytes = int64_t{1} << 30;
 };
 
 // `vantage learner`: serves actors (see deploy/learner_server.h) until the

@@ -62,11 +62,13 @@ AlgorithmStats A2cUpdater::Update(const UpdateBatch& batch, double progress,
     const at::Tensor entropy = policy_->Entropy(output).mean();
     const at::Tensor value_loss =
         ValueLoss(*value_, obs, batch.returns.slice(0, begin, begin + rows));
-    GradientStep(*optimizer_, parameters_,
-                 policy_loss + config_.value_coef * value_loss -
-                     config_.entropy_coef * entropy,
-                 config_.max_grad_norm);
+    const double gradient_norm =
+        GradientStep(*optimizer_, parameters_,
+                     policy_loss + config_.value_coef * value_loss -
+                         config_.entropy_coef * entropy,
+                     config_.max_grad_norm);
     AlgorithmStats step;
+    step.max_gradient_norm = gradient_norm;
     step.policy_loss = policy_loss.item<double>();
     step.value_loss = value_loss.item<double>();
     step.entropy = entropy.item<double>();

@@ -4,6 +4,8 @@
 #include <torch/optim/optimizer.h>
 #include <torch/serialize/archive.h>
 
+#include <cmath>
+
 #include "absl/strings/str_cat.h"
 #include "learner/archive_io.h"
 
@@ -15,13 +17,15 @@ at::Tensor ValueLoss(ValueNetworkImpl& value, const at::Tensor& observations,
   return 0.5 * (error * error).mean();
 }
 
-void GradientStep(torch::optim::Optimizer& optimizer,
-                  const std::vector<at::Tensor>& parameters,
-                  const at::Tensor& loss, double max_grad_norm) {
+double GradientStep(torch::optim::Optimizer& optimizer,
+                    const std::vector<at::Tensor>& parameters,
+                    const at::Tensor& loss, double max_grad_norm) {
   optimizer.zero_grad();
   loss.backward();
-  torch::nn::utils::clip_grad_norm_(parameters, max_grad_norm);
+  const double norm =
+      torch::nn::utils::clip_grad_norm_(parameters, max_grad_norm);
   optimizer.step();
+  return norm;
 }
 
 void SetLearningRate(torch::optim::Optimizer& optimizer, double learning_rate) {
@@ -43,6 +47,11 @@ void MeanStats::Add(const AlgorithmStats& stats) {
   sum_.entropy += stats.entropy;
   sum_.approx_kl += stats.approx_kl;
   sum_.clip_fraction += stats.clip_fraction;
+  // A NaN norm must stick, which std::max does not guarantee.
+  const double norm = stats.max_gradient_norm;
+  if (count_ == 0 || std::isnan(norm) || norm > sum_.max_gradient_norm) {
+    sum_.max_gradient_norm = norm;
+  }
   ++count_;
 }
 

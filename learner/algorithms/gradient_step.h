@@ -27,10 +27,11 @@ at::Tensor ValueLoss(ValueNetworkImpl& value, const at::Tensor& observations,
                      const at::Tensor& targets);
 
 // Zeroes the gradients, backpropagates `loss`, clips the global gradient
-// norm of `parameters` to `max_grad_norm` and steps.
-void GradientStep(torch::optim::Optimizer& optimizer,
-                  const std::vector<at::Tensor>& parameters,
-                  const at::Tensor& loss, double max_grad_norm);
+// norm of `parameters` to `max_grad_norm` and steps. Returns the norm before
+// clipping.
+double GradientStep(torch::optim::Optimizer& optimizer,
+                    const std::vector<at::Tensor>& parameters,
+                    const at::Tensor& loss, double max_grad_norm);
 
 // Sets every parameter group's learning rate.
 void SetLearningRate(torch::optim::Optimizer& optimizer, double learning_rate);
@@ -39,7 +40,8 @@ void SetLearningRate(torch::optim::Optimizer& optimizer, double learning_rate);
 std::vector<at::Tensor> JointParameters(PolicyNetworkImpl& policy,
                                         ValueNetworkImpl& value);
 
-// Averages per-minibatch statistics (a NaN field stays NaN).
+// Averages per-minibatch statistics (a NaN field stays NaN), except
+// max_gradient_norm, which is the largest (NaN if any was).
 class MeanStats {
  public:
   void Add(const AlgorithmStats& stats);

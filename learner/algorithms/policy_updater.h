@@ -37,6 +37,10 @@ struct AlgorithmStats {
   double entropy = 0.0;
   double approx_kl = 0.0;  // between the policy before and after
   double clip_fraction = 0.0;
+  // The largest global gradient norm (before clipping) of any gradient step
+  // of the policy; NaN where the algorithm takes none (TRPO's natural
+  // gradient step).
+  double max_gradient_norm = 0.0;
 };
 
 class PolicyUpdater {

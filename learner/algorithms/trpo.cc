@@ -90,6 +90,7 @@ AlgorithmStats TrpoUpdater::Update(const UpdateBatch& batch,
   }
   AlgorithmStats stats;
   stats.clip_fraction = std::numeric_limits<double>::quiet_NaN();
+  stats.max_gradient_norm = std::numeric_limits<double>::quiet_NaN();
   {
     at::NoGradGuard no_grad;
     stats.entropy = policy_->Entropy(policy_->forward(batch.observations))

@@ -2,6 +2,7 @@
 
 #include <ATen/ATen.h>
 
+#include <limits>
 #include <memory>
 
 #include "absl/strings/str_cat.h"
@@ -106,6 +107,20 @@ int64_t RolloutStitcher::DropStepsOlderThan(int64_t min_version) {
     }
   }
   stats_.stale_steps += dropped;
+  return dropped;
+}
+
+int64_t RolloutStitcher::ForgetActor(int64_t actor_id) {
+  constexpr int64_t kLowest = std::numeric_limits<int64_t>::min();
+  const auto begin = streams_.lower_bound({actor_id, kLowest});
+  auto end = begin;
+  int64_t dropped = 0;
+  while (end != streams_.end() && end->first.first == actor_id) {
+    dropped += end->second.steps;
+    ++end;
+  }
+  streams_.erase(begin, end);
+  stats_.dropped_steps += dropped;
   return dropped;
 }
 

@@ -59,6 +59,13 @@ class RolloutStitcher {
   // Returns the number of steps dropped (also in stats().stale_steps).
   int64_t DropStepsOlderThan(int64_t min_version);
 
+  // Frees every stream of `actor_id` (a registration that expired), with
+  // its buffered steps; returns how many were dropped (also counted in
+  // stats().dropped_steps). Its later segments would start new streams.
+  int64_t ForgetActor(int64_t actor_id);
+  // Streams with state, over all actors.
+  size_t stream_count() const { return streams_.size(); }
+
   // Steps waiting in partial rollouts, over all streams.
   int64_t buffered_steps() const;
   const StitcherStats& stats() const { return stats_; }

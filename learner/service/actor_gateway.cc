@@ -1,9 +1,12 @@
 #include "learner/service/actor_gateway.h"
 
+#include <random>
 #include <utility>
 
+#include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
-#include "proto/wire_format.h"
+#include "absl/strings/str_format.h"
+#include "learner/service/security.h"
 
 namespace vantage {
 namespace {
@@ -12,7 +15,40 @@ std::chrono::nanoseconds ToChrono(absl::Duration d) {
   return absl::ToChronoNanoseconds(d);
 }
 
+// 128 bits from the operating system's generator (std::random_device is
+// getrandom(2) on Linux), as 32 hex digits.
+std::string NewSecret() {
+  std::random_device device;
+  std::string secret;
+  for (int i = 0; i < 4; ++i) {
+    absl::StrAppendFormat(&secret, "%08x", static_cast<uint32_t>(device()));
+  }
+  return secret;
+}
+
+absl::Status AtLeastOne(int64_t value, const char* name) {
+  if (value < 1) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(name, " must be >= 1, got ", value));
+  }
+  return absl::OkStatus();
+}
+
 }  // namespace
+
+absl::Status GatewayLimits::Validate() const {
+  for (absl::Status status :
+       {AtLeastOne(max_live_actors, "max_live_actors"),
+        AtLeastOne(max_envs_per_actor, "max_envs_per_actor"),
+        AtLeastOne(max_live_env_slots, "max_live_env_slots"),
+        AtLeastOne(max_tensor_bytes, "max_tensor_bytes"), values.Validate()}) {
+    if (!status.ok()) return status;
+  }
+  if (actor_expiry <= absl::ZeroDuration()) {
+    return absl::InvalidArgumentError("actor_expiry must be > 0");
+  }
+  return absl::OkStatus();
+}
 
 ActorGateway::ActorGateway(GatewayConfig config, SegmentSink& sink)
     : config_(std::move(config)),
@@ -21,29 +57,53 @@ ActorGateway::ActorGateway(GatewayConfig config, SegmentSink& sink)
 
 absl::StatusOr<pb::RegisterResponse> ActorGateway::Register(
     const pb::RegisterRequest& request, absl::Duration timeout) {
-  absl::StatusOr<EnvSpec> spec = EnvSpecFromProto(request.spec());
-  if (!spec.ok()) return spec.status();
-  if (!config_.run_config.env().empty() &&
-      spec->name != config_.run_config.env()) {
-    return absl::InvalidArgumentError(absl::StrCat("this learner trains ",
-                                                   config_.run_config.env(),
-                                                   ", not ", spec->name));
+  auto refuse = [&](absl::Status status) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    ++counters_.refused_registrations;
+    return status;
+  };
+  absl::StatusOr<EnvSpec> spec =
+      EnvSpecFromProto(request.spec(), config_.limits.spec);
+  if (!spec.ok()) return refuse(spec.status());
+  if (spec->name != config_.spec.name) {
+    return refuse(absl::InvalidArgumentError(absl::StrCat(
+        "this learner trains ", config_.spec.name, ", not ", spec->name)));
+  }
+  if (absl::Status status = CheckSameSpec(config_.spec, *spec); !status.ok()) {
+    return refuse(status);
+  }
+  const int64_t num_envs = request.num_envs();
+  if (num_envs < 1 || num_envs > config_.limits.max_envs_per_actor) {
+    return refuse(absl::InvalidArgumentError(
+        absl::StrCat("num_envs is ", num_envs, ", expected 1..",
+                     config_.limits.max_envs_per_actor)));
   }
   int64_t actor_id = 0;
+  std::string secret = NewSecret();
   {
     std::unique_lock<std::mutex> lock(mutex_);
     if (closed_) return absl::UnavailableError("the learner is shutting down");
-    if (spec_.has_value()) {
-      if (absl::Status status = CheckSameSpec(*spec_, *spec); !status.ok()) {
-        return status;
-      }
-    } else {
-      spec_ = *spec;
-      changed_.notify_all();
+    if (static_cast<int64_t>(actors_.size()) >=
+            config_.limits.max_live_actors ||
+        counters_.live_env_slots + num_envs >
+            config_.limits.max_live_env_slots) {
+      ++counters_.refused_registrations;
+      return absl::ResourceExhaustedError(absl::StrCat(
+          "the learner serves at most ", config_.limits.max_live_actors,
+          " actors and ", config_.limits.max_live_env_slots,
+          " env slots at once (now ", actors_.size(), " and ",
+          counters_.live_env_slots,
+          "); registrations of departed actors expire after ",
+          absl::FormatDuration(config_.limits.actor_expiry)));
     }
     actor_id = next_actor_id_++;
-    actors_.insert(actor_id);
+    Registration& registration = actors_[actor_id];
+    registration.secret = secret;
+    registration.num_envs = num_envs;
+    registration.next_sequence.assign(num_envs, 0);
+    registration.last_seen = absl::Now();
     ++counters_.registrations;
+    counters_.live_env_slots += num_envs;
   }
   std::shared_ptr<const pb::Weights> weights =
       WaitForWeightsNewerThan(-1, timeout);
@@ -53,33 +113,104 @@ absl::StatusOr<pb::RegisterResponse> ActorGateway::Register(
   }
   pb::RegisterResponse response;
   response.set_actor_id(actor_id);
+  response.set_session(absl::StrCat(actor_id, ":", secret));
   *response.mutable_run_config() = config_.run_config;
   *response.mutable_weights() = *weights;
   return response;
 }
 
+absl::StatusOr<int64_t> ActorGateway::Attach(absl::string_view session) {
+  const size_t colon = session.find(':');
+  int64_t actor_id = -1;
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (colon == absl::string_view::npos ||
+      !absl::SimpleAtoi(session.substr(0, colon), &actor_id)) {
+    ++counters_.rejected["bad_session"];
+    return absl::PermissionDeniedError(
+        "the call carries no valid session; register first and send the "
+        "session it returned");
+  }
+  auto it = actors_.find(actor_id);
+  if (it == actors_.end()) {
+    ++counters_.rejected["unknown_session"];
+    return absl::NotFoundError(absl::StrCat(
+        "actor ", actor_id,
+        " has no live registration (never registered, or expired); "
+        "register again"));
+  }
+  if (!ConstantTimeEquals(session.substr(colon + 1), it->second.secret)) {
+    ++counters_.rejected["bad_session"];
+    return absl::PermissionDeniedError(
+        absl::StrCat("wrong session secret for actor ", actor_id));
+  }
+  ++it->second.open_calls;
+  it->second.last_seen = absl::Now();
+  return actor_id;
+}
+
+void ActorGateway::Detach(int64_t actor_id) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  auto it = actors_.find(actor_id);
+  if (it == actors_.end()) return;
+  --it->second.open_calls;
+  it->second.last_seen = absl::Now();
+}
+
+std::vector<int64_t> ActorGateway::ExpireIdle(absl::Time now) {
+  std::vector<int64_t> expired;
+  std::lock_guard<std::mutex> lock(mutex_);
+  for (auto it = actors_.begin(); it != actors_.end();) {
+    const Registration& registration = it->second;
+    if (registration.open_calls == 0 &&
+        now - registration.last_seen > config_.limits.actor_expiry) {
+      expired.push_back(it->first);
+      counters_.live_env_slots -= registration.num_envs;
+      ++counters_.expirations;
+      it = actors_.erase(it);
+    } else {
+      ++it;
+    }
+  }
+  return expired;
+}
+
 absl::Status ActorGateway::Reject(const std::string& reason,
                                   absl::Status status) {
-  std::lock_guard<std::mutex> lock(mutex_);
-  ++counters_.rejected[reason];
+  CountRejected(reason);
   return status;
 }
 
-absl::Status ActorGateway::Admit(const pb::Segment& proto,
+void ActorGateway::CountRejected(const std::string& reason) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  ++counters_.rejected[reason];
+}
+
+absl::Status ActorGateway::Admit(int64_t actor_id, const pb::Segment& proto,
                                  std::string* dropped) {
   if (dropped != nullptr) dropped->clear();
   int64_t newest = -1;
-  std::optional<EnvSpec> spec;
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    if (actors_.count(proto.actor_id()) == 0) {
-      ++counters_.rejected["unknown_actor"];
-      return absl::FailedPreconditionError(
-          absl::StrCat("segment.actor_id ", proto.actor_id(),
-                       " is not registered with this learner; register first"));
+    auto it = actors_.find(actor_id);
+    if (it == actors_.end()) {
+      ++counters_.rejected["unknown_session"];
+      return absl::NotFoundError(absl::StrCat(
+          "actor ", actor_id, "'s registration expired; register again"));
     }
+    if (proto.actor_id() != actor_id) {
+      ++counters_.rejected["foreign_actor"];
+      return absl::PermissionDeniedError(absl::StrCat(
+          "segment.actor_id ", proto.actor_id(),
+          " does not belong to this stream, which is actor ", actor_id, "'s"));
+    }
+    if (proto.env_slot() < 0 || proto.env_slot() >= it->second.num_envs) {
+      ++counters_.rejected["foreign_slot"];
+      return absl::PermissionDeniedError(absl::StrCat(
+          "segment.env_slot ", proto.env_slot(), " is not one of actor ",
+          actor_id, "'s ", it->second.num_envs, " env slots"));
+    }
+    it->second.last_seen = absl::Now();
     newest = weights_ == nullptr ? -1 : weights_->version();
-    spec = spec_;
   }
   if (proto.policy_version() > newest) {
     return Reject("future_version",
@@ -88,23 +219,44 @@ absl::Status ActorGateway::Admit(const pb::Segment& proto,
                       " has not been published (newest: ", newest, ")")));
   }
   absl::StatusOr<Segment> segment =
-      SegmentFromProto(proto, config_.max_tensor_bytes);
+      SegmentFromProto(proto, config_.limits.max_tensor_bytes);
   if (!segment.ok()) return Reject("malformed", segment.status());
   if (absl::Status status =
-          ValidateSegment(*segment, *spec, config_.max_segment_steps);
+          ValidateSegment(*segment, config_.spec, config_.max_segment_steps,
+                          config_.limits.values);
       !status.ok()) {
     return Reject("invalid", status);
   }
+  auto drop = [&](const std::string& reason, std::string why) {
+    if (dropped != nullptr) *dropped = std::move(why);
+    CountRejected(reason);
+    return absl::OkStatus();
+  };
   if (config_.max_policy_lag >= 0 &&
       segment->policy_version < newest - config_.max_policy_lag) {
-    if (dropped != nullptr) {
-      *dropped = absl::StrCat(
-          "segment.policy_version ", segment->policy_version, " is more than ",
-          config_.max_policy_lag, " versions behind the newest (", newest, ")");
-    }
+    return drop("stale",
+                absl::StrCat("segment.policy_version ", segment->policy_version,
+                             " is more than ", config_.max_policy_lag,
+                             " versions behind the newest (", newest, ")"));
+  }
+  {
+    // Sequence numbers only grow along a slot's stream (a jump starts a
+    // new stream); one already admitted would be stitched twice.
     std::lock_guard<std::mutex> lock(mutex_);
-    ++counters_.rejected["stale"];
-    return absl::OkStatus();
+    auto it = actors_.find(actor_id);
+    if (it != actors_.end()) {
+      int64_t& next = it->second.next_sequence[segment->env_slot];
+      if (segment->sequence < next) {
+        ++counters_.rejected["duplicate"];
+        if (dropped != nullptr) {
+          *dropped = absl::StrCat("segment.sequence ", segment->sequence,
+                                  " of slot ", segment->env_slot,
+                                  " was already admitted (next: ", next, ")");
+        }
+        return absl::OkStatus();
+      }
+      next = segment->sequence + 1;
+    }
   }
   const int64_t steps = segment->steps();
   if (absl::Status status = sink_.Send(*std::move(segment)); !status.ok()) {
@@ -114,19 +266,6 @@ absl::Status ActorGateway::Admit(const pb::Segment& proto,
   ++counters_.accepted_segments;
   counters_.accepted_steps += steps;
   return absl::OkStatus();
-}
-
-std::optional<EnvSpec> ActorGateway::WaitForSpec(absl::Duration timeout) {
-  std::unique_lock<std::mutex> lock(mutex_);
-  changed_.wait_for(lock, ToChrono(timeout),
-                    [&] { return spec_.has_value() || closed_; });
-  return spec_;
-}
-
-void ActorGateway::SetSpec(const EnvSpec& spec) {
-  std::lock_guard<std::mutex> lock(mutex_);
-  spec_ = spec;
-  changed_.notify_all();
 }
 
 void ActorGateway::Publish(const PolicyWeights& weights) {
@@ -170,7 +309,9 @@ bool ActorGateway::closed() const {
 
 GatewayCounters ActorGateway::counters() const {
   std::lock_guard<std::mutex> lock(mutex_);
-  return counters_;
+  GatewayCounters counters = counters_;
+  counters.live_actors = static_cast<int64_t>(actors_.size());
+  return counters;
 }
 
 }  // namespace vantage

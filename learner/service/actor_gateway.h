@@ -2,46 +2,86 @@
 #define VANTAGE_LEARNER_SERVICE_ACTOR_GATEWAY_H_
 
 // Everything the learner's gRPC service does, without gRPC: actor
-// registration, admission of segments into the learner's queue, and the
-// board of published weights. The service methods only translate.
+// registration and the sessions it hands out, admission of segments into
+// the learner's queue, and the board of published weights. The service
+// methods only translate.
 
 #include <condition_variable>
 #include <cstdint>
 #include <map>
 #include <memory>
 #include <mutex>
-#include <optional>
-#include <set>
 #include <string>
+#include <vector>
 
 #include "absl/status/statusor.h"
+#include "absl/strings/string_view.h"
 #include "absl/time/time.h"
 #include "common/env/environment.h"
 #include "common/nn/policy_weights.h"
+#include "common/rollout/segment.h"
 #include "common/rollout/segment_queue.h"
 #include "proto/run_config.pb.h"
 #include "proto/vantage.pb.h"
+#include "proto/wire_format.h"
 
 namespace vantage {
 
+// What one client can make the learner hold. Defaults suit a cluster run of
+// a few hundred actors; every one is a flag of `vantage learner`.
+struct GatewayLimits {
+  int64_t max_live_actors = 256;
+  int64_t max_envs_per_actor = 1024;
+  // Env streams over all live registrations: each may buffer up to a
+  // horizon of steps in the learner, so this bounds that memory.
+  int64_t max_live_env_slots = 4096;
+  // A registration with no open call for this long expires: its session
+  // stops working and the learner frees what it buffered for it.
+  absl::Duration actor_expiry = absl::Seconds(60);
+  int64_t max_tensor_bytes = 64 << 20;
+  SpecLimits spec;
+  ValueLimits values;
+
+  absl::Status Validate() const;
+};
+
+// Limits of the gRPC service around a gateway (see LearnerService); here so
+// that configuring them needs no gRPC headers.
+struct ServiceLimits {
+  // A segment stream that delivers nothing for this long is cancelled
+  // (actors send at least one segment per policy version).
+  absl::Duration idle_stream_timeout = absl::Seconds(300);
+  // Bytes of one segment message (see MaxSegmentMessageBytes).
+  int64_t max_segment_message_bytes = 64 << 20;
+  // Register and weights requests are a few hundred bytes.
+  int64_t max_request_bytes = 64 << 10;
+};
+
 struct GatewayConfig {
   pb::RunConfig run_config;  // resolved; sent to every registering actor
+  // The run's environment, pinned by the learner's own configuration (or
+  // its checkpoint); registrations must match it exactly.
+  EnvSpec spec;
   int64_t max_segment_steps = 4096;
-  int64_t max_tensor_bytes = 64 << 20;
   // Segments older than the newest version minus this are dropped and
   // counted (not an error for the actor); -1: any age.
   int64_t max_policy_lag = 0;
   // Ids are never reused within a run: a resumed learner continues after
   // the ids its checkpoint had handed out.
   int64_t first_actor_id = 0;
+  GatewayLimits limits;
 };
 
-// Why segments were refused, for logs and metrics.
+// What the gateway saw, for logs, acks and metrics.
 struct GatewayCounters {
-  int64_t registrations = 0;
+  int64_t registrations = 0;  // granted, over the run of this process
+  int64_t refused_registrations = 0;
+  int64_t expirations = 0;
+  int64_t live_actors = 0;  // registrations not expired
+  int64_t live_env_slots = 0;
   int64_t accepted_segments = 0;
   int64_t accepted_steps = 0;
-  std::map<std::string, int64_t> rejected;  // reason -> segments
+  std::map<std::string, int64_t> rejected;  // reason -> segments or calls
 };
 
 class ActorGateway {
@@ -50,26 +90,40 @@ class ActorGateway {
   // reaches the actors through their streams).
   ActorGateway(GatewayConfig config, SegmentSink& sink);
 
-  // The first registration fixes the environment spec (unless the run
-  // already has one); later ones must match it (InvalidArgument naming the
-  // field). Answers once the first weights are published; Unavailable if
-  // none arrive within `timeout`.
+  // Checks the spec against the run's (InvalidArgument naming the field)
+  // and num_envs against the limits, then grants an actor id and a secret
+  // session (ResourceExhausted when the live actors or env slots are at
+  // their limit). Answers once the first weights are published;
+  // Unavailable if none arrive within `timeout`.
   absl::StatusOr<pb::RegisterResponse> Register(
       const pb::RegisterRequest& request, absl::Duration timeout);
 
-  // Decodes and validates one segment and hands it to the learner.
-  // InvalidArgument (malformed, or wrong for the spec) and
-  // FailedPrecondition (unknown actor, a version not published yet) name
-  // the problem; too stale a version is dropped with OK and, if `dropped`
-  // is not null, *dropped says why (else it is cleared). Every refusal is
-  // counted by reason.
-  absl::Status Admit(const pb::Segment& segment,
-                     std::string* dropped = nullptr);
+  // Binds a call to the registration whose session it carries and keeps
+  // that registration alive until Detach. NotFound for a session that is
+  // unknown or expired (register again), PermissionDenied for a wrong
+  // secret; both counted.
+  absl::StatusOr<int64_t> Attach(absl::string_view session);
+  void Detach(int64_t actor_id);
 
-  // The spec, once known.
-  std::optional<EnvSpec> WaitForSpec(absl::Duration timeout);
-  // Fixes the spec up front (a resumed run knows it from its checkpoint).
-  void SetSpec(const EnvSpec& spec);
+  // Decodes and validates one segment of a stream bound to `actor_id` and
+  // hands it to the learner. PermissionDenied for a segment of another
+  // actor or of a slot the registration does not have; InvalidArgument
+  // (malformed, or wrong for the spec) and FailedPrecondition (a version
+  // not published yet) name the problem. A too stale version or an already
+  // admitted sequence number is dropped with OK and, if `dropped` is not
+  // null, *dropped says why (else it is cleared). Every refusal and drop is
+  // counted by reason.
+  absl::Status Admit(int64_t actor_id, const pb::Segment& segment,
+                     std::string* dropped = nullptr);
+  // Counts a refusal that happened before Admit (for example, bytes that
+  // are no segment at all).
+  void CountRejected(const std::string& reason);
+
+  // Expires the registrations idle since before now - actor_expiry and
+  // returns their ids (each once), so that the learner can free them.
+  std::vector<int64_t> ExpireIdle(absl::Time now = absl::Now());
+
+  const EnvSpec& spec() const { return config_.spec; }
 
   void Publish(const PolicyWeights& weights);
   // The newest weights if newer than `version`, waiting up to `timeout`;
@@ -87,14 +141,22 @@ class ActorGateway {
   GatewayCounters counters() const;
 
  private:
+  struct Registration {
+    std::string secret;
+    int64_t num_envs = 0;
+    // Per env slot: the lowest sequence number not yet admitted.
+    std::vector<int64_t> next_sequence;
+    int64_t open_calls = 0;
+    absl::Time last_seen;
+  };
+
   absl::Status Reject(const std::string& reason, absl::Status status);
 
   const GatewayConfig config_;
   SegmentSink& sink_;
   mutable std::mutex mutex_;
   std::condition_variable changed_;
-  std::optional<EnvSpec> spec_;
-  std::set<int64_t> actors_;
+  std::map<int64_t, Registration> actors_;
   int64_t next_actor_id_ = 0;
   std::shared_ptr<const pb::Weights> weights_;
   bool closed_ = false;

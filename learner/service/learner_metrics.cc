@@ -15,7 +15,9 @@ namespace {
 // The reasons the gateway refuses segments for; created up front so that
 // their series exist (at 0) before the first refusal and rate() works.
 constexpr const char* kKnownRejectReasons[] = {
-    "malformed", "invalid", "unknown_actor", "future_version", "stale"};
+    "malformed",      "invalid",      "unparsable",  "oversized",
+    "foreign_actor",  "foreign_slot", "bad_session", "unknown_session",
+    "future_version", "stale",        "duplicate",   "idle_stream"};
 
 prometheus::Counter& AddCounter(prometheus::Registry& registry,
                                 const std::string& name,
@@ -84,8 +86,18 @@ LearnerMetrics::LearnerMetrics()
                           "Updates made by this learner process.")),
       episodes_(AddCounter(*registry_, "episodes_total",
                            "Episodes finished in consumed segments.")),
-      actors_registered_(AddGauge(*registry_, "actors_registered",
-                                  "Actors registered with the learner.")) {
+      live_actors_(AddGauge(*registry_, "live_actors",
+                            "Actor registrations that have not expired.")),
+      live_streams_(AddGauge(*registry_, "live_streams",
+                             "Open segment streams and weight subscriptions "
+                             "of registered actors.")),
+      registrations_(AddCounter(*registry_, "registrations_total",
+                                "Actor registrations granted.")),
+      expirations_(AddCounter(*registry_, "registration_expirations_total",
+                              "Registrations expired after their actor left.")),
+      rolled_back_updates_(AddCounter(
+          *registry_, "rolled_back_updates_total",
+          "Updates undone because they produced non-finite numbers.")) {
   for (const char* reason : kKnownRejectReasons) RejectedCounter(reason);
 }
 
@@ -166,8 +178,20 @@ void LearnerMetrics::SetQueueDepth(int64_t segments, int64_t buffered_steps) {
   buffered_steps_.Set(static_cast<double>(buffered_steps));
 }
 
-void LearnerMetrics::SetActorsRegistered(int64_t n) {
-  actors_registered_.Set(static_cast<double>(n));
+void LearnerMetrics::RecordActors(const Actors& actors) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  live_actors_.Set(static_cast<double>(actors.live_actors));
+  live_streams_.Set(static_cast<double>(actors.live_streams));
+  registrations_.Increment(static_cast<double>(
+      registrations_total_.Advance(actors.registrations_total)));
+  expirations_.Increment(static_cast<double>(
+      expirations_total_.Advance(actors.expirations_total)));
+}
+
+void LearnerMetrics::RecordRolledBackUpdates(int64_t total) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  rolled_back_updates_.Increment(
+      static_cast<double>(rolled_back_total_.Advance(total)));
 }
 
 prometheus::Counter& LearnerMetrics::RejectedCounter(

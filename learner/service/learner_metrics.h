@@ -50,8 +50,9 @@ class LearnerMetrics {
                     double mean_return, double steps_per_second);
   // Running total of segments admitted into the learner's queue.
   void RecordSegmentsAccepted(int64_t total_segments);
-  // Running totals of refused segments by reason (the gateway's "malformed",
-  // "invalid", "unknown_actor", "future_version", "stale", or any other).
+  // Running totals of refused segments and calls by reason (the gateway's
+  // "malformed", "invalid", "foreign_actor", "foreign_slot", "stale", ...;
+  // docs/security.md lists them).
   // Each reason's total must come from a single counting source.
   void RecordRejected(const std::map<std::string, int64_t>& totals_by_reason);
   // Versions between the newest policy and the one that acted an admitted
@@ -60,7 +61,18 @@ class LearnerMetrics {
   // Segments waiting in the learner's queue, and steps held in the
   // stitcher's buffers and pending rollouts.
   void SetQueueDepth(int64_t segments, int64_t buffered_steps);
-  void SetActorsRegistered(int64_t n);
+  // Who is connected: live registrations, their open segment streams and
+  // weight subscriptions, and the running totals of registrations granted
+  // and expired.
+  struct Actors {
+    int64_t live_actors = 0;
+    int64_t live_streams = 0;
+    int64_t registrations_total = 0;
+    int64_t expirations_total = 0;
+  };
+  void RecordActors(const Actors& actors);
+  // Running total of updates undone for non-finite numbers.
+  void RecordRolledBackUpdates(int64_t total);
 
  private:
   LearnerMetrics();
@@ -80,7 +92,11 @@ class LearnerMetrics {
   prometheus::Gauge& steps_per_second_;
   prometheus::Counter& updates_;
   prometheus::Counter& episodes_;
-  prometheus::Gauge& actors_registered_;
+  prometheus::Gauge& live_actors_;
+  prometheus::Gauge& live_streams_;
+  prometheus::Counter& registrations_;
+  prometheus::Counter& expirations_;
+  prometheus::Counter& rolled_back_updates_;
 
   // Guards the totals: the learner loop and the gRPC threads both report.
   std::mutex mutex_;
@@ -88,6 +104,9 @@ class LearnerMetrics {
   RunningTotal env_steps_total_;
   RunningTotal episodes_total_;
   RunningTotal segments_accepted_total_;
+  RunningTotal registrations_total_;
+  RunningTotal expirations_total_;
+  RunningTotal rolled_back_total_;
   std::map<std::string, RunningTotal> rejected_totals_;
   std::map<std::string, prometheus::Counter*> rejected_counters_;
 

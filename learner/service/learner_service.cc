@@ -1,6 +1,13 @@
 #include "learner/service/learner_service.h"
 
+#include <grpcpp/support/proto_buffer_reader.h>
+
+#include <algorithm>
+#include <exception>
+#include <limits>
+#include <new>
 #include <string>
+#include <vector>
 
 #include "absl/strings/str_cat.h"
 
@@ -11,6 +18,45 @@ namespace {
 constexpr absl::Duration kPoll = absl::Milliseconds(200);
 // How long a registration may wait for the learner's first weights.
 constexpr absl::Duration kRegistrationWait = absl::Seconds(60);
+// StreamSegments' index in the service definition (proto/vantage.proto).
+constexpr int kStreamSegmentsMethod = 1;
+
+// Runs a handler body; an exception (an allocation that failed, a LibTorch
+// error nobody foresaw) becomes an error reply and a count instead of
+// leaving the server with gRPC's bare UNKNOWN.
+template <typename Body>
+grpc::Status Guarded(ActorGateway& gateway, Body body) {
+  try {
+    return body();
+  } catch (const std::bad_alloc&) {
+    gateway.CountRejected("out_of_memory");
+    return grpc::Status(grpc::StatusCode::RESOURCE_EXHAUSTED,
+                        "the learner could not allocate memory for this call");
+  } catch (const std::exception& e) {
+    gateway.CountRejected("internal_error");
+    return grpc::Status(grpc::StatusCode::INTERNAL,
+                        absl::StrCat("learner error: ", e.what()));
+  }
+}
+
+template <typename Request>
+grpc::Status CheckRequestSize(const Request& request, int64_t limit,
+                              const char* what) {
+  const size_t bytes = request.ByteSizeLong();
+  if (static_cast<int64_t>(bytes) > limit) {
+    return grpc::Status(grpc::StatusCode::INVALID_ARGUMENT,
+                        absl::StrCat(what, " of ", bytes,
+                                     " bytes exceeds the limit of ", limit));
+  }
+  return grpc::Status::OK;
+}
+
+absl::string_view SessionOf(const grpc::ServerContext& context) {
+  const auto& metadata = context.client_metadata();
+  auto it = metadata.find(kSessionMetadataKey);
+  if (it == metadata.end()) return absl::string_view();
+  return absl::string_view(it->second.data(), it->second.size());
+}
 
 }  // namespace
 
@@ -20,72 +66,218 @@ grpc::Status ToGrpcStatus(const absl::Status& status) {
                       std::string(status.message()));
 }
 
-grpc::Status LearnerService::Register(grpc::ServerContext* context,
-                                      const pb::RegisterRequest* request,
-                                      pb::RegisterResponse* response) {
+LearnerService::LearnerService(ActorGateway& gateway, ServiceLimits limits)
+    : gateway_(gateway), limits_(limits) {
+  // Raw bytes instead of pb::Segment: gRPC's own decoding ends a stream
+  // whose bytes do not parse as if the client had finished it.
+  MarkMethodStreamed(
+      kStreamSegmentsMethod,
+      new grpc::internal::ClientStreamingHandler<
+          LearnerService, grpc::ByteBuffer, pb::SegmentAck>(
+          [](LearnerService* service, grpc::ServerContext* context,
+             grpc::ServerReader<grpc::ByteBuffer>* reader,
+             pb::SegmentAck* ack) {
+            return service->SegmentStream(context, reader, ack);
+          },
+          this));
+}
+
+grpc::Status LearnerService::StreamedRegister(
+    grpc::ServerContext* context,
+    grpc::ServerUnaryStreamer<pb::RegisterRequest, pb::RegisterResponse>*
+        streamer) {
   if (grpc::Status auth = CheckAuthToken(*context, auth_token_); !auth.ok()) {
     return auth;
   }
-  absl::StatusOr<pb::RegisterResponse> registered =
-      gateway_.Register(*request, kRegistrationWait);
-  if (!registered.ok()) return ToGrpcStatus(registered.status());
-  *response = *std::move(registered);
-  return grpc::Status::OK;
+  return Guarded(gateway_, [&] {
+    pb::RegisterRequest request;
+    if (!streamer->Read(&request)) {
+      return grpc::Status(grpc::StatusCode::INVALID_ARGUMENT,
+                          "no readable RegisterRequest");
+    }
+    if (grpc::Status size = CheckRequestSize(request, limits_.max_request_bytes,
+                                             "RegisterRequest");
+        !size.ok()) {
+      return size;
+    }
+    absl::StatusOr<pb::RegisterResponse> registered =
+        gateway_.Register(request, kRegistrationWait);
+    if (!registered.ok()) return ToGrpcStatus(registered.status());
+    streamer->Write(*registered);
+    return grpc::Status::OK;
+  });
 }
 
-grpc::Status LearnerService::StreamSegments(
-    grpc::ServerContext* context, grpc::ServerReader<pb::Segment>* reader,
+absl::StatusOr<int64_t> LearnerService::OpenBoundCall(
+    grpc::ServerContext& context, CallKind kind, int64_t& actor_id) {
+  absl::StatusOr<int64_t> attached = gateway_.Attach(SessionOf(context));
+  if (!attached.ok()) return attached.status();
+  actor_id = *attached;
+  std::lock_guard<std::mutex> lock(calls_mutex_);
+  // One call of each kind per actor: an actor that reconnects leaves its
+  // old call behind, and a client that opens many holds only one thread.
+  for (auto& [key, call] : calls_) {
+    if (call.actor_id == actor_id && call.kind == kind) {
+      call.context->TryCancel();
+    }
+  }
+  const int64_t key = next_call_key_++;
+  calls_[key] = {&context, kind, actor_id, absl::Now()};
+  return key;
+}
+
+void LearnerService::Touch(int64_t key) {
+  std::lock_guard<std::mutex> lock(calls_mutex_);
+  auto it = calls_.find(key);
+  if (it != calls_.end()) it->second.last_activity = absl::Now();
+}
+
+void LearnerService::CloseBoundCall(int64_t key, int64_t actor_id) {
+  {
+    std::lock_guard<std::mutex> lock(calls_mutex_);
+    calls_.erase(key);
+  }
+  gateway_.Detach(actor_id);
+}
+
+int LearnerService::CancelIdleStreams(absl::Time now) {
+  int cancelled = 0;
+  std::lock_guard<std::mutex> lock(calls_mutex_);
+  for (auto& [key, call] : calls_) {
+    if (call.kind == CallKind::kSegments &&
+        now - call.last_activity > limits_.idle_stream_timeout) {
+      call.context->TryCancel();
+      // Counted once: the entry's clock restarts until its handler ends.
+      call.last_activity = now;
+      gateway_.CountRejected("idle_stream");
+      ++cancelled;
+    }
+  }
+  return cancelled;
+}
+
+int64_t LearnerService::open_streams() const {
+  std::lock_guard<std::mutex> lock(calls_mutex_);
+  return static_cast<int64_t>(calls_.size());
+}
+
+grpc::Status LearnerService::SegmentStream(
+    grpc::ServerContext* context, grpc::ServerReader<grpc::ByteBuffer>* reader,
     pb::SegmentAck* ack) {
   if (grpc::Status auth = CheckAuthToken(*context, auth_token_); !auth.ok()) {
     return auth;
   }
-  pb::Segment segment;
-  std::string dropped;
-  while (reader->Read(&segment)) {
-    if (absl::Status status = gateway_.Admit(segment, &dropped); !status.ok()) {
-      return ToGrpcStatus(status);
+  int64_t actor_id = -1;
+  absl::StatusOr<int64_t> key =
+      OpenBoundCall(*context, CallKind::kSegments, actor_id);
+  if (!key.ok()) return ToGrpcStatus(key.status());
+  const grpc::Status status = Guarded(gateway_, [&] {
+    grpc::ByteBuffer bytes;
+    pb::Segment segment;
+    std::string dropped;
+    while (reader->Read(&bytes)) {
+      Touch(*key);
+      if (static_cast<int64_t>(bytes.Length()) >
+          limits_.max_segment_message_bytes) {
+        gateway_.CountRejected("oversized");
+        return grpc::Status(
+            grpc::StatusCode::INVALID_ARGUMENT,
+            absl::StrCat("a segment message of ", bytes.Length(),
+                         " bytes exceeds this run's limit of ",
+                         limits_.max_segment_message_bytes));
+      }
+      grpc::ProtoBufferReader input(&bytes);
+      if (!segment.ParseFromZeroCopyStream(&input)) {
+        gateway_.CountRejected("unparsable");
+        return grpc::Status(
+            grpc::StatusCode::INVALID_ARGUMENT,
+            absl::StrCat("message ", ack->accepted() + ack->rejected(),
+                         " of the stream is not a Segment"));
+      }
+      if (absl::Status admitted = gateway_.Admit(actor_id, segment, &dropped);
+          !admitted.ok()) {
+        return ToGrpcStatus(admitted);
+      }
+      if (dropped.empty()) {
+        ack->set_accepted(ack->accepted() + 1);
+      } else {
+        ack->set_rejected(ack->rejected() + 1);
+        ack->set_last_error(dropped);
+      }
     }
-    if (dropped.empty()) {
-      ack->set_accepted(ack->accepted() + 1);
-    } else {
-      ack->set_rejected(ack->rejected() + 1);
-      ack->set_last_error(dropped);
+    if (context->IsCancelled()) {
+      return grpc::Status(grpc::StatusCode::CANCELLED,
+                          "the learner ended this stream (idle, or the same "
+                          "actor opened a newer one)");
     }
-  }
-  return grpc::Status::OK;
+    return grpc::Status::OK;
+  });
+  CloseBoundCall(*key, actor_id);
+  return status;
 }
 
-grpc::Status LearnerService::SubscribeWeights(
-    grpc::ServerContext* context, const pb::WeightsRequest* request,
-    grpc::ServerWriter<pb::Weights>* writer) {
+grpc::Status LearnerService::StreamedSubscribeWeights(
+    grpc::ServerContext* context,
+    grpc::ServerSplitStreamer<pb::WeightsRequest, pb::Weights>* streamer) {
   if (grpc::Status auth = CheckAuthToken(*context, auth_token_); !auth.ok()) {
     return auth;
   }
-  int64_t known = request->known_version();
-  while (!context->IsCancelled() && !gateway_.closed()) {
+  int64_t actor_id = -1;
+  absl::StatusOr<int64_t> key =
+      OpenBoundCall(*context, CallKind::kWeights, actor_id);
+  if (!key.ok()) return ToGrpcStatus(key.status());
+  const grpc::Status status = Guarded(gateway_, [&] {
+    pb::WeightsRequest request;
+    if (!streamer->Read(&request)) {
+      return grpc::Status(grpc::StatusCode::INVALID_ARGUMENT,
+                          "no readable WeightsRequest");
+    }
+    if (grpc::Status size = CheckRequestSize(request, limits_.max_request_bytes,
+                                             "WeightsRequest");
+        !size.ok()) {
+      return size;
+    }
+    int64_t known = request.known_version();
+    while (!context->IsCancelled() && !gateway_.closed()) {
+      std::shared_ptr<const pb::Weights> weights =
+          gateway_.WaitForWeightsNewerThan(known, kPoll);
+      if (weights == nullptr) continue;
+      if (!streamer->Write(*weights)) break;
+      Touch(*key);
+      known = weights->version();
+    }
+    return grpc::Status::OK;
+  });
+  CloseBoundCall(*key, actor_id);
+  return status;
+}
+
+grpc::Status LearnerService::StreamedGetWeights(
+    grpc::ServerContext* context,
+    grpc::ServerUnaryStreamer<pb::WeightsRequest, pb::Weights>* streamer) {
+  if (grpc::Status auth = CheckAuthToken(*context, auth_token_); !auth.ok()) {
+    return auth;
+  }
+  return Guarded(gateway_, [&] {
+    pb::WeightsRequest request;
+    if (!streamer->Read(&request)) {
+      return grpc::Status(grpc::StatusCode::INVALID_ARGUMENT,
+                          "no readable WeightsRequest");
+    }
+    if (grpc::Status size = CheckRequestSize(request, limits_.max_request_bytes,
+                                             "WeightsRequest");
+        !size.ok()) {
+      return size;
+    }
     std::shared_ptr<const pb::Weights> weights =
-        gateway_.WaitForWeightsNewerThan(known, kPoll);
-    if (weights == nullptr) continue;
-    if (!writer->Write(*weights)) break;
-    known = weights->version();
-  }
-  return grpc::Status::OK;
-}
-
-grpc::Status LearnerService::GetWeights(grpc::ServerContext* context,
-                                        const pb::WeightsRequest* request,
-                                        pb::Weights* response) {
-  if (grpc::Status auth = CheckAuthToken(*context, auth_token_); !auth.ok()) {
-    return auth;
-  }
-  std::shared_ptr<const pb::Weights> weights =
-      gateway_.WaitForWeightsNewerThan(-1, absl::ZeroDuration());
-  if (weights == nullptr) {
-    return grpc::Status(grpc::StatusCode::UNAVAILABLE,
-                        "the learner has published no weights yet");
-  }
-  *response = *weights;
-  return grpc::Status::OK;
+        gateway_.WaitForWeightsNewerThan(-1, absl::ZeroDuration());
+    if (weights == nullptr) {
+      return grpc::Status(grpc::StatusCode::UNAVAILABLE,
+                          "the learner has published no weights yet");
+    }
+    streamer->Write(*weights);
+    return grpc::Status::OK;
+  });
 }
 
 absl::StatusOr<RunningServer> StartServer(const ServerOptions& options,
@@ -97,8 +289,18 @@ absl::StatusOr<RunningServer> StartServer(const ServerOptions& options,
   RunningServer running;
   grpc::ServerBuilder builder;
   builder.AddListeningPort(options.listen, *credentials, &running.port);
-  builder.SetMaxReceiveMessageSize(options.max_message_bytes);
-  builder.SetMaxSendMessageSize(options.max_message_bytes);
+  builder.SetMaxReceiveMessageSize(static_cast<int>(std::min<int64_t>(
+      options.max_receive_message_bytes, std::numeric_limits<int>::max())));
+  builder.SetMaxSendMessageSize(static_cast<int>(std::min<int64_t>(
+      options.max_send_message_bytes, std::numeric_limits<int>::max())));
+  // Past max_threads, new calls are refused with RESOURCE_EXHAUSTED
+  // instead of a thread each; the memory quota bounds gRPC's buffers.
+  grpc::ResourceQuota quota("vantage-learner");
+  quota.SetMaxThreads(options.max_threads);
+  quota.Resize(static_cast<size_t>(options.max_memory_bytes));
+  builder.SetResourceQuota(quota);
+  // An actor keeps three calls open on one connection.
+  builder.AddChannelArgument(GRPC_ARG_MAX_CONCURRENT_STREAMS, 16);
   builder.RegisterService(&service);
   running.server = builder.BuildAndStart();
   if (running.server == nullptr || running.port == 0) {

@@ -3,10 +3,14 @@
 
 #include <grpcpp/grpcpp.h>
 
+#include <cstdint>
+#include <map>
 #include <memory>
+#include <mutex>
 #include <string>
 
 #include "absl/status/statusor.h"
+#include "absl/time/time.h"
 #include "learner/service/actor_gateway.h"
 #include "learner/service/security.h"
 #include "proto/vantage.grpc.pb.h"
@@ -16,40 +20,82 @@ namespace vantage {
 // absl::Status -> grpc::Status with the same code and message.
 grpc::Status ToGrpcStatus(const absl::Status& status);
 
-// The gRPC face of an ActorGateway; every method only translates, after
-// checking the auth token (if one is required).
-class LearnerService final : public pb::Learner::Service {
+// The metadata entry that carries a registration's session.
+inline constexpr char kSessionMetadataKey[] = "vantage-session";
+
+// The gRPC face of an ActorGateway. Every method checks the auth token (if
+// one is required) before it reads the request, and runs in its own
+// server thread: the unary methods and SubscribeWeights use gRPC's streamed
+// handlers, whose request is read only when the method asks for it, and
+// StreamSegments reads raw bytes, so that bytes which are no segment are
+// an INVALID_ARGUMENT reply instead of a silently ended stream. Errors the
+// gateway does not foresee (an allocation failure) are replies too.
+class LearnerService final : public pb::Learner::StreamedService {
  public:
-  explicit LearnerService(ActorGateway& gateway) : gateway_(gateway) {}
+  explicit LearnerService(ActorGateway& gateway,
+                          ServiceLimits limits = ServiceLimits());
 
   // Every call must then carry `authorization: Bearer <token>`; empty: none.
   // Set before the server starts.
   void RequireAuthToken(std::string token) { auth_token_ = std::move(token); }
 
-  grpc::Status Register(grpc::ServerContext* context,
-                        const pb::RegisterRequest* request,
-                        pb::RegisterResponse* response) override;
+  grpc::Status StreamedRegister(
+      grpc::ServerContext* context,
+      grpc::ServerUnaryStreamer<pb::RegisterRequest, pb::RegisterResponse>*
+          streamer) override;
   // Ends at the first refused segment with its error (counted); the actor
-  // reopens the stream. Too stale segments are dropped and counted in the
-  // ack's `rejected`.
-  grpc::Status StreamSegments(grpc::ServerContext* context,
-                              grpc::ServerReader<pb::Segment>* reader,
-                              pb::SegmentAck* ack) override;
-  grpc::Status SubscribeWeights(
-      grpc::ServerContext* context, const pb::WeightsRequest* request,
-      grpc::ServerWriter<pb::Weights>* writer) override;
-  grpc::Status GetWeights(grpc::ServerContext* context,
-                          const pb::WeightsRequest* request,
-                          pb::Weights* response) override;
+  // reopens the stream. Too stale and duplicate segments are dropped and
+  // counted in the ack's `rejected`.
+  grpc::Status SegmentStream(grpc::ServerContext* context,
+                             grpc::ServerReader<grpc::ByteBuffer>* reader,
+                             pb::SegmentAck* ack);
+  grpc::Status StreamedSubscribeWeights(
+      grpc::ServerContext* context,
+      grpc::ServerSplitStreamer<pb::WeightsRequest, pb::Weights>* streamer)
+      override;
+  grpc::Status StreamedGetWeights(
+      grpc::ServerContext* context,
+      grpc::ServerUnaryStreamer<pb::WeightsRequest, pb::Weights>* streamer)
+      override;
+
+  // Cancels segment streams idle for longer than the limit. The learner
+  // calls it periodically; returns how many it cancelled.
+  int CancelIdleStreams(absl::Time now = absl::Now());
+  // Open segment streams and weight subscriptions.
+  int64_t open_streams() const;
 
  private:
+  enum class CallKind { kSegments, kWeights };
+  struct OpenCall {
+    grpc::ServerContext* context;
+    CallKind kind;
+    int64_t actor_id;
+    absl::Time last_activity;
+  };
+
+  // Attaches the call to its session's actor and ends the same actor's
+  // older call of the same kind; returns the call's key for Touch/Close.
+  absl::StatusOr<int64_t> OpenBoundCall(grpc::ServerContext& context,
+                                        CallKind kind, int64_t& actor_id);
+  void Touch(int64_t key);
+  void CloseBoundCall(int64_t key, int64_t actor_id);
+
   ActorGateway& gateway_;
+  const ServiceLimits limits_;
   std::string auth_token_;
+  mutable std::mutex calls_mutex_;
+  std::map<int64_t, OpenCall> calls_;
+  int64_t next_call_key_ = 0;
 };
 
 struct ServerOptions {
   std::string listen = "127.0.0.1:0";  // port 0: the OS picks one
-  int max_message_bytes = 256 << 20;
+  // Largest message the server reads (a segment) and sends (weights).
+  int64_t max_receive_message_bytes = 64 << 20;
+  int64_t max_send_message_bytes = 256 << 20;
+  // Server threads (each open call holds one) and memory gRPC may use.
+  int max_threads = 600;
+  int64_t max_memory_bytes = int64_t{1} << 30;
   SecurityOptions security;  // TLS and the auth token
 };
 

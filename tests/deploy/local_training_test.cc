@@ -77,7 +77,7 @@ TEST(LocalTrainingTest, SameSeedSameProgressCsv) {
             "env_steps,updates,policy_version,episodes,mean_return,"
             "policy_loss,value_loss,entropy,approx_kl,clip_fraction,"
             "explained_variance,biased_fraction,mean_abs_bias,"
-            "rejected_segments");
+            "rejected_segments,rolled_back_updates");
   EXPECT_EQ(first, DeterministicProgress(b));
   EXPECT_NE(first, DeterministicProgress(c));
   // One row per update, steps counted exactly.

@@ -8,79 +8,21 @@
 #include "actor/actor_core.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
+#include "tests/fakes/learner_batches.h"
 
 namespace vantage {
 namespace {
 
 using ::testing::HasSubstr;
 
-constexpr int64_t kHorizon = 64;
-constexpr int kEnvs = 2;
+constexpr int64_t kHorizon = kTestHorizon;
 
 std::string TempFile(const std::string& name) {
   return std::string(::testing::TempDir()) + "/" + name;
 }
 
 LearnerConfig Config(const EnvSpec& spec, const std::string& algorithm) {
-  LearnerConfig config;
-  config.spec = spec;
-  // A2C's rollouts are 5n steps.
-  config.horizon = algorithm == "a2c" ? 60 : kHorizon;
-  config.rollouts_per_batch = kEnvs;
-  config.max_segment_steps = kHorizon;
-  config.total_env_steps = 10 * kHorizon * kEnvs;
-  config.seed = 3;
-  config.scale_rewards = true;
-  config.advantage.statistic = *ParseStatistic("maxabs");
-  config.advantage.rho = 0.5;
-  config.algorithm.name = algorithm;
-  config.algorithm.ppo.minibatches = 4;
-  config.algorithm.ppo.epochs = 2;
-  return config;
-}
-
-std::unique_ptr<ActorCore> MakeActor(int64_t segment_length = kHorizon) {
-  ActorConfig config;
-  config.env = "Hopper";
-  config.num_envs = kEnvs;
-  config.segment_length = segment_length;
-  config.seed = 9;
-  return *ActorCore::Create(config);
-}
-
-// One batch of segments acted by `learner`'s current weights.
-std::vector<Segment> Act(ActorCore& actor, LearnerCore& learner) {
-  EXPECT_TRUE(actor.SetWeights(learner.CurrentWeights()).ok());
-  SegmentQueue queue(kEnvs);
-  EXPECT_TRUE(actor.CollectSegments(queue).ok());
-  queue.Close();
-  std::vector<Segment> segments;
-  for (absl::StatusOr<Segment> s = queue.Receive(); s.ok();
-       s = queue.Receive()) {
-    segments.push_back(*std::move(s));
-  }
-  return segments;
-}
-
-UpdateStats Update(LearnerCore& learner, const std::vector<Segment>& batch) {
-  SegmentQueue queue(batch.size());
-  for (const Segment& s : batch) EXPECT_TRUE(queue.Send(s).ok());
-  absl::StatusOr<UpdateStats> stats = learner.RunUpdate(queue);
-  EXPECT_TRUE(stats.ok()) << stats.status();
-  return *stats;
-}
-
-void ExpectSameWeights(LearnerCore& a, LearnerCore& b) {
-  const PolicyWeights wa = a.CurrentWeights();
-  const PolicyWeights wb = b.CurrentWeights();
-  EXPECT_EQ(wa.version, wb.version);
-  ASSERT_EQ(wa.parameters.size(), wb.parameters.size());
-  for (size_t i = 0; i < wa.parameters.size(); ++i) {
-    EXPECT_TRUE(wa.parameters[i].equal(wb.parameters[i])) << "parameter " << i;
-  }
-  EXPECT_EQ(wa.normalizer_count, wb.normalizer_count);
-  EXPECT_TRUE(wa.normalizer_mean.equal(wb.normalizer_mean));
-  EXPECT_TRUE(wa.normalizer_var.equal(wb.normalizer_var));
+  return TestLearnerConfig(spec, algorithm);
 }
 
 class CheckpointTest : public ::testing::TestWithParam<std::string> {};
@@ -90,10 +32,11 @@ class CheckpointTest : public ::testing::TestWithParam<std::string> {};
 // segments, the same next update (which needs the optimiser's moments, the
 // reward scaler and the minibatch generator to have come back too).
 TEST_P(CheckpointTest, RoundTripRestoresTheWholeLearner) {
-  auto actor = MakeActor(GetParam() == "a2c" ? 60 : kHorizon);
+  auto actor = MakeTestActor(GetParam() == "a2c" ? 60 : kHorizon);
   const LearnerConfig config = Config(actor->spec(), GetParam());
   auto learner = *LearnerCore::Create(config);
-  for (int i = 0; i < 2; ++i) Update(*learner, Act(*actor, *learner));
+  for (int i = 0; i < 2; ++i)
+    UpdateWith(*learner, ActOneBatch(*actor, *learner));
   const std::string path = TempFile("round_trip_" + GetParam() + ".pt");
   const CheckpointExtras extras = {{"config", "{\"env\": \"Hopper\"}"},
                                    {"blob", std::string("a\0b\xff", 4)}};
@@ -110,9 +53,9 @@ TEST_P(CheckpointTest, RoundTripRestoresTheWholeLearner) {
   ASSERT_TRUE(read.ok()) << read.status();
   EXPECT_EQ(*read, extras);
 
-  const std::vector<Segment> next = Act(*actor, *learner);
-  const UpdateStats a = Update(*learner, next);
-  const UpdateStats b = Update(**restored, next);
+  const std::vector<Segment> next = ActOneBatch(*actor, *learner);
+  const UpdateStats a = UpdateWith(*learner, next);
+  const UpdateStats b = UpdateWith(**restored, next);
   EXPECT_EQ(a.algorithm.policy_loss, b.algorithm.policy_loss);
   EXPECT_EQ(a.algorithm.value_loss, b.algorithm.value_loss);
   EXPECT_EQ(a.biased_fraction, b.biased_fraction);
@@ -126,7 +69,7 @@ INSTANTIATE_TEST_SUITE_P(Algorithms, CheckpointTest,
 class CheckpointErrorTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    actor_ = MakeActor();
+    actor_ = MakeTestActor();
     config_ = Config(actor_->spec(), "ppo");
     learner_ = *LearnerCore::Create(config_);
     path_ = TempFile("errors.pt");

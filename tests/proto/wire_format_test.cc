@@ -310,8 +310,9 @@ TEST(SegmentWireTest, EmptyFinalObservationsKeepTheirShape) {
   Segment segment = RealisticSegment();
   segment.truncated.zero_();
   segment.final_observations = at::zeros({0, 17});
-  segment.episode_returns.clear();
-  segment.episode_lengths.clear();
+  // Only the termination at step 11 ends an episode now.
+  segment.episode_returns = {1234.5678};
+  segment.episode_lengths = {12};
   absl::StatusOr<Segment> back = SegmentOverWire(segment);
   ASSERT_TRUE(back.ok()) << back.status();
   EXPECT_EQ(back->final_observations.sizes(), at::IntArrayRef({0, 17}));
@@ -434,7 +435,20 @@ TEST(SegmentWireTest, DecodedSegmentValidatesExactlyAsTheOriginal) {
        [](Segment& s) {
          s.truncated.zero_();
          s.final_observations = at::zeros({0, 3});
+         s.episode_returns.clear();
+         s.episode_lengths.clear();
        }},
+      {"reward beyond the limit", &spec,
+       [](Segment& s) { s.rewards[3] = 3e38f; }},
+      {"log-prob beyond the limit", &spec,
+       [](Segment& s) { s.behaviour_log_probs[0] = -3e38f; }},
+      {"an episode too many", &spec,
+       [](Segment& s) {
+         s.episode_returns.push_back(1.0);
+         s.episode_lengths.push_back(1);
+       }},
+      {"nan episode return", &spec,
+       [](Segment& s) { s.episode_returns[0] = NAN; }},
       {"non-contiguous actions", &spec,
        [](Segment& s) {
          s.actions = at::rand({2, 4}).t();
@@ -601,7 +615,7 @@ TEST(EnvSpecWireTest, RoundTrips) {
   continuous.action_low = {-1.0, -0.5, -std::numeric_limits<double>::infinity(),
                            0.1,  -2.0, 0.0};
   continuous.action_high = {1.0, 0.5, std::numeric_limits<double>::infinity(),
-                            0.2, 2.0, 0.0};
+                            0.2, 2.0, 1e-9};
   EnvSpec discrete;
   discrete.name = "CartPole";
   discrete.observation_size = 4;
@@ -645,10 +659,25 @@ TEST(EnvSpecWireTest, RefusesImpossibleSpecs) {
        },
        "spec.action_high: 6 values, expected 0 for discrete:6"},
       {[](EnvSpec& s) { s.action_low[3] = 1.5; },
-       "spec.action_low[3]: 1.5 with action_high[3] 1, expected low <= high"},
+       "spec.action_low[3]: 1.5 with action_high[3] 1, expected low < high"},
+      {[](EnvSpec& s) { s.action_low[2] = s.action_high[2]; },
+       "spec.action_low[2]: 1 with action_high[2] 1, expected low < high"},
       {[](EnvSpec& s) { s.action_high[0] = NAN; },
-       "spec.action_low[0]: -1 with action_high[0] nan, expected low <= "
+       "spec.action_low[0]: -1 with action_high[0] nan, expected low < "
        "high"},
+      {[](EnvSpec& s) { s.name = std::string(4097, 'x'); },
+       "spec.name: 4097 bytes, expected at most 4096"},
+      {[](EnvSpec& s) { s.observation_size = 1000000000; },
+       "spec.observation_size: 1000000000, expected <= 65536"},
+      {[](EnvSpec& s) {
+         s.discrete = true;
+         s.action_size = 1000000000;
+         s.action_low.clear();
+         s.action_high.clear();
+       },
+       "spec.action_size: 1000000000, expected <= 4096"},
+      {[](EnvSpec& s) { s.max_episode_steps = int64_t{1} << 40; },
+       "spec.max_episode_steps: 1099511627776, expected <= 100000000"},
       {[](EnvSpec& s) { s.max_episode_steps = -1; },
        "spec.max_episode_steps: -1, expected >= 0"},
       {[](EnvSpec& s) { s.control_dt = -0.01; },

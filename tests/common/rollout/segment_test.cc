@@ -2,7 +2,10 @@
 
 #include <ATen/ATen.h>
 
+#include <functional>
+#include <string>
 #include <thread>
+#include <vector>
 
 #include "common/rollout/segment_queue.h"
 #include "gmock/gmock.h"
@@ -76,6 +79,104 @@ TEST(SegmentTest, EveryDefectIsNamed) {
   s.actions[3][0] = 2.0;
   EXPECT_THAT(ValidateSegment(s, discrete, 128).message(),
               HasSubstr("not action indices in [0, 2)"));
+}
+
+TEST(SegmentTest, ValuesBeyondTheLimitsAreNamed) {
+  ValueLimits limits;
+  limits.max_abs_observation = 100;
+  limits.max_abs_action = 10;
+  limits.max_abs_reward = 5;
+  limits.max_abs_log_prob = 50;
+  ASSERT_TRUE(limits.Validate().ok());
+  EXPECT_TRUE(ValidateSegment(ValidSegment(), Spec(), 128, limits).ok());
+  struct Case {
+    std::function<void(Segment&)> change;
+    std::string message;
+  };
+  const std::vector<Case> cases = {
+      {[](Segment& s) { s.observations[2][1] = -101; },
+       "observations holds -101 at element 7, beyond the limit of +-100"},
+      {[](Segment& s) { s.final_observations[0][0] = 1e3; },
+       "final_observations holds 1000 at element 0"},
+      {[](Segment& s) { s.actions[0][1] = 11; },
+       "actions holds 11 at element 1, beyond the limit of +-10"},
+      {[](Segment& s) { s.rewards[3] = 3e38f; },
+       "rewards holds 3e+38 at element 3, beyond the limit of +-5"},
+      {[](Segment& s) { s.behaviour_log_probs[1] = -3e38f; },
+       "behaviour_log_probs holds -3e+38 at element 1"},
+  };
+  for (const Case& c : cases) {
+    Segment s = ValidSegment();
+    c.change(s);
+    EXPECT_THAT(ValidateSegment(s, Spec(), 128, limits).message(),
+                HasSubstr(c.message));
+  }
+  // The default limits are generous but finite: 3e38 is refused there too.
+  Segment poisoned = ValidSegment();
+  poisoned.rewards[0] = 3e38f;
+  EXPECT_THAT(ValidateSegment(poisoned, Spec(), 128).message(),
+              HasSubstr("beyond the limit of +-1e+06"));
+  limits.max_abs_reward = 0;
+  EXPECT_THAT(limits.Validate().message(),
+              HasSubstr("max_abs_reward must be > 0"));
+}
+
+TEST(SegmentTest, EpisodesMustMatchTheEpisodeEnds) {
+  struct Case {
+    std::function<void(Segment&)> change;
+    std::string message;
+  };
+  // ValidSegment ends one episode, by truncation at step 2.
+  const std::vector<Case> cases = {
+      {[](Segment& s) {
+         s.episode_returns.clear();
+         s.episode_lengths.clear();
+       },
+       "reports 0 episodes but ends one at step 2"},
+      {[](Segment& s) {
+         s.episode_returns.assign(12600000, 1.0);
+         s.episode_lengths.assign(12600000, 1);
+       },
+       "reports 12600000 episodes but ends 1"},
+      {[](Segment& s) { s.episode_lengths.push_back(1); },
+       "1 episode returns but 2 episode lengths"},
+      {[](Segment& s) { s.episode_returns[0] = NAN; },
+       "episode_returns[0] is nan"},
+      {[](Segment& s) { s.episode_returns[0] = 1e300; },
+       "episode_returns[0] is 1e+300"},
+      {[](Segment& s) { s.episode_lengths[0] = 0; },
+       "episode_lengths[0] is 0 for the episode ending at step 2"},
+      // The spec's time limit bounds every episode.
+      {[](Segment& s) { s.episode_lengths[0] = 1001; },
+       "episode_lengths[0] is 1001"},
+      // A second end: that episode lies wholly inside the segment.
+      {[](Segment& s) {
+         s.terminated[3] = true;
+         s.episode_returns.push_back(1.0);
+         s.episode_lengths.push_back(2);
+       },
+       "episode_lengths[1] is 2 for the episode ending at step 3, expected "
+       "1..1"},
+  };
+  for (const Case& c : cases) {
+    Segment s = ValidSegment();
+    c.change(s);
+    EXPECT_THAT(ValidateSegment(s, Spec(), 128).message(),
+                HasSubstr(c.message));
+  }
+  Segment two = ValidSegment();
+  two.terminated[3] = true;
+  two.episode_returns.push_back(1.0);
+  two.episode_lengths.push_back(1);
+  EXPECT_TRUE(ValidateSegment(two, Spec(), 128).ok());
+}
+
+TEST(SegmentTest, ScalarRewardsAreRefusedNotThrown) {
+  Segment s = ValidSegment();
+  s.rewards = at::ones({});
+  EXPECT_EQ(s.steps(), 0);
+  EXPECT_THAT(ValidateSegment(s, Spec(), 128).message(),
+              HasSubstr("0 steps, expected 1..128"));
 }
 
 TEST(SegmentQueueTest, BoundedFifoThatCloses) {

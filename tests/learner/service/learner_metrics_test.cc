@@ -47,7 +47,9 @@ TEST(LearnerMetricsTest, ServesRecordedValuesWithHelp) {
   metrics->RecordSegmentsAccepted(32);
   metrics->RecordRejected({{"stale", 3}, {"malformed", 1}});
   metrics->SetQueueDepth(5, 640);
-  metrics->SetActorsRegistered(2);
+  metrics->RecordActors({/*live_actors=*/2, /*live_streams=*/4,
+                         /*registrations_total=*/5, /*expirations_total=*/3});
+  metrics->RecordRolledBackUpdates(1);
 
   const std::vector<std::string> lines = Scrape(*metrics);
   for (const char* line : {
@@ -62,7 +64,11 @@ TEST(LearnerMetricsTest, ServesRecordedValuesWithHelp) {
            "vantage_learner_segments_rejected_total{reason=\"malformed\"} 1",
            "vantage_learner_queue_depth 5",
            "vantage_learner_buffered_steps 640",
-           "vantage_learner_actors_registered 2",
+           "vantage_learner_live_actors 2",
+           "vantage_learner_live_streams 4",
+           "vantage_learner_registrations_total 5",
+           "vantage_learner_registration_expirations_total 3",
+           "vantage_learner_rolled_back_updates_total 1",
            "vantage_learner_update_seconds_count 1",
            "vantage_learner_update_seconds_sum 0.5",
            "vantage_learner_update_seconds_bucket{le=\"0.25\"} 0",
@@ -78,7 +84,8 @@ TEST(LearnerMetricsTest, ServesRecordedValuesWithHelp) {
        {"env_steps_total", "segments_accepted_total", "segments_rejected_total",
         "policy_version", "policy_lag", "queue_depth", "buffered_steps",
         "update_seconds", "mean_return", "steps_per_second", "updates_total",
-        "episodes_total", "actors_registered"}) {
+        "episodes_total", "live_actors", "live_streams", "registrations_total",
+        "registration_expirations_total", "rolled_back_updates_total"}) {
     EXPECT_THAT(
         lines,
         Contains(HasSubstr(absl::StrCat("# HELP vantage_learner_", name, " "))))
@@ -91,7 +98,8 @@ TEST(LearnerMetricsTest, KnownRejectReasonsStartAtZero) {
   ASSERT_NE(metrics, nullptr);
   const std::vector<std::string> lines = Scrape(*metrics);
   for (const char* reason :
-       {"malformed", "invalid", "unknown_actor", "future_version", "stale"}) {
+       {"malformed", "invalid", "foreign_actor", "foreign_slot",
+        "unknown_session", "future_version", "stale", "duplicate"}) {
     EXPECT_THAT(lines, Contains(absl::StrCat(
                            "vantage_learner_segments_rejected_total{reason=\"",
                            reason, "\"} 0")));

@@ -12,12 +12,14 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <set>
 #include <string>
 #include <thread>
 #include <vector>
 
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
+#include "absl/strings/str_cat.h"
 #include "absl/time/time.h"
 #include "common/env/environment.h"
 #include "common/nn/networks.h"
@@ -204,6 +206,7 @@ class LearnerServiceTest : public ::testing::Test {
   static GatewayConfig DefaultConfig() {
     GatewayConfig config;
     config.run_config = RunConfig();
+    config.spec = Spec();
     config.max_segment_steps = 8;
     config.max_policy_lag = 0;
     return config;
@@ -215,7 +218,7 @@ class LearnerServiceTest : public ::testing::Test {
     return stub_->Register(&context, Request(spec), response);
   }
 
-  // Registers actor 0 and publishes version 0.
+  // Registers actor 0 (its session in session_) and publishes version 0.
   void StartRegistered(GatewayConfig config = DefaultConfig(),
                        size_t capacity = 16) {
     Start(std::move(config), capacity);
@@ -224,12 +227,19 @@ class LearnerServiceTest : public ::testing::Test {
     const grpc::Status status = Register(Spec(), &response);
     ASSERT_TRUE(status.ok()) << status.error_message();
     ASSERT_EQ(response.actor_id(), 0);
+    session_ = response.session();
   }
 
+  // A stream that carries `session` (actor 0's by default).
   StreamResult Stream(const std::vector<pb::Segment>& segments) {
+    return StreamWith(session_, segments);
+  }
+  StreamResult StreamWith(const std::string& session,
+                          const std::vector<pb::Segment>& segments) {
     StreamResult result;
     grpc::ClientContext context;
     SetDeadline(context);
+    context.AddMetadata(kSessionMetadataKey, session);
     std::unique_ptr<grpc::ClientWriter<pb::Segment>> writer =
         stub_->StreamSegments(&context, &result.ack);
     for (const pb::Segment& segment : segments) {
@@ -272,16 +282,16 @@ class LearnerServiceTest : public ::testing::Test {
   std::unique_ptr<LearnerService> service_;
   std::unique_ptr<grpc::Server> server_;
   std::unique_ptr<pb::Learner::Stub> stub_;
+  std::string session_;
 };
 
 // --- Register ---
 
-TEST_F(LearnerServiceTest, RegisterFixesTheSpecAndNumbersActors) {
+TEST_F(LearnerServiceTest, RegisterMatchesThePinnedSpecAndNumbersActors) {
   Start();
   const PolicyWeights weights = MakeWeights(3);
   gateway_->Publish(weights);
-  EXPECT_FALSE(gateway_->WaitForSpec(absl::ZeroDuration()).has_value());
-
+  std::set<std::string> sessions;
   for (int64_t expected_id : {0, 1, 2}) {
     pb::RegisterResponse response;
     const grpc::Status status = Register(Spec(), &response);
@@ -290,11 +300,16 @@ TEST_F(LearnerServiceTest, RegisterFixesTheSpecAndNumbersActors) {
     EXPECT_EQ(response.run_config().SerializeAsString(),
               RunConfig().SerializeAsString());
     ExpectWeightsAre(response.weights(), weights);
+    // "<id>:" and 128 bits of hex, new for every registration.
+    EXPECT_THAT(response.session(), ::testing::MatchesRegex(absl::StrCat(
+                                        expected_id, ":[0-9a-f]{32}")));
+    sessions.insert(response.session());
   }
-  std::optional<EnvSpec> spec = gateway_->WaitForSpec(absl::ZeroDuration());
-  ASSERT_TRUE(spec.has_value());
-  EXPECT_TRUE(CheckSameSpec(Spec(), *spec).ok());
-  EXPECT_EQ(gateway_->counters().registrations, 3);
+  EXPECT_EQ(sessions.size(), 3u);
+  const GatewayCounters counters = gateway_->counters();
+  EXPECT_EQ(counters.registrations, 3);
+  EXPECT_EQ(counters.live_actors, 3);
+  EXPECT_EQ(counters.live_env_slots, 6);
 }
 
 TEST_F(LearnerServiceTest, RegisterWithAnotherSpecNamesTheField) {
@@ -321,12 +336,13 @@ TEST_F(LearnerServiceTest, RegisterWithAnotherSpecNamesTheField) {
   status = Register(broken, &response);
   EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
 
-  // Refusals take no actor id, and the first spec still holds.
+  // Refusals take no actor id.
   pb::RegisterResponse second;
   status = Register(Spec(), &second);
   ASSERT_TRUE(status.ok()) << status.error_message();
   EXPECT_EQ(second.actor_id(), 1);
   EXPECT_EQ(gateway_->counters().registrations, 2);
+  EXPECT_EQ(gateway_->counters().refused_registrations, 3);
 }
 
 TEST_F(LearnerServiceTest, RegisterForAnotherEnvironmentIsRefused) {
@@ -339,8 +355,7 @@ TEST_F(LearnerServiceTest, RegisterForAnotherEnvironmentIsRefused) {
   EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
   EXPECT_THAT(status.error_message(),
               HasSubstr("this learner trains InvertedPendulum"));
-  // It fixed nothing: the right environment still registers as actor 0.
-  EXPECT_FALSE(gateway_->WaitForSpec(absl::ZeroDuration()).has_value());
+  // The right environment still registers as actor 0.
   ASSERT_TRUE(Register(Spec(), &response).ok());
   EXPECT_EQ(response.actor_id(), 0);
 }
@@ -349,9 +364,10 @@ TEST_F(LearnerServiceTest, RegisterWaitsForTheFirstWeights) {
   Start();
   const PolicyWeights weights = MakeWeights(5);
   std::thread publisher([&] {
-    // Publish only once the registration is waiting: the spec is fixed
-    // before the wait begins.
-    EXPECT_TRUE(gateway_->WaitForSpec(absl::Seconds(10)).has_value());
+    // Publish only once the registration is waiting.
+    while (gateway_->counters().registrations == 0) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
     std::this_thread::sleep_for(std::chrono::milliseconds(100));
     gateway_->Publish(weights);
   });
@@ -396,11 +412,11 @@ TEST_F(LearnerServiceTest, ValidSegmentsReachTheQueueUnchanged) {
   EXPECT_TRUE(counters.rejected.empty());
 }
 
-TEST_F(LearnerServiceTest, SegmentFromAnUnregisteredActorIsRefused) {
+TEST_F(LearnerServiceTest, SegmentOfAnotherActorIsRefused) {
   StartRegistered();
   ExpectRefused(ToProto(MakeSegment(7, 0, 0)),
-                grpc::StatusCode::FAILED_PRECONDITION, "segment.actor_id",
-                "unknown_actor");
+                grpc::StatusCode::PERMISSION_DENIED, "segment.actor_id 7",
+                "foreign_actor");
 }
 
 TEST_F(LearnerServiceTest, SegmentOfAnUnpublishedVersionIsRefused) {
@@ -498,7 +514,7 @@ TEST_F(LearnerServiceTest, EveryRefusalIsCountedByItsReason) {
   EXPECT_EQ(queue_->size(), 0u);
   const GatewayCounters counters = gateway_->counters();
   EXPECT_EQ(counters.rejected, (std::map<std::string, int64_t>{
-                                   {"unknown_actor", 1},
+                                   {"foreign_actor", 1},
                                    {"future_version", 1},
                                    {"malformed", 1},
                                    {"invalid", 3},
@@ -533,6 +549,7 @@ TEST_F(LearnerServiceTest, SubscriptionDeliversEachNewerVersionUntilCancelled) {
   StartRegistered();  // publishes version 0
   grpc::ClientContext context;
   SetDeadline(context);
+  context.AddMetadata(kSessionMetadataKey, session_);
   pb::WeightsRequest request;
   request.set_actor_id(0);
   request.set_known_version(0);
@@ -568,11 +585,12 @@ TEST_F(LearnerServiceTest, SubscriptionDeliversEachNewerVersionUntilCancelled) {
 }
 
 TEST_F(LearnerServiceTest, SubscriptionEndsWhenTheGatewayCloses) {
-  Start();
-  const PolicyWeights published = MakeWeights(0);
+  StartRegistered();
+  const PolicyWeights published = MakeWeights(1);
   gateway_->Publish(published);
   grpc::ClientContext context;
   SetDeadline(context);
+  context.AddMetadata(kSessionMetadataKey, session_);
   pb::WeightsRequest request;
   request.set_known_version(-1);
   std::unique_ptr<grpc::ClientReader<pb::Weights>> reader =

@@ -1,0 +1,71 @@
+#include "tests/fakes/learner_process.h"
+
+#include <chrono>
+#include <filesystem>
+#include <thread>
+
+#include "absl/strings/numbers.h"
+#include "absl/strings/str_split.h"
+#include "absl/strings/strip.h"
+#include "gtest/gtest.h"
+#include "tests/deploy/cli/run_vantage.h"
+
+namespace vantage {
+
+std::string FreshDirectory(const std::string& name) {
+  const std::string path = TempPath(name);
+  std::filesystem::remove_all(path);
+  return path;
+}
+
+// Starts `vantage learner <args>` and waits for its port file.
+Learner StartLearner(const std::string& args) {
+  Learner learner;
+  const std::string port_file = TempPath("port");
+  std::filesystem::remove(port_file);  // a stale one from an earlier run
+  learner.out = TempPath("learner.out");
+  learner.err = TempPath("learner.err");
+  learner.pid = StartVantage(
+      "learner --listen=127.0.0.1:0 --port_file=" + port_file + " " + args,
+      learner.out, learner.err);
+  for (int i = 0; i < 600 && !std::filesystem::exists(port_file); ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  learner.port = ReadFile(port_file);
+  while (!learner.port.empty() && learner.port.back() == '\n') {
+    learner.port.pop_back();
+  }
+  EXPECT_FALSE(learner.port.empty()) << ReadFile(learner.err);
+  return learner;
+}
+
+// The port a process printed as "<who>: metrics on port N".
+int MetricsPort(const std::string& err_path, const std::string& who) {
+  const std::string marker = who + ": metrics on port ";
+  for (int i = 0; i < 600; ++i) {
+    const std::string err = ReadFile(err_path);
+    const size_t at = err.find(marker);
+    int port = 0;
+    if (at != std::string::npos &&
+        absl::SimpleAtoi(err.substr(at + marker.size(),
+                                    err.find('\n', at) - at - marker.size()),
+                         &port)) {
+      return port;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  return 0;
+}
+
+// The value of an unlabelled sample in Prometheus text.
+double Sample(const std::string& text, const std::string& name) {
+  for (absl::string_view line : absl::StrSplit(text, '\n')) {
+    if (absl::ConsumePrefix(&line, name + " ")) {
+      double value = 0;
+      if (absl::SimpleAtod(line, &value)) return value;
+    }
+  }
+  return -1;
+}
+
+}  // namespace vantage

@@ -1,0 +1,33 @@
+#ifndef VANTAGE_TESTS_FAKES_LEARNER_PROCESS_H_
+#define VANTAGE_TESTS_FAKES_LEARNER_PROCESS_H_
+
+// A real `vantage learner` process on a loopback port, for the tests that
+// run the learner and actors as separate processes.
+
+#include <string>
+
+namespace vantage {
+
+// TempPath(name), emptied.
+std::string FreshDirectory(const std::string& name);
+
+struct Learner {
+  int pid = 0;
+  std::string port;
+  std::string out, err;
+};
+
+// Starts `vantage learner <args>` and waits for its port file.
+Learner StartLearner(const std::string& args);
+
+// The port a process printed on stderr as "<who>: metrics on port N",
+// waiting up to 30 s; 0 if it never did.
+int MetricsPort(const std::string& err_path, const std::string& who);
+
+// The value of a sample (with its labels, if any, as printed) in
+// Prometheus text; -1 if absent.
+double Sample(const std::string& text, const std::string& name);
+
+}  // namespace vantage
+
+#endif  // VANTAGE_TESTS_FAKES_LEARNER_PROCESS_H_

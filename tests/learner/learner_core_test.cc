@@ -1,0 +1,136 @@
+#include "learner/learner_core.h"
+
+#include <ATen/ATen.h>
+
+#include <cmath>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "gmock/gmock.h"
+#include "gtest/gtest.h"
+#include "learner/checkpoint.h"
+#include "tests/fakes/learner_batches.h"
+
+namespace vantage {
+namespace {
+
+using ::testing::HasSubstr;
+
+constexpr double kInfinity = std::numeric_limits<double>::infinity();
+
+bool AllFinite(const PolicyWeights& weights) {
+  for (const at::Tensor& p : weights.parameters) {
+    if (!at::isfinite(p).all().item<bool>()) return false;
+  }
+  return true;
+}
+
+// A learner whose value gate lets everything finite through, so that a
+// poisoned batch reaches the update and only the rollback stands between it
+// and the weights.
+LearnerConfig UngatedConfig(const EnvSpec& spec, const std::string& algorithm) {
+  LearnerConfig config = TestLearnerConfig(spec, algorithm);
+  config.scale_rewards = false;
+  config.value_limits.max_abs_reward = kInfinity;
+  config.value_limits.max_abs_log_prob = kInfinity;
+  return config;
+}
+
+class RollbackTest : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(RollbackTest, APoisonedBatchIsUndoneAndTheRunGoesOn) {
+  auto actor = MakeTestActor(GetParam() == "a2c" ? 60 : kTestHorizon);
+  const LearnerConfig config = UngatedConfig(actor->spec(), GetParam());
+  auto learner = *LearnerCore::Create(config);
+  UpdateWith(*learner, ActOneBatch(*actor, *learner));
+  std::vector<Segment> poisoned = ActOneBatch(*actor, *learner);
+  for (Segment& segment : poisoned) {
+    segment.rewards.fill_(3e38f);
+    segment.behaviour_log_probs.fill_(-3e38f);
+  }
+  const PolicyWeights before = learner->CurrentWeights();
+
+  const UpdateStats stats = UpdateWith(*learner, poisoned);
+  EXPECT_TRUE(stats.rolled_back);
+  EXPECT_THAT(stats.rollback_reason, HasSubstr("non-finite"));
+  EXPECT_EQ(stats.rolled_back_updates, 1);
+  // The version advances (synchronous actors wait for it) with the weights
+  // and normaliser of before.
+  const PolicyWeights after = learner->CurrentWeights();
+  EXPECT_EQ(after.version, before.version + 1);
+  ASSERT_EQ(after.parameters.size(), before.parameters.size());
+  for (size_t i = 0; i < before.parameters.size(); ++i) {
+    EXPECT_TRUE(after.parameters[i].equal(before.parameters[i])) << i;
+  }
+  EXPECT_EQ(after.normalizer_count, before.normalizer_count);
+  EXPECT_TRUE(after.normalizer_mean.equal(before.normalizer_mean));
+  EXPECT_TRUE(AllFinite(after));
+
+  // An honest batch trains again, from intact optimiser state.
+  const UpdateStats next = UpdateWith(*learner, ActOneBatch(*actor, *learner));
+  EXPECT_FALSE(next.rolled_back) << next.rollback_reason;
+  EXPECT_EQ(next.rolled_back_updates, 1);
+  const PolicyWeights trained = learner->CurrentWeights();
+  EXPECT_TRUE(AllFinite(trained));
+  EXPECT_FALSE(trained.parameters[0].equal(before.parameters[0]));
+
+  // The count survives a checkpoint.
+  const std::string path =
+      std::string(::testing::TempDir()) + "/rollback_" + GetParam() + ".pt";
+  ASSERT_TRUE(WriteCheckpoint(path, *learner, {}).ok());
+  absl::StatusOr<std::unique_ptr<LearnerCore>> restored =
+      ReadCheckpoint(path, config);
+  ASSERT_TRUE(restored.ok()) << restored.status();
+  const UpdateStats resumed =
+      UpdateWith(**restored, ActOneBatch(*actor, **restored));
+  EXPECT_EQ(resumed.rolled_back_updates, 1);
+}
+
+INSTANTIATE_TEST_SUITE_P(Algorithms, RollbackTest,
+                         ::testing::Values("ppo", "a2c", "trpo"));
+
+TEST(RollbackLimitTest, AGradientNormExplosionIsUndone) {
+  for (const std::string algorithm : {"ppo", "a2c"}) {
+    SCOPED_TRACE(algorithm);
+    auto actor = MakeTestActor(algorithm == "a2c" ? 60 : kTestHorizon);
+    LearnerConfig config = TestLearnerConfig(actor->spec(), algorithm);
+    // Any real gradient is larger than this.
+    config.rollback_gradient_norm = 1e-12;
+    auto learner = *LearnerCore::Create(config);
+    const PolicyWeights before = learner->CurrentWeights();
+    const UpdateStats stats =
+        UpdateWith(*learner, ActOneBatch(*actor, *learner));
+    EXPECT_TRUE(stats.rolled_back);
+    EXPECT_THAT(stats.rollback_reason, HasSubstr("gradient norm"));
+    EXPECT_GT(stats.algorithm.max_gradient_norm, 0.0);
+    EXPECT_TRUE(
+        learner->CurrentWeights().parameters[0].equal(before.parameters[0]));
+  }
+}
+
+TEST(RollbackLimitTest, AnHonestRunNeverRollsBack) {
+  auto actor = MakeTestActor();
+  auto learner = *LearnerCore::Create(TestLearnerConfig(actor->spec(), "ppo"));
+  for (int i = 0; i < 3; ++i) {
+    const UpdateStats stats =
+        UpdateWith(*learner, ActOneBatch(*actor, *learner));
+    EXPECT_FALSE(stats.rolled_back) << stats.rollback_reason;
+    EXPECT_TRUE(std::isfinite(stats.algorithm.max_gradient_norm));
+  }
+}
+
+TEST(LearnerConfigTest, RefusesBadLimits) {
+  auto actor = MakeTestActor();
+  LearnerConfig config = TestLearnerConfig(actor->spec(), "ppo");
+  config.rollback_gradient_norm = 0;
+  EXPECT_THAT(config.Validate().message(),
+              HasSubstr("rollback_gradient_norm must be > 0"));
+  config = TestLearnerConfig(actor->spec(), "ppo");
+  config.value_limits.max_abs_observation = -1;
+  EXPECT_THAT(config.Validate().message(),
+              HasSubstr("max_abs_observation must be > 0"));
+}
+
+}  // namespace
+}  // namespace vantage
