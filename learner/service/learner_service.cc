@@ -39,9 +39,15 @@ grpc::Status Guarded(ActorGateway& gateway, Body body) {
   }
 }
 
-template <typename Request>
-grpc::Status CheckRequestSize(const Request& request, int64_t limit,
-                              const char* what) {
+// Reads the one request of a streamed handler (after the token check) and
+// refuses one larger than `limit` bytes.
+template <typename Request, typename Streamer>
+grpc::Status ReadRequest(Streamer& streamer, int64_t limit, const char* what,
+                         Request& request) {
+  if (!streamer.Read(&request)) {
+    return grpc::Status(grpc::StatusCode::INVALID_ARGUMENT,
+                        absl::StrCat("no readable ", what));
+  }
   const size_t bytes = request.ByteSizeLong();
   if (static_cast<int64_t>(bytes) > limit) {
     return grpc::Status(grpc::StatusCode::INVALID_ARGUMENT,
@@ -91,14 +97,10 @@ grpc::Status LearnerService::StreamedRegister(
   }
   return Guarded(gateway_, [&] {
     pb::RegisterRequest request;
-    if (!streamer->Read(&request)) {
-      return grpc::Status(grpc::StatusCode::INVALID_ARGUMENT,
-                          "no readable RegisterRequest");
-    }
-    if (grpc::Status size = CheckRequestSize(request, limits_.max_request_bytes,
-                                             "RegisterRequest");
-        !size.ok()) {
-      return size;
+    if (grpc::Status read = ReadRequest(*streamer, limits_.max_request_bytes,
+                                        "RegisterRequest", request);
+        !read.ok()) {
+      return read;
     }
     absl::StatusOr<pb::RegisterResponse> registered =
         gateway_.Register(request, kRegistrationWait);
@@ -228,14 +230,10 @@ grpc::Status LearnerService::StreamedSubscribeWeights(
   if (!key.ok()) return ToGrpcStatus(key.status());
   const grpc::Status status = Guarded(gateway_, [&] {
     pb::WeightsRequest request;
-    if (!streamer->Read(&request)) {
-      return grpc::Status(grpc::StatusCode::INVALID_ARGUMENT,
-                          "no readable WeightsRequest");
-    }
-    if (grpc::Status size = CheckRequestSize(request, limits_.max_request_bytes,
-                                             "WeightsRequest");
-        !size.ok()) {
-      return size;
+    if (grpc::Status read = ReadRequest(*streamer, limits_.max_request_bytes,
+                                        "WeightsRequest", request);
+        !read.ok()) {
+      return read;
     }
     int64_t known = request.known_version();
     while (!context->IsCancelled() && !gateway_.closed()) {
@@ -260,14 +258,10 @@ grpc::Status LearnerService::StreamedGetWeights(
   }
   return Guarded(gateway_, [&] {
     pb::WeightsRequest request;
-    if (!streamer->Read(&request)) {
-      return grpc::Status(grpc::StatusCode::INVALID_ARGUMENT,
-                          "no readable WeightsRequest");
-    }
-    if (grpc::Status size = CheckRequestSize(request, limits_.max_request_bytes,
-                                             "WeightsRequest");
-        !size.ok()) {
-      return size;
+    if (grpc::Status read = ReadRequest(*streamer, limits_.max_request_bytes,
+                                        "WeightsRequest", request);
+        !read.ok()) {
+      return read;
     }
     std::shared_ptr<const pb::Weights> weights =
         gateway_.WaitForWeightsNewerThan(-1, absl::ZeroDuration());

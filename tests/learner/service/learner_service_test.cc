@@ -523,6 +523,102 @@ TEST_F(LearnerServiceTest, EveryRefusalIsCountedByItsReason) {
   EXPECT_EQ(counters.accepted_segments, 0);
 }
 
+// --- Sessions ---
+
+TEST_F(LearnerServiceTest, SegmentOfASlotTheActorDidNotRegisterIsRefused) {
+  StartRegistered();  // num_envs 2: slots 0 and 1
+  Segment segment = MakeSegment(0, 0, 0);
+  segment.env_slot = 2;
+  ExpectRefused(ToProto(segment), grpc::StatusCode::PERMISSION_DENIED,
+                "segment.env_slot 2", "foreign_slot");
+}
+
+TEST_F(LearnerServiceTest, StreamsWithoutTheRightSessionAreRefused) {
+  StartRegistered();
+  const pb::Segment segment = ToProto(MakeSegment(0, 0, 0));
+  StreamResult result = StreamWith("", {segment});
+  EXPECT_EQ(result.status.error_code(), grpc::StatusCode::PERMISSION_DENIED);
+  std::string wrong = session_;
+  wrong.back() = wrong.back() == '0' ? '1' : '0';
+  result = StreamWith(wrong, {segment});
+  EXPECT_EQ(result.status.error_code(), grpc::StatusCode::PERMISSION_DENIED);
+  EXPECT_THAT(result.status.error_message(), HasSubstr("wrong session"));
+  result = StreamWith("7:" + session_.substr(2), {segment});
+  EXPECT_EQ(result.status.error_code(), grpc::StatusCode::NOT_FOUND);
+  EXPECT_EQ(queue_->size(), 0u);
+  EXPECT_EQ(gateway_->counters().rejected,
+            (std::map<std::string, int64_t>{{"bad_session", 2},
+                                            {"unknown_session", 1}}));
+}
+
+TEST_F(LearnerServiceTest, AnAdmittedSequenceIsDroppedTheSecondTime) {
+  StartRegistered();
+  const pb::Segment segment = ToProto(MakeSegment(0, 0, 3));
+  const StreamResult result = Stream({segment, segment});
+  ASSERT_TRUE(result.status.ok()) << result.status.error_message();
+  EXPECT_EQ(result.ack.accepted(), 1);
+  EXPECT_EQ(result.ack.rejected(), 1);
+  EXPECT_THAT(result.ack.last_error(), HasSubstr("already admitted"));
+  EXPECT_EQ(queue_->size(), 1u);
+  EXPECT_EQ(gateway_->counters().rejected,
+            (std::map<std::string, int64_t>{{"duplicate", 1}}));
+}
+
+TEST_F(LearnerServiceTest, AnIdleRegistrationExpiresAndItsSessionEnds) {
+  StartRegistered();
+  // Not idle long enough yet.
+  EXPECT_TRUE(gateway_->ExpireIdle(absl::Now()).empty());
+  EXPECT_EQ(gateway_->ExpireIdle(absl::Now() + absl::Minutes(2)),
+            std::vector<int64_t>{0});
+  const GatewayCounters counters = gateway_->counters();
+  EXPECT_EQ(counters.live_actors, 0);
+  EXPECT_EQ(counters.live_env_slots, 0);
+  EXPECT_EQ(counters.expirations, 1);
+  const StreamResult result = Stream({ToProto(MakeSegment(0, 0, 0))});
+  EXPECT_EQ(result.status.error_code(), grpc::StatusCode::NOT_FOUND);
+  EXPECT_THAT(result.status.error_message(), HasSubstr("register again"));
+}
+
+TEST_F(LearnerServiceTest, RegistrationsStopAtTheLimits) {
+  GatewayConfig config = DefaultConfig();
+  config.limits.max_live_actors = 2;
+  config.limits.max_live_env_slots = 3;
+  Start(config);
+  gateway_->Publish(MakeWeights(0));
+  pb::RegisterResponse response;
+  ASSERT_TRUE(Register(Spec(), &response).ok());      // 2 slots
+  grpc::Status status = Register(Spec(), &response);  // 4 > 3 slots
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED);
+  EXPECT_THAT(status.error_message(), HasSubstr("3 env slots"));
+  pb::RegisterRequest one = Request(Spec());
+  one.set_num_envs(1);
+  grpc::ClientContext context;
+  SetDeadline(context);
+  ASSERT_TRUE(stub_->Register(&context, one, &response).ok());
+  one.set_num_envs(0);
+  grpc::ClientContext zero;
+  SetDeadline(zero);
+  status = stub_->Register(&zero, one, &response);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(status.error_message(), HasSubstr("num_envs is 0"));
+  EXPECT_EQ(gateway_->counters().refused_registrations, 2);
+}
+
+TEST_F(LearnerServiceTest, ANewerStreamOfTheSameActorEndsTheOlder) {
+  StartRegistered();
+  grpc::ClientContext first;
+  SetDeadline(first);
+  first.AddMetadata(kSessionMetadataKey, session_);
+  pb::SegmentAck ack;
+  auto older = stub_->StreamSegments(&first, &ack);
+  ASSERT_TRUE(older->Write(ToProto(MakeSegment(0, 0, 0))));
+  ASSERT_TRUE(ReceiveWithin(*queue_, std::chrono::seconds(5)).ok());
+  const StreamResult newer = Stream({ToProto(MakeSegment(0, 0, 1))});
+  EXPECT_TRUE(newer.status.ok()) << newer.status.error_message();
+  EXPECT_EQ(older->Finish().error_code(), grpc::StatusCode::CANCELLED);
+  EXPECT_EQ(service_->open_streams(), 0);
+}
+
 // --- Weights ---
 
 TEST_F(LearnerServiceTest, GetWeightsIsUnavailableUntilPublished) {
