@@ -184,7 +184,8 @@ absl::Status RunLearnerServer(
   std::unique_ptr<LearnerMetrics> metrics;
   if (!config.metrics_address.empty()) {
     absl::StatusOr<std::unique_ptr<LearnerMetrics>> started =
-        LearnerMetrics::Start(config.metrics_address);
+        LearnerMetrics::Start(config.metrics_address,
+                              config.security.auth_token);
     if (!started.ok()) {
       server->server->Shutdown();
       return started.status();

@@ -7,6 +7,7 @@
 #include "absl/memory/memory.h"
 #include "absl/status/status.h"
 #include "absl/strings/str_cat.h"
+#include "common/metrics/metrics_endpoint.h"
 
 namespace vantage {
 namespace {
@@ -52,30 +53,17 @@ ActorMetrics::ActorMetrics()
 ActorMetrics::~ActorMetrics() = default;
 
 absl::StatusOr<std::unique_ptr<ActorMetrics>> ActorMetrics::Start(
-    const std::string& bind_address) {
-  if (bind_address.empty()) {
-    return absl::InvalidArgumentError(
-        "the metrics address is empty (expected IP:PORT)");
-  }
+    const std::string& bind_address, const std::string& auth_token) {
   auto metrics = absl::WrapUnique(new ActorMetrics());
-  try {
-    metrics->exposer_ = std::make_unique<prometheus::Exposer>(bind_address);
-  } catch (const std::exception& e) {
-    // civetweb reports every failure to listen the same way.
-    return absl::UnavailableError(
-        absl::StrCat("cannot serve actor metrics on \"", bind_address,
-                     "\" (in use, malformed, or not a local address; "
-                     "expected IP:PORT): ",
-                     e.what()));
-  }
-  metrics->exposer_->RegisterCollectable(metrics->registry_);
+  absl::StatusOr<std::unique_ptr<prometheus::Exposer>> exposer =
+      StartMetricsEndpoint({bind_address, auth_token}, metrics->registry_,
+                           "actor");
+  if (!exposer.ok()) return exposer.status();
+  metrics->exposer_ = *std::move(exposer);
   return metrics;
 }
 
-int ActorMetrics::port() const {
-  const std::vector<int> ports = exposer_->GetListeningPorts();
-  return ports.empty() ? 0 : ports.front();
-}
+int ActorMetrics::port() const { return MetricsPort(*exposer_); }
 
 void ActorMetrics::RecordEnvSteps(int64_t env_steps_total) {
   std::lock_guard<std::mutex> lock(mutex_);

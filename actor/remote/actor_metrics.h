@@ -23,11 +23,12 @@ namespace vantage {
 class ActorMetrics {
  public:
   // Serves the metrics over HTTP on `bind_address` ("IP:PORT", e.g.
-  // "0.0.0.0:9101"; port 0 lets the OS choose, see port()). An address
-  // that cannot be bound (in use, malformed, not local) is an Unavailable
-  // error naming it.
+  // "0.0.0.0:9101", or "PORT" for 127.0.0.1; port 0 lets the OS choose,
+  // see port()). Bound beyond loopback with an `auth_token`, it answers
+  // only HTTP basic auth "vantage:<token>". An address that cannot be
+  // bound (in use, malformed, not local) is an Unavailable error naming it.
   static absl::StatusOr<std::unique_ptr<ActorMetrics>> Start(
-      const std::string& bind_address);
+      const std::string& bind_address, const std::string& auth_token = "");
   ~ActorMetrics();
 
   ActorMetrics(const ActorMetrics&) = delete;

@@ -243,7 +243,7 @@ absl::Status RunRemoteActor(const RemoteActorConfig& config,
   std::unique_ptr<ActorMetrics> metrics;
   if (!config.metrics_address.empty()) {
     absl::StatusOr<std::unique_ptr<ActorMetrics>> started =
-        ActorMetrics::Start(config.metrics_address);
+        ActorMetrics::Start(config.metrics_address, config.security.auth_token);
     if (!started.ok()) return started.status();
     metrics = *std::move(started);
     std::fprintf(stderr, "%s: metrics on port %d\n", config.name.c_str(),

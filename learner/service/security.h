@@ -12,6 +12,7 @@
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
 #include "absl/strings/string_view.h"
+#include "common/util/constant_time.h"
 
 namespace vantage {
 
@@ -54,10 +55,6 @@ void AddAuthToken(const SecurityOptions& options, grpc::ClientContext& context);
 // OK if `token` is empty or the call carries it; UNAUTHENTICATED otherwise.
 grpc::Status CheckAuthToken(const grpc::ServerContext& context,
                             absl::string_view token);
-
-// Equality whose time depends only on the lengths, never on where the
-// contents differ.
-bool ConstantTimeEquals(absl::string_view a, absl::string_view b);
 
 }  // namespace vantage
 

@@ -35,7 +35,8 @@ absl::Status Errno(const std::string& what) {
 
 }  // namespace
 
-absl::StatusOr<std::string> HttpGet(int port, const std::string& path) {
+absl::StatusOr<std::string> HttpGet(int port, const std::string& path,
+                                    const std::string& headers) {
   Socket socket;
   if (socket.fd() < 0) return Errno("socket");
   // A hung server must fail the test, not stall it.
@@ -53,8 +54,8 @@ absl::StatusOr<std::string> HttpGet(int port, const std::string& path) {
     return Errno(absl::StrCat("connect to 127.0.0.1:", port));
   }
 
-  const std::string request =
-      absl::StrCat("GET ", path, " HTTP/1.0\r\nHost: 127.0.0.1\r\n\r\n");
+  const std::string request = absl::StrCat(
+      "GET ", path, " HTTP/1.0\r\nHost: 127.0.0.1\r\n", headers, "\r\n");
   for (size_t sent = 0; sent < request.size();) {
     const ssize_t n =
         send(socket.fd(), request.data() + sent, request.size() - sent, 0);

@@ -10,9 +10,11 @@
 
 namespace vantage {
 
-// GET http://127.0.0.1:<port><path>; the body of a 200 answer, otherwise
-// an error carrying the status line. Gives up after a few seconds.
-absl::StatusOr<std::string> HttpGet(int port, const std::string& path);
+// GET http://127.0.0.1:<port><path> with `headers` ("Name: value\r\n"
+// lines) added; the body of a 200 answer, otherwise an error carrying the
+// status line. Gives up after a few seconds.
+absl::StatusOr<std::string> HttpGet(int port, const std::string& path,
+                                    const std::string& headers = "");
 
 }  // namespace vantage
 
