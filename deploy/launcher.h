@@ -19,8 +19,9 @@ struct LaunchConfig {
   std::string work_dir;
   // Continue the run in run_dir from its last checkpoint.
   bool resume = false;
-  // Restarts of crashed actors before the run is given up.
-  int max_actor_restarts = 20;
+  // Restarts of crashed actors before the run is given up (a long run on
+  // preemptible nodes loses actors many times).
+  int max_actor_restarts = 100;
   // Restarts of a crashed learner (each resumes from the run's last
   // checkpoint; needs a run_dir with one) before the run is given up.
   int max_learner_restarts = 5;

@@ -76,26 +76,6 @@ TEST(DistributedTest, TwoActorsFeedOneLearner) {
   EXPECT_THAT(rows[4], ::testing::StartsWith("4096,4,4,"));
 }
 
-// The children of `parent` whose command line contains `word`.
-std::vector<int> ChildrenRunning(int parent, const std::string& word) {
-  std::vector<int> pids;
-  for (const auto& entry : std::filesystem::directory_iterator("/proc")) {
-    int pid = 0;
-    if (!absl::SimpleAtoi(entry.path().filename().string(), &pid)) continue;
-    const std::string stat = ReadFile(entry.path().string() + "/stat");
-    // Field 4 of /proc/PID/stat is the parent (after "(comm)").
-    const size_t close = stat.rfind(')');
-    if (close == std::string::npos) continue;
-    const std::vector<std::string> fields =
-        absl::StrSplit(stat.substr(close + 2), ' ');
-    if (fields.size() < 2 || fields[1] != std::to_string(parent)) continue;
-    std::string command = ReadFile(entry.path().string() + "/cmdline");
-    std::replace(command.begin(), command.end(), '\0', ' ');
-    if (command.find(word) != std::string::npos) pids.push_back(pid);
-  }
-  return pids;
-}
-
 // The main job: `vantage train --actors=2` supervises its processes; an
 // actor killed with SIGKILL mid-run is restarted (and logged), the learner
 // keeps training and the run completes.

@@ -1,8 +1,10 @@
 #include "tests/fakes/learner_process.h"
 
+#include <algorithm>
 #include <chrono>
 #include <filesystem>
 #include <thread>
+#include <vector>
 
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_split.h"
@@ -66,6 +68,26 @@ double Sample(const std::string& text, const std::string& name) {
     }
   }
   return -1;
+}
+
+// The children of `parent` whose command line contains `word`.
+std::vector<int> ChildrenRunning(int parent, const std::string& word) {
+  std::vector<int> pids;
+  for (const auto& entry : std::filesystem::directory_iterator("/proc")) {
+    int pid = 0;
+    if (!absl::SimpleAtoi(entry.path().filename().string(), &pid)) continue;
+    const std::string stat = ReadFile(entry.path().string() + "/stat");
+    // Field 4 of /proc/PID/stat is the parent (after "(comm)").
+    const size_t close = stat.rfind(')');
+    if (close == std::string::npos) continue;
+    const std::vector<std::string> fields =
+        absl::StrSplit(stat.substr(close + 2), ' ');
+    if (fields.size() < 2 || fields[1] != std::to_string(parent)) continue;
+    std::string command = ReadFile(entry.path().string() + "/cmdline");
+    std::replace(command.begin(), command.end(), '\0', ' ');
+    if (command.find(word) != std::string::npos) pids.push_back(pid);
+  }
+  return pids;
 }
 
 }  // namespace vantage

@@ -5,6 +5,7 @@
 // run the learner and actors as separate processes.
 
 #include <string>
+#include <vector>
 
 namespace vantage {
 
@@ -19,6 +20,9 @@ struct Learner {
 
 // Starts `vantage learner <args>` and waits for its port file.
 Learner StartLearner(const std::string& args);
+
+// The children of `parent` whose command line contains `word`.
+std::vector<int> ChildrenRunning(int parent, const std::string& word);
 
 // The port a process printed on stderr as "<who>: metrics on port N",
 // waiting up to 30 s; 0 if it never did.
