@@ -10,10 +10,12 @@
 
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <random>
 
 #include "bench/fastest.h"
 #include "learner/algorithms/ppo.h"
+#include "learner/update_guard.h"
 
 namespace vantage {
 namespace {
@@ -130,6 +132,18 @@ int RunLearnerBenchmark() {
     }
   })->Apply([](auto* b) { UseFastestOfSingleRuns(b, kRepetitions); });
 
+  // The same update inside the learner's rollback guard (snapshot before,
+  // finiteness checks after), which every learner update pays for.
+  benchmark::RegisterBenchmark("guarded_ppo_update", [&](benchmark::State&
+                                                             state) {
+    for (auto _ : state) {
+      UpdateGuard guard(*policy, *value, ppo, /*reward_scaler=*/nullptr);
+      const AlgorithmStats stats = ppo.Update(batch, progress, rng);
+      benchmark::DoNotOptimize(
+          guard.Fault(stats, std::numeric_limits<double>::infinity()));
+    }
+  })->Apply([](auto* b) { UseFastestOfSingleRuns(b, kRepetitions); });
+
   BarePpo bare;
   benchmark::RegisterBenchmark("bare_update", [&](benchmark::State& state) {
     for (auto _ : state) bare.Update(batch);
@@ -145,10 +159,12 @@ int RunLearnerBenchmark() {
   const double samples = static_cast<double>(kBatch) * kEpochs;
   const double ppo_rate = samples / collector.Seconds("ppo_update");
   const double bare_rate = samples / collector.Seconds("bare_update");
+  const double guarded_rate = samples / collector.Seconds("guarded_ppo_update");
   std::printf(
       "RESULT learner ppo_samples_per_s=%.0f bare_samples_per_s=%.0f "
-      "ratio=%.3f\n",
-      ppo_rate, bare_rate, ppo_rate / bare_rate);
+      "ratio=%.3f guarded_samples_per_s=%.0f guard_ratio=%.3f\n",
+      ppo_rate, bare_rate, ppo_rate / bare_rate, guarded_rate,
+      guarded_rate / ppo_rate);
   return 0;
 }
 

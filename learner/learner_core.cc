@@ -16,6 +16,7 @@
 #include "common/advantage/advantage.h"
 #include "learner/archive_io.h"
 #include "learner/ingest/training_batch.h"
+#include "learner/update_guard.h"
 
 namespace vantage {
 
@@ -142,7 +143,8 @@ absl::StatusOr<UpdateStats> LearnerCore::RunUpdate(SegmentSource& source) {
         return value_->forward(normalizer_.Normalize(observations, clip));
       });
   if (!batch.ok()) return batch.status();
-  const Snapshot before = TakeSnapshot();
+  UpdateGuard guard(*policy_, *value_, *updater_,
+                    config_.scale_rewards ? &reward_scaler_ : nullptr);
   if (config_.scale_rewards) {
     if (absl::Status status = reward_scaler_.Observe(rollouts); !status.ok()) {
       return status;
@@ -162,9 +164,10 @@ absl::StatusOr<UpdateStats> LearnerCore::RunUpdate(SegmentSource& source) {
       static_cast<double>(env_steps_) / config_.total_env_steps;
   UpdateStats stats;
   stats.algorithm = updater_->Update(update, progress, rng_);
-  stats.rollback_reason = UpdateFault(stats.algorithm);
+  stats.rollback_reason =
+      guard.Fault(stats.algorithm, config_.rollback_gradient_norm);
   if (!stats.rollback_reason.empty()) {
-    Restore(before);
+    guard.Restore();
     stats.rolled_back = true;
     ++rolled_back_updates_;
     std::fprintf(stderr,
@@ -206,79 +209,6 @@ absl::StatusOr<UpdateStats> LearnerCore::RunUpdate(SegmentSource& source) {
                              std::chrono::steady_clock::now() - update_start)
                              .count();
   return stats;
-}
-
-LearnerCore::Snapshot LearnerCore::TakeSnapshot() const {
-  Snapshot snapshot;
-  for (const at::Tensor& p : policy_->parameters()) {
-    snapshot.parameters.push_back(p.detach().clone());
-  }
-  for (const at::Tensor& p : value_->parameters()) {
-    snapshot.parameters.push_back(p.detach().clone());
-  }
-  // The optimisers' state is reached only through their archives.
-  torch::serialize::OutputArchive updater, scaler;
-  updater_->Save(updater);
-  std::ostringstream updater_bytes;
-  updater.save_to(updater_bytes);
-  snapshot.updater = updater_bytes.str();
-  if (config_.scale_rewards) {
-    reward_scaler_.Save(scaler);
-    std::ostringstream scaler_bytes;
-    scaler.save_to(scaler_bytes);
-    snapshot.reward_scaler = scaler_bytes.str();
-  }
-  return snapshot;
-}
-
-void LearnerCore::Restore(const Snapshot& snapshot) {
-  {
-    at::NoGradGuard no_grad;
-    size_t i = 0;
-    for (at::Tensor& p : policy_->parameters()) {
-      p.copy_(snapshot.parameters[i++]);
-    }
-    for (at::Tensor& p : value_->parameters()) {
-      p.copy_(snapshot.parameters[i++]);
-    }
-  }
-  // The state was saved by these very objects a moment ago, so failing to
-  // load it back is a programmer error.
-  torch::serialize::InputArchive updater;
-  std::istringstream updater_bytes(snapshot.updater);
-  updater.load_from(updater_bytes);
-  const absl::Status loaded = updater_->Load(updater);
-  TORCH_CHECK(loaded.ok(), "rollback: ", loaded.ToString());
-  if (config_.scale_rewards) {
-    torch::serialize::InputArchive scaler;
-    std::istringstream scaler_bytes(snapshot.reward_scaler);
-    scaler.load_from(scaler_bytes);
-    const absl::Status scaler_loaded = reward_scaler_.Load(scaler);
-    TORCH_CHECK(scaler_loaded.ok(), "rollback: ", scaler_loaded.ToString());
-  }
-}
-
-std::string LearnerCore::UpdateFault(const AlgorithmStats& stats) const {
-  if (!std::isfinite(stats.policy_loss) || !std::isfinite(stats.value_loss)) {
-    return absl::StrCat("non-finite loss: policy ", stats.policy_loss,
-                        ", value ", stats.value_loss);
-  }
-  // NaN (no gradient step of this kind) never exceeds the limit.
-  if (stats.max_gradient_norm > config_.rollback_gradient_norm) {
-    return absl::StrCat("gradient norm ", stats.max_gradient_norm,
-                        " above the limit of ", config_.rollback_gradient_norm);
-  }
-  for (const auto& item : policy_->named_parameters()) {
-    if (!at::isfinite(item.value()).all().item<bool>()) {
-      return absl::StrCat("non-finite policy parameter ", item.key());
-    }
-  }
-  for (const auto& item : value_->named_parameters()) {
-    if (!at::isfinite(item.value()).all().item<bool>()) {
-      return absl::StrCat("non-finite value parameter ", item.key());
-    }
-  }
-  return "";
 }
 
 namespace {

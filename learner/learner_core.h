@@ -125,17 +125,6 @@ class LearnerCore {
  private:
   explicit LearnerCore(const LearnerConfig& config);
 
-  // What an update may change and a rollback restores.
-  struct Snapshot {
-    std::vector<at::Tensor> parameters;  // policy's then value's
-    std::string updater;                 // the optimisers' state
-    std::string reward_scaler;
-  };
-  Snapshot TakeSnapshot() const;
-  void Restore(const Snapshot& snapshot);
-  // Why the networks may not be published after an update; empty if fine.
-  std::string UpdateFault(const AlgorithmStats& stats) const;
-
   const LearnerConfig config_;
   PolicyNetwork policy_;
   ValueNetwork value_;
