@@ -4,6 +4,7 @@
 #include <ATen/core/grad_mode.h>
 #include <torch/serialize/archive.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -32,6 +33,11 @@ absl::Status LearnerConfig::Validate() const {
   if (!(observation_clip > 0) || !(reward_clip > 0)) {
     return absl::InvalidArgumentError(
         "observation_clip and reward_clip must be > 0");
+  }
+  if (max_buffered_steps < 0) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("max_buffered_steps must be >= 0 (0: 8 batches), got ",
+                     max_buffered_steps));
   }
   if (!(rollback_gradient_norm > 0)) {
     return absl::InvalidArgumentError(absl::StrCat(
@@ -114,6 +120,14 @@ absl::StatusOr<UpdateStats> LearnerCore::RunUpdate(SegmentSource& source) {
     // Returns count only for segments the stitcher accepts (a duplicate
     // must not count twice).
     const std::vector<double> returns = segment->episode_returns;
+    // Room for this segment within the budget, at the expense of the
+    // streams fed least recently (an abandoned or hostile one first).
+    const int64_t budget =
+        config_.max_buffered_steps > 0
+            ? config_.max_buffered_steps
+            : 8 * config_.horizon * config_.rollouts_per_batch;
+    stitcher_.EvictDownTo(std::max<int64_t>(0, budget - segment->steps()),
+                          segment->actor_id, segment->env_slot);
     if (!stitcher_.Add(std::move(*segment)).ok()) {
       ++rejected_;
       continue;
@@ -205,6 +219,7 @@ absl::StatusOr<UpdateStats> LearnerCore::RunUpdate(SegmentSource& source) {
   stats.rejected_segments = rejected_;
   stats.stale_segments = stale_segments_;
   stats.stale_steps = stale_steps_;
+  stats.evicted_steps = stitcher_.stats().evicted_steps;
   stats.update_seconds = std::chrono::duration<double>(
                              std::chrono::steady_clock::now() - update_start)
                              .count();

@@ -41,6 +41,10 @@ struct LearnerConfig {
   // of its gradient steps is rolled back like one that produced non-finite
   // numbers; infinite: only non-finite numbers roll back.
   double rollback_gradient_norm = std::numeric_limits<double>::infinity();
+  // Steps the stitcher may hold in partial rollouts over all streams; past
+  // it, the least recently fed streams are dropped (counted in
+  // evicted_steps). 0: 8 batches (horizon * rollouts_per_batch * 8).
+  int64_t max_buffered_steps = 0;
   // What a segment's values must stay within (see ValidateSegment).
   ValueLimits value_limits;
   AdvantageConfig advantage;
@@ -61,6 +65,7 @@ struct UpdateStats {
   int64_t rejected_segments = 0;  // so far, any reason (stale included)
   int64_t stale_segments = 0;     // so far, too old a policy version
   int64_t stale_steps = 0;        // so far, dropped for their version
+  int64_t evicted_steps = 0;      // so far, dropped to stay in budget
   // This update produced a non-finite loss or parameter (or too large a
   // gradient) and was undone: the networks, the optimiser state and the
   // reward scaler are as before it, the batch is dropped, the version still

@@ -25,16 +25,19 @@ absl::Status RolloutStitcher::Add(Segment segment) {
   if (stream.started && segment.sequence > stream.next_sequence) {
     ++stats_.gaps;
     stats_.dropped_steps += stream.steps;
+    buffered_ -= stream.steps;
     stream.pieces.clear();
     stream.steps = 0;
   }
   stream.started = true;
   stream.next_sequence = segment.sequence + 1;
+  stream.last_fed = ++adds_;
   ++stats_.segments;
   const int64_t steps = segment.steps();
   stream.pieces.push_back(
       {std::make_shared<const Segment>(std::move(segment)), 0, steps});
   stream.steps += steps;
+  buffered_ += steps;
   while (stream.steps >= horizon_) {
     ready_.push_back(Cut(actor_id, env_slot, stream));
     ++stats_.rollouts;
@@ -69,6 +72,7 @@ Rollout RolloutStitcher::Cut(int64_t actor_id, int64_t env_slot,
     next_observation = s.observations.slice(0, e, e + 1);
     needed -= take;
     stream.steps -= take;
+    buffered_ -= take;
     piece.begin = e;
     if (piece.begin == piece.end) stream.pieces.pop_front();
   }
@@ -103,11 +107,39 @@ int64_t RolloutStitcher::DropStepsOlderThan(int64_t min_version) {
       const Piece& piece = stream.pieces.front();
       dropped += piece.end - piece.begin;
       stream.steps -= piece.end - piece.begin;
+      buffered_ -= piece.end - piece.begin;
       stream.pieces.pop_front();
     }
   }
   stats_.stale_steps += dropped;
   return dropped;
+}
+
+int64_t RolloutStitcher::EvictDownTo(int64_t max_steps, int64_t actor_id,
+                                     int64_t env_slot) {
+  int64_t evicted = 0;
+  while (buffered_ > max_steps) {
+    auto oldest = streams_.end();
+    for (auto it = streams_.begin(); it != streams_.end(); ++it) {
+      if (it->second.steps == 0 ||
+          it->first == std::make_pair(actor_id, env_slot)) {
+        continue;
+      }
+      if (oldest == streams_.end() ||
+          it->second.last_fed < oldest->second.last_fed) {
+        oldest = it;
+      }
+    }
+    if (oldest == streams_.end()) break;
+    buffered_ -= oldest->second.steps;
+    evicted += oldest->second.steps;
+    // The stream's next segment starts it afresh, as after a gap.
+    oldest->second.pieces.clear();
+    oldest->second.steps = 0;
+    oldest->second.started = false;
+  }
+  stats_.evicted_steps += evicted;
+  return evicted;
 }
 
 int64_t RolloutStitcher::ForgetActor(int64_t actor_id) {
@@ -120,14 +152,9 @@ int64_t RolloutStitcher::ForgetActor(int64_t actor_id) {
     ++end;
   }
   streams_.erase(begin, end);
+  buffered_ -= dropped;
   stats_.dropped_steps += dropped;
   return dropped;
-}
-
-int64_t RolloutStitcher::buffered_steps() const {
-  int64_t steps = 0;
-  for (const auto& entry : streams_) steps += entry.second.steps;
-  return steps;
 }
 
 }  // namespace vantage

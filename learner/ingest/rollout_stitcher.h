@@ -37,6 +37,7 @@ struct StitcherStats {
   int64_t dropped_steps = 0;   // buffered steps discarded at gaps
   int64_t stale_segments = 0;  // sequence at or below one already used
   int64_t stale_steps = 0;     // dropped as too old a policy version
+  int64_t evicted_steps = 0;   // dropped to keep the buffers in budget
 };
 
 // Joins each stream's segments, in sequence order, into rollouts of exactly
@@ -59,6 +60,13 @@ class RolloutStitcher {
   // Returns the number of steps dropped (also in stats().stale_steps).
   int64_t DropStepsOlderThan(int64_t min_version);
 
+  // Frees whole streams, the least recently fed first, until at most
+  // `max_steps` steps stay buffered; the stream (actor_id, env_slot) is
+  // spared (it is about to be fed). Returns the steps dropped (also in
+  // stats().evicted_steps). What bounds a learner's buffers however many
+  // streams its clients open.
+  int64_t EvictDownTo(int64_t max_steps, int64_t actor_id, int64_t env_slot);
+
   // Frees every stream of `actor_id` (a registration that expired), with
   // its buffered steps; returns how many were dropped (also counted in
   // stats().dropped_steps). Its later segments would start new streams.
@@ -67,7 +75,7 @@ class RolloutStitcher {
   size_t stream_count() const { return streams_.size(); }
 
   // Steps waiting in partial rollouts, over all streams.
-  int64_t buffered_steps() const;
+  int64_t buffered_steps() const { return buffered_; }
   const StitcherStats& stats() const { return stats_; }
 
  private:
@@ -81,6 +89,7 @@ class RolloutStitcher {
     bool started = false;
     std::deque<Piece> pieces;
     int64_t steps = 0;
+    int64_t last_fed = 0;  // the Add count when it last got a segment
   };
 
   Rollout Cut(int64_t actor_id, int64_t env_slot, Stream& stream);
@@ -89,6 +98,8 @@ class RolloutStitcher {
   std::map<std::pair<int64_t, int64_t>, Stream> streams_;
   std::vector<Rollout> ready_;
   StitcherStats stats_;
+  int64_t adds_ = 0;
+  int64_t buffered_ = 0;  // the sum of the streams' steps
 };
 
 }  // namespace vantage

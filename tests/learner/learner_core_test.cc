@@ -120,6 +120,28 @@ TEST(RollbackLimitTest, AnHonestRunNeverRollsBack) {
   }
 }
 
+TEST(BufferBudgetTest, StreamsThatNeverCompleteCannotGrowTheBuffers) {
+  auto actor = MakeTestActor(/*segment_length=*/kTestHorizon / 2);
+  LearnerConfig config = TestLearnerConfig(actor->spec(), "ppo");
+  config.max_buffered_steps = 3 * kTestHorizon;
+  auto learner = *LearnerCore::Create(config);
+  // Half-rollouts of 20 streams nobody completes, then an honest batch.
+  const std::vector<Segment> first = ActOneBatch(*actor, *learner);
+  std::vector<Segment> queue;
+  for (int64_t stream = 0; stream < 20; ++stream) {
+    Segment orphan = first[0];
+    orphan.actor_id = 100 + stream;
+    queue.push_back(orphan);
+  }
+  for (const Segment& s : first) queue.push_back(s);
+  for (const Segment& s : ActOneBatch(*actor, *learner)) queue.push_back(s);
+  const UpdateStats stats = UpdateWith(*learner, queue);
+  EXPECT_EQ(stats.policy_version, 1);
+  EXPECT_LE(learner->stitcher().buffered_steps(), 3 * kTestHorizon);
+  EXPECT_GE(stats.evicted_steps, 20 * kTestHorizon / 2 - 3 * kTestHorizon);
+  EXPECT_EQ(stats.evicted_steps, learner->stitcher().stats().evicted_steps);
+}
+
 TEST(LearnerConfigTest, RefusesBadLimits) {
   auto actor = MakeTestActor();
   LearnerConfig config = TestLearnerConfig(actor->spec(), "ppo");
@@ -130,6 +152,10 @@ TEST(LearnerConfigTest, RefusesBadLimits) {
   config.value_limits.max_abs_observation = -1;
   EXPECT_THAT(config.Validate().message(),
               HasSubstr("max_abs_observation must be > 0"));
+  config = TestLearnerConfig(actor->spec(), "ppo");
+  config.max_buffered_steps = -1;
+  EXPECT_THAT(config.Validate().message(),
+              HasSubstr("max_buffered_steps must be >= 0"));
 }
 
 }  // namespace

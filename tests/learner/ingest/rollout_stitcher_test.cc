@@ -159,5 +159,41 @@ TEST(RolloutStitcherTest, StreamsStayApart) {
   EXPECT_EQ(rollouts[1].env_slot, 1);
 }
 
+TEST(RolloutStitcherTest, EvictionDropsTheLeastRecentlyFedStreams) {
+  RolloutStitcher stitcher(32);
+  // Three partial streams of 7, 8 and 9 steps, fed in the order 0, 1, 2.
+  for (int64_t slot = 0; slot < 3; ++slot) {
+    const Stream s = MakeStream({7 + slot}, /*actor=*/7, slot);
+    ASSERT_TRUE(stitcher.Add(s.segments[0]).ok());
+  }
+  EXPECT_EQ(stitcher.buffered_steps(), 24);
+  // Room for 12 with slot 0 spared: slot 1 (the older) goes, then slot 2.
+  EXPECT_EQ(stitcher.EvictDownTo(12, /*actor_id=*/7, /*env_slot=*/0), 8 + 9);
+  EXPECT_EQ(stitcher.buffered_steps(), 7);
+  EXPECT_EQ(stitcher.stats().evicted_steps, 17);
+  // The spared stream is never evicted, even when alone over budget.
+  EXPECT_EQ(stitcher.EvictDownTo(0, 7, 0), 0);
+  EXPECT_EQ(stitcher.buffered_steps(), 7);
+  // An evicted stream starts afresh with its next segment.
+  const Stream again = MakeStream({8, 32}, 7, 1);
+  ASSERT_TRUE(stitcher.Add(again.segments[1]).ok());
+  EXPECT_EQ(stitcher.TakeReady().size(), 1u);
+  EXPECT_EQ(stitcher.buffered_steps(), 7);
+}
+
+TEST(RolloutStitcherTest, ForgettingAnActorFreesItsStreams) {
+  RolloutStitcher stitcher(16);
+  for (int64_t actor : {3, 4}) {
+    for (int64_t slot = 0; slot < 2; ++slot) {
+      ASSERT_TRUE(stitcher.Add(MakeStream({7}, actor, slot).segments[0]).ok());
+    }
+  }
+  EXPECT_EQ(stitcher.stream_count(), 4u);
+  EXPECT_EQ(stitcher.ForgetActor(3), 14);
+  EXPECT_EQ(stitcher.stream_count(), 2u);
+  EXPECT_EQ(stitcher.buffered_steps(), 14);
+  EXPECT_EQ(stitcher.ForgetActor(9), 0);
+}
+
 }  // namespace
 }  // namespace vantage
