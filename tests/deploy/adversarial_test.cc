@@ -42,22 +42,6 @@ constexpr int64_t kSegmentSteps = 8;
 // How much the learner's resident memory may grow over a whole attack.
 constexpr int64_t kRssBoundBytes = 150 << 20;
 
-// A /proc/PID/status field in bytes (VmRSS) or as a count (Threads).
-int64_t ProcStatus(int pid, const std::string& field) {
-  std::ifstream file(absl::StrCat("/proc/", pid, "/status"));
-  std::string line;
-  while (std::getline(file, line)) {
-    absl::string_view rest = line;
-    if (!absl::ConsumePrefix(&rest, field + ":")) continue;
-    int64_t value = 0;
-    const std::vector<std::string> words =
-        absl::StrSplit(absl::StripAsciiWhitespace(rest), ' ');
-    if (!absl::SimpleAtoi(words[0], &value)) return -1;
-    return words.size() > 1 && words[1] == "kB" ? value * 1024 : value;
-  }
-  return -1;
-}
-
 pb::EnvSpec PendulumSpec() {
   pb::EnvSpec spec;
   spec.set_name("InvertedPendulum");
@@ -133,7 +117,7 @@ class AdversarialTest : public ::testing::Test {
         TempPath("actor.out"), TempPath("actor.err"));
     // Training under way before the first attack.
     WaitForNewVersions(3);
-    baseline_rss_ = ProcStatus(learner_->pid, "VmRSS");
+    baseline_rss_ = ProcessStatusField(learner_->pid, "VmRSS");
   }
 
   void TearDown() override {
@@ -165,11 +149,11 @@ class AdversarialTest : public ::testing::Test {
 
   void ExpectTrainingGoesOn() {
     WaitForNewVersions(3);
-    const int64_t rss = ProcStatus(learner_->pid, "VmRSS");
+    const int64_t rss = ProcessStatusField(learner_->pid, "VmRSS");
     EXPECT_LT(rss, baseline_rss_ + kRssBoundBytes)
         << "learner RSS grew from " << baseline_rss_ << " to " << rss;
     // The server's threads stay bounded (a few per actor and call).
-    EXPECT_LT(ProcStatus(learner_->pid, "Threads"), 80);
+    EXPECT_LT(ProcessStatusField(learner_->pid, "Threads"), 80);
     for (const std::string& row : DeterministicProgress(*run_)) {
       EXPECT_THAT(row, ::testing::Not(HasSubstr("nan"))) << row;
     }
@@ -447,7 +431,7 @@ TEST_F(AdversarialTest, RegistrationFloodsHitTheLimitAndExpire) {
 
 TEST_F(AdversarialTest, IdleAndRepeatedStreamsHoldNoThreads) {
   const Registered attacker = RegisterAttacker();
-  const int64_t threads_before = ProcStatus(learner_->pid, "Threads");
+  const int64_t threads_before = ProcessStatusField(learner_->pid, "Threads");
   // 200 streams of one session: each newer one ends the one before, so at
   // most one is open at a time.
   std::vector<std::unique_ptr<grpc::ClientContext>> contexts;
@@ -461,7 +445,7 @@ TEST_F(AdversarialTest, IdleAndRepeatedStreamsHoldNoThreads) {
     writers.push_back(stub->StreamSegments(contexts.back().get(), &acks[i]));
   }
   std::this_thread::sleep_for(std::chrono::milliseconds(500));
-  EXPECT_LT(ProcStatus(learner_->pid, "Threads"), threads_before + 10);
+  EXPECT_LT(ProcessStatusField(learner_->pid, "Threads"), threads_before + 10);
   // The newest one, silent, is cancelled after --idle_stream_timeout_s=2.
   const grpc::Status last = writers.back()->Finish();
   EXPECT_EQ(last.error_code(), grpc::StatusCode::CANCELLED);

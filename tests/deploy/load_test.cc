@@ -31,21 +31,6 @@ constexpr int kIdleStreams = 1000;
 constexpr int kSilentActors = 50;
 constexpr int kChannels = 100;  // 10 streams each, within HTTP/2's limits
 
-int64_t ProcField(int pid, const std::string& field) {
-  std::ifstream file(absl::StrCat("/proc/", pid, "/status"));
-  std::string line;
-  while (std::getline(file, line)) {
-    absl::string_view rest = line;
-    if (!absl::ConsumePrefix(&rest, field + ":")) continue;
-    const std::vector<std::string> words =
-        absl::StrSplit(absl::StripAsciiWhitespace(rest), ' ');
-    int64_t value = 0;
-    if (!absl::SimpleAtoi(words[0], &value)) return -1;
-    return words.size() > 1 && words[1] == "kB" ? value * 1024 : value;
-  }
-  return -1;
-}
-
 int64_t Versions(const std::string& run) {
   const int64_t rows = DeterministicProgress(run).size();
   return rows > 0 ? rows - 1 : 0;
@@ -83,8 +68,8 @@ TEST(LoadTest, IdleStreamsAndSilentActorsDoNotSlowTraining) {
     std::this_thread::sleep_for(std::chrono::milliseconds(50));
   }
   const double undisturbed = VersionsPerSecond(run, 15);
-  const int64_t threads_before = ProcField(learner.pid, "Threads");
-  const int64_t rss_before = ProcField(learner.pid, "VmRSS");
+  const int64_t threads_before = ProcessStatusField(learner.pid, "Threads");
+  const int64_t rss_before = ProcessStatusField(learner.pid, "VmRSS");
 
   std::vector<std::shared_ptr<grpc::Channel>> channels;
   for (int i = 0; i < kChannels; ++i) {
@@ -132,8 +117,8 @@ TEST(LoadTest, IdleStreamsAndSilentActorsDoNotSlowTraining) {
         stubs[i % kChannels]->StreamSegments(contexts.back().get(), &acks[i]));
   }
   const double loaded = VersionsPerSecond(run, 15);
-  const int64_t threads_loaded = ProcField(learner.pid, "Threads");
-  const int64_t rss_loaded = ProcField(learner.pid, "VmRSS");
+  const int64_t threads_loaded = ProcessStatusField(learner.pid, "Threads");
+  const int64_t rss_loaded = ProcessStatusField(learner.pid, "VmRSS");
   std::printf(
       "load: %.2f versions/s undisturbed, %.2f under %d idle streams and %d "
       "silent actors; learner threads %ld -> %ld, RSS %ld -> %ld MB\n",

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <filesystem>
+#include <fstream>
 #include <thread>
 #include <vector>
 
@@ -66,6 +67,21 @@ double Sample(const std::string& text, const std::string& name) {
       double value = 0;
       if (absl::SimpleAtod(line, &value)) return value;
     }
+  }
+  return -1;
+}
+
+int64_t ProcessStatusField(int pid, const std::string& field) {
+  std::ifstream file("/proc/" + std::to_string(pid) + "/status");
+  std::string line;
+  while (std::getline(file, line)) {
+    absl::string_view rest = line;
+    if (!absl::ConsumePrefix(&rest, field + ":")) continue;
+    const std::vector<std::string> words =
+        absl::StrSplit(absl::StripAsciiWhitespace(rest), ' ');
+    int64_t value = 0;
+    if (!absl::SimpleAtoi(words[0], &value)) return -1;
+    return words.size() > 1 && words[1] == "kB" ? value * 1024 : value;
   }
   return -1;
 }

@@ -4,6 +4,7 @@
 // A real `vantage learner` process on a loopback port, for the tests that
 // run the learner and actors as separate processes.
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -20,6 +21,10 @@ struct Learner {
 
 // Starts `vantage learner <args>` and waits for its port file.
 Learner StartLearner(const std::string& args);
+
+// A field of /proc/PID/status: in bytes for sizes ("VmRSS"), as a count
+// otherwise ("Threads"); -1 if absent.
+int64_t ProcessStatusField(int pid, const std::string& field);
 
 // The children of `parent` whose command line contains `word`.
 std::vector<int> ChildrenRunning(int parent, const std::string& word);
