@@ -4,6 +4,7 @@
 #include <torch/nn/module.h>
 #include <torch/serialize/archive.h>
 
+#include <exception>
 #include <vector>
 
 #include "absl/strings/str_cat.h"
@@ -17,6 +18,10 @@ absl::Status CatchTorchErrors(absl::string_view what,
   } catch (const c10::Error& error) {
     return absl::InvalidArgumentError(
         absl::StrCat(what, ": ", error.what_without_backtrace()));
+  } catch (const std::exception& error) {
+    // Not every LibTorch error is a c10::Error: the TorchScript parser that
+    // reads an archive's code/ entries throws std::runtime_error.
+    return absl::InvalidArgumentError(absl::StrCat(what, ": ", error.what()));
   }
   return absl::OkStatus();
 }

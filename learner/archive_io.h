@@ -39,8 +39,6 @@ void WriteRunningMeanStd(torch::serialize::OutputArchive& archive,
 absl::Status ReadRunningMeanStd(torch::serialize::InputArchive& archive,
                                 const std::string& key, RunningMeanStd& stats);
 
-// Runs `read` and turns a LibTorch exception (a module or optimiser whose
-// saved shapes do not fit) into InvalidArgument naming `what`.
 // A module's parameters and buffers, flat, as `key`.<name>. Loading
 // checks every entry's presence, dtype and shape before copying any, so
 // on error the module is unchanged.
@@ -49,6 +47,9 @@ void WriteModule(torch::serialize::OutputArchive& archive,
 absl::Status ReadModule(torch::serialize::InputArchive& archive,
                         const std::string& key, torch::nn::Module& module);
 
+// Runs `read` and turns a LibTorch exception (a module or optimiser whose
+// saved shapes do not fit, an archive whose TorchScript does not parse)
+// into InvalidArgument naming `what`.
 absl::Status CatchTorchErrors(absl::string_view what,
                               absl::FunctionRef<void()> read);
 

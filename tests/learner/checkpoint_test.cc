@@ -4,6 +4,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 
 #include "actor/actor_core.h"
 #include "gmock/gmock.h"
@@ -118,6 +119,26 @@ TEST_F(CheckpointErrorTest, AnotherAlgorithmIsRefused) {
   const absl::Status status = ReadCheckpoint(path_, other).status();
   EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument);
   EXPECT_THAT(std::string(status.message()), HasSubstr("ppo"));
+}
+
+// A checkpoint carries the TorchScript of its archives' module types, which
+// LibTorch compiles while loading (it checks no zip CRCs) and whose syntax
+// errors it throws as std::runtime_error, not c10::Error. Found by
+// tests/fuzz/checkpoint_fuzzer: the reader used to terminate the process.
+TEST_F(CheckpointErrorTest, BrokenArchiveCodeIsRefused) {
+  std::stringstream read;
+  read << std::ifstream(path_, std::ios::binary).rdbuf();
+  std::string bytes = read.str();
+  const size_t code = bytes.find("class Module(Module):");
+  ASSERT_NE(code, std::string::npos);
+  bytes[code] = ';';
+  const std::string broken = TempFile("broken_code.pt");
+  std::ofstream(broken, std::ios::binary) << bytes;
+  for (const absl::Status& status : {ReadCheckpoint(broken, config_).status(),
+                                     ReadCheckpointExtras(broken).status()}) {
+    EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument);
+    EXPECT_THAT(std::string(status.message()), HasSubstr(broken));
+  }
 }
 
 TEST_F(CheckpointErrorTest, UnwritableDirectoryIsAnErrorAndLeavesNoFile) {
