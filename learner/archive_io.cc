@@ -137,6 +137,12 @@ absl::Status ReadModule(torch::serialize::InputArchive& archive,
                        entry, "' has shape ", c10::str(read[i].sizes()),
                        ", the network ", c10::str(tensors[i].second.sizes())));
     }
+    // A learner publishes what it loads, and never non-finite weights.
+    if (read[i].is_floating_point() &&
+        !at::isfinite(read[i]).all().item<bool>()) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          "checkpoint entry '", entry, "' holds non-finite values"));
+    }
   }
   at::NoGradGuard no_grad;
   for (size_t i = 0; i < tensors.size(); ++i) {

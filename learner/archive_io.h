@@ -40,8 +40,8 @@ absl::Status ReadRunningMeanStd(torch::serialize::InputArchive& archive,
                                 const std::string& key, RunningMeanStd& stats);
 
 // A module's parameters and buffers, flat, as `key`.<name>. Loading
-// checks every entry's presence, dtype and shape before copying any, so
-// on error the module is unchanged.
+// checks every entry's presence, dtype, shape and finiteness before copying
+// any, so on error the module is unchanged.
 void WriteModule(torch::serialize::OutputArchive& archive,
                  const std::string& key, const torch::nn::Module& module);
 absl::Status ReadModule(torch::serialize::InputArchive& archive,

@@ -1,12 +1,15 @@
 #include "learner/checkpoint.h"
 
 #include <ATen/ATen.h>
+#include <torch/serialize/archive.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 
 #include "actor/actor_core.h"
+#include "common/nn/networks.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
 #include "tests/fakes/learner_batches.h"
@@ -139,6 +142,25 @@ TEST_F(CheckpointErrorTest, BrokenArchiveCodeIsRefused) {
     EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument);
     EXPECT_THAT(std::string(status.message()), HasSubstr(broken));
   }
+}
+
+// A learner publishes the weights it loads, and it must never publish
+// non-finite ones. Found by tests/fuzz/checkpoint_entries_fuzzer.
+TEST_F(CheckpointErrorTest, NonFiniteWeightsAreRefused) {
+  torch::serialize::OutputArchive archive;
+  learner_->Save(archive);
+  PolicyNetwork policy(config_.spec, config_.network);
+  const auto first = policy->named_parameters()[0];
+  at::Tensor poisoned = first.value().detach().clone();
+  poisoned.view(-1)[0] = std::nan("");
+  const std::string entry = "policy." + first.key();
+  archive.write(entry, poisoned);
+  const std::string path = TempFile("non_finite.pt");
+  archive.save_to(path);
+  const absl::Status status = ReadCheckpoint(path, config_).status();
+  EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(std::string(status.message()), HasSubstr(entry));
+  EXPECT_THAT(std::string(status.message()), HasSubstr("non-finite"));
 }
 
 TEST_F(CheckpointErrorTest, UnwritableDirectoryIsAnErrorAndLeavesNoFile) {
