@@ -1,6 +1,7 @@
 #include "actor/envs/mujoco/gym_tasks.h"
 
 #include <cmath>
+#include <limits>
 #include <utility>
 
 #include "absl/strings/match.h"
@@ -133,11 +134,14 @@ absl::StatusOr<std::unique_ptr<Environment>> MakeMjcfEnv(
       if (size != 1) return bad(key, "needs exactly one number");
       return values[0];
     };
-    const auto positive_integer = [&]() -> absl::StatusOr<int64_t> {
+    // `max` must be exact as a double, so that every value this accepts
+    // converts to an integer exactly.
+    const auto positive_integer = [&](int64_t max) -> absl::StatusOr<int64_t> {
       absl::StatusOr<double> value = one();
       if (!value.ok()) return value.status();
-      if (*value < 1 || *value != std::floor(*value)) {
-        return bad(key, "needs a whole number >= 1");
+      if (*value < 1 || *value > static_cast<double>(max) ||
+          *value != std::floor(*value)) {
+        return bad(key, absl::StrCat("needs a whole number in [1, ", max, "]"));
       }
       return static_cast<int64_t>(*value);
     };
@@ -163,11 +167,13 @@ absl::StatusOr<std::unique_ptr<Environment>> MakeMjcfEnv(
       task.terminate_when_unhealthy = true;
       has_healthy_z = true;
     } else if (key == "vantage_frame_skip") {
-      absl::StatusOr<int64_t> value = positive_integer();
+      absl::StatusOr<int64_t> value =
+          positive_integer(std::numeric_limits<int>::max());
       if (!value.ok()) return value.status();
       task.frame_skip = static_cast<int>(*value);
     } else if (key == "vantage_max_steps") {
-      absl::StatusOr<int64_t> value = positive_integer();
+      // Above 2^53 not every whole number is a double.
+      absl::StatusOr<int64_t> value = positive_integer(int64_t{1} << 53);
       if (!value.ok()) return value.status();
       task.max_episode_steps = *value;
     } else {

@@ -333,6 +333,13 @@ TEST_F(MjcfEnvTest, BadCustomEntriesAreNamed) {
        "names body 'wheel'"},
       {R"(<numeric name="vantage_healthy_z" data="0 1"/>)",
        "needs vantage_forward_body"},
+      // Whole numbers beyond the setting's type: converting them was
+      // undefined behaviour (found by tests/fuzz/mjcf_fuzzer) or wrapped
+      // around (4294967297 frames became 1).
+      {R"(<numeric name="vantage_max_steps" data="922337203685477580850"/>)",
+       "'vantage_max_steps' needs a whole number in [1, 9007199254740992]"},
+      {R"(<numeric name="vantage_frame_skip" data="4294967297"/>)",
+       "'vantage_frame_skip' needs a whole number in [1, 2147483647]"},
   };
   int i = 0;
   for (const auto& [custom, message] : cases) {
