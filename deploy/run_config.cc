@@ -55,17 +55,24 @@ absl::StatusOr<pb::RunConfig> ResolveRunConfig(const pb::RunConfig& given) {
     if (c.actors() < 1 || c.actors() > 256) {
       return Invalid("actors", "must be in [1, 256]");
     }
-    if (c.envs_per_actor() < 1)
-      return Invalid("envs_per_actor", "must be >= 1");
+    if (c.envs_per_actor() < 1 || c.envs_per_actor() > 4096) {
+      return Invalid("envs_per_actor", "must be in [1, 4096]");
+    }
+    // At most 256 x 4096: the product fits an int32.
+    const int32_t streams = c.actors() * c.envs_per_actor();
+    if (streams > 4096) {
+      return Invalid("envs_per_actor",
+                     absl::StrCat("makes --actors x --envs_per_actor = ",
+                                  streams, " streams, more than 4096"));
+    }
     // The learner's batch holds one rollout per actor environment.
-    if (c.has_envs() && c.envs() != c.actors() * c.envs_per_actor()) {
+    if (c.has_envs() && c.envs() != streams) {
       return Invalid("envs",
                      absl::StrCat("is the learner's batch of --actors x "
                                   "--envs_per_actor = ",
-                                  c.actors() * c.envs_per_actor(),
-                                  " streams in a distributed run"));
+                                  streams, " streams in a distributed run"));
     }
-    c.set_envs(c.actors() * c.envs_per_actor());
+    c.set_envs(streams);
   } else {
     c.clear_actors();
     c.clear_envs_per_actor();
