@@ -31,10 +31,11 @@ namespace vantage {
 // a few hundred actors; every one is a flag of `vantage learner`.
 struct GatewayLimits {
   int64_t max_live_actors = 256;
-  int64_t max_envs_per_actor = 1024;
-  // Env streams over all live registrations: each may buffer up to a
-  // horizon of steps in the learner, so this bounds that memory.
-  int64_t max_live_env_slots = 4096;
+  // A run config allows up to 4096 envs per actor and 4096 in all.
+  int64_t max_envs_per_actor = 4096;
+  // Env streams over all live registrations (twice a run's largest, for
+  // the registrations of reconnected actors that have not expired yet).
+  int64_t max_live_env_slots = 8192;
   // A registration with no open call for this long expires: its session
   // stops working and the learner frees what it buffered for it.
   absl::Duration actor_expiry = absl::Seconds(60);
