@@ -27,6 +27,7 @@ packages=(
   libabsl-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   prometheus-cpp-dev
+  libminizip-dev
 )
 
 missing=()

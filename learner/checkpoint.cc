@@ -15,6 +15,7 @@
 #include "absl/strings/str_format.h"
 #include "absl/strings/str_join.h"
 #include "absl/strings/str_split.h"
+#include "learner/archive_integrity.h"
 #include "learner/archive_io.h"
 
 namespace vantage {
@@ -57,6 +58,9 @@ absl::StatusOr<torch::serialize::InputArchive> OpenArchive(
     const std::string& path) {
   if (!std::filesystem::is_regular_file(path)) {
     return absl::NotFoundError(absl::StrCat("no checkpoint file ", path));
+  }
+  if (absl::Status status = VerifyArchiveIntegrity(path); !status.ok()) {
+    return status;
   }
   torch::serialize::InputArchive archive;
   if (absl::Status status = CatchTorchErrors(

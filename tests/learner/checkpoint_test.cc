@@ -124,23 +124,70 @@ TEST_F(CheckpointErrorTest, AnotherAlgorithmIsRefused) {
   EXPECT_THAT(std::string(status.message()), HasSubstr("ppo"));
 }
 
-// A checkpoint carries the TorchScript of its archives' module types, which
-// LibTorch compiles while loading (it checks no zip CRCs) and whose syntax
-// errors it throws as std::runtime_error, not c10::Error. Found by
-// tests/fuzz/checkpoint_fuzzer: the reader used to terminate the process.
-TEST_F(CheckpointErrorTest, BrokenArchiveCodeIsRefused) {
+std::string ReadAll(const std::string& path) {
   std::stringstream read;
-  read << std::ifstream(path_, std::ios::binary).rdbuf();
-  std::string bytes = read.str();
+  read << std::ifstream(path, std::ios::binary).rdbuf();
+  return read.str();
+}
+
+// Every read of a checkpoint (the learner, and the extras a resume reads
+// first) refuses `bytes` as damaged, naming the file and `why`.
+void ExpectDamaged(const std::string& bytes, const std::string& name,
+                   const LearnerConfig& config, const std::string& why) {
+  const std::string path = TempFile(name);
+  std::ofstream(path, std::ios::binary) << bytes;
+  for (const absl::Status& status : {ReadCheckpoint(path, config).status(),
+                                     ReadCheckpointExtras(path).status()}) {
+    EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument) << status;
+    EXPECT_THAT(std::string(status.message()),
+                HasSubstr("checkpoint " + path + " is damaged"));
+    EXPECT_THAT(std::string(status.message()), HasSubstr(why));
+  }
+}
+
+// A checkpoint carries the TorchScript of its archives' module types, which
+// LibTorch compiles while loading without checking any zip CRC; some corrupt
+// sources crash its parser (found by tests/fuzz/checkpoint_fuzzer). The
+// CRC-32 check refuses them before LibTorch reads anything.
+TEST_F(CheckpointErrorTest, BrokenArchiveCodeIsRefused) {
+  std::string bytes = ReadAll(path_);
   const size_t code = bytes.find("class Module(Module):");
   ASSERT_NE(code, std::string::npos);
   bytes[code] = ';';
-  const std::string broken = TempFile("broken_code.pt");
-  std::ofstream(broken, std::ios::binary) << bytes;
-  for (const absl::Status& status : {ReadCheckpoint(broken, config_).status(),
-                                     ReadCheckpointExtras(broken).status()}) {
-    EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument);
-    EXPECT_THAT(std::string(status.message()), HasSubstr(broken));
+  ExpectDamaged(bytes, "broken_code.pt", config_, "fails its CRC-32 check");
+}
+
+// One flipped bit in a weight used to load silently as another weight.
+TEST_F(CheckpointErrorTest, AFlippedBitInAWeightIsRefused) {
+  at::Tensor largest;  // a weight matrix: random, so its bytes are unique
+  for (const at::Tensor& parameter : learner_->CurrentWeights().parameters) {
+    if (!largest.defined() || parameter.numel() > largest.numel()) {
+      largest = parameter.contiguous();
+    }
+  }
+  const std::string weights(reinterpret_cast<const char*>(largest.data_ptr()),
+                            largest.numel() * largest.element_size());
+  std::string bytes = ReadAll(path_);
+  const size_t at = bytes.find(weights);
+  ASSERT_NE(at, std::string::npos);
+  bytes[at + weights.size() / 2] ^= 0x01;
+  ExpectDamaged(bytes, "flipped_weight.pt", config_,
+                "fails its CRC-32 check");
+}
+
+// A copy cut short (a full disk, an interrupted transfer): refused as a
+// damaged archive, or, when only the end record's tail is missing (every
+// entry and the zip64 directory intact), by LibTorch's reader.
+TEST_F(CheckpointErrorTest, ATruncatedCopyIsRefused) {
+  const std::string bytes = ReadAll(path_);
+  ExpectDamaged(bytes.substr(0, bytes.size() / 2), "truncated.pt", config_,
+                "not a zip archive");
+  const std::string path = TempFile("end_record_cut.pt");
+  std::ofstream(path, std::ios::binary) << bytes.substr(0, bytes.size() - 10);
+  for (const absl::Status& status : {ReadCheckpoint(path, config_).status(),
+                                     ReadCheckpointExtras(path).status()}) {
+    EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument) << status;
+    EXPECT_THAT(std::string(status.message()), HasSubstr(path));
   }
 }
 
