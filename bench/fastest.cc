@@ -1,5 +1,7 @@
 #include "bench/fastest.h"
 
+#include <unistd.h>
+
 #include <algorithm>
 
 namespace vantage {
@@ -27,6 +29,10 @@ void UseFastestOfSingleRuns(benchmark::internal::Benchmark* benchmark,
       ->Unit(benchmark::kMillisecond);
   ReportFastest(benchmark);
 }
+
+FastestCollector::FastestCollector()
+    : ConsoleReporter(::isatty(STDOUT_FILENO) == 1 ? OO_ColorTabular
+                                                   : OO_Tabular) {}
 
 void FastestCollector::ReportRuns(const std::vector<Run>& runs) {
   for (const Run& run : runs) {

@@ -25,8 +25,12 @@ void UseFastestOfSingleRuns(benchmark::internal::Benchmark* benchmark,
 
 // Prints as the console reporter does and records each benchmark's fastest
 // repetition (seconds per iteration).
+// Colours only on a terminal: Google Benchmark's console reporter colours
+// by default, and its escape codes in a pipe would precede the RESULT lines
+// that scripts read.
 class FastestCollector : public benchmark::ConsoleReporter {
  public:
+  FastestCollector();
   void ReportRuns(const std::vector<Run>& runs) override;
   // -1 if the benchmark did not run.
   double Seconds(const std::string& name) const;

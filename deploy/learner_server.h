@@ -7,9 +7,9 @@
 
 #include "absl/status/status.h"
 #include "common/env/environment.h"
+#include "common/net/security_options.h"
 #include "deploy/local_training.h"
 #include "learner/service/actor_gateway.h"
-#include "learner/service/security.h"
 #include "proto/run_config.pb.h"
 
 namespace vantage {

@@ -37,7 +37,8 @@ absl::Status VerifyArchiveIntegrity(const std::string& path) {
     const std::string entry = absl::StrCat("entry '", name.data(), "'");
     // Opening checks the entry's local header against its directory record.
     if (unzOpenCurrentFile(zip.get()) != UNZ_OK) {
-      return Damaged(path, absl::StrCat(entry, " has no matching local header"));
+      return Damaged(path,
+                     absl::StrCat(entry, " has no matching local header"));
     }
     int read = 0;
     do {

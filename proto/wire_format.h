@@ -26,6 +26,10 @@
 
 namespace vantage {
 
+// The call metadata entry that carries a registration's session (what
+// RegisterResponse.session returned) on every stream and subscription.
+inline constexpr char kSessionMetadataKey[] = "vantage-session";
+
 // Supports float32, float64, int64, bool and uint8 tensors on any device and
 // with any strides; other dtypes are a programmer error (c10::Error). An
 // undefined tensor clears `proto`, which TensorFromProto refuses.

@@ -12,11 +12,7 @@
 #include <string>
 
 #include "absl/status/statusor.h"
-#include "common/util/running_total.h"
-#include "prometheus/counter.h"
-#include "prometheus/exposer.h"
-#include "prometheus/gauge.h"
-#include "prometheus/registry.h"
+#include "common/metrics/metrics_registry.h"
 
 namespace vantage {
 
@@ -54,8 +50,7 @@ class ActorMetrics {
  private:
   ActorMetrics();
 
-  // Declared before the exposer, so it outlives the exposer's threads.
-  std::shared_ptr<prometheus::Registry> registry_;
+  MetricsRegistry metrics_;  // first: every series below lives in it
   prometheus::Counter& env_steps_;
   prometheus::Counter& segments_sent_;
   prometheus::Counter& inference_seconds_;
@@ -65,9 +60,7 @@ class ActorMetrics {
   prometheus::Counter& reconnects_;
 
   std::mutex mutex_;  // guards env_steps_total_
-  RunningTotal env_steps_total_;
-
-  std::unique_ptr<prometheus::Exposer> exposer_;
+  TotalCounter env_steps_total_;
 };
 
 }  // namespace vantage

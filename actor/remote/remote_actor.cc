@@ -12,6 +12,7 @@
 #include "actor/actor_core.h"
 #include "actor/envs/env_registry.h"
 #include "actor/remote/actor_metrics.h"
+#include "common/net/grpc_security.h"
 #include "proto/vantage.grpc.pb.h"
 #include "proto/wire_format.h"
 
@@ -23,10 +24,6 @@ absl::Status FromGrpc(const grpc::Status& status, absl::string_view what) {
   return absl::Status(static_cast<absl::StatusCode>(status.error_code()),
                       absl::StrCat(what, ": ", status.error_message()));
 }
-
-// Where the registration's session travels (the learner's
-// kSessionMetadataKey; actors do not include the learner's headers).
-constexpr char kSessionKey[] = "vantage-session";
 
 // Refusals that no retry can mend (an expired registration, NOT_FOUND, is
 // mended by registering again).
@@ -137,7 +134,7 @@ class Session {
     WeightsSlot slot;
     grpc::ClientContext subscription_context;
     AddAuthToken(config_.security, subscription_context);
-    subscription_context.AddMetadata(kSessionKey, response.session());
+    subscription_context.AddMetadata(kSessionMetadataKey, response.session());
     pb::WeightsRequest weights_request;
     weights_request.set_actor_id(response.actor_id());
     weights_request.set_known_version(actor->policy_version());
@@ -151,7 +148,7 @@ class Session {
 
     grpc::ClientContext stream_context;
     AddAuthToken(config_.security, stream_context);
-    stream_context.AddMetadata(kSessionKey, response.session());
+    stream_context.AddMetadata(kSessionMetadataKey, response.session());
     pb::SegmentAck ack;
     std::unique_ptr<grpc::ClientWriter<pb::Segment>> writer =
         stub_->StreamSegments(&stream_context, &ack);

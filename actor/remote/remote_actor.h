@@ -9,7 +9,7 @@
 
 #include "absl/status/status.h"
 #include "absl/time/time.h"
-#include "learner/service/security.h"
+#include "common/net/security_options.h"
 
 namespace vantage {
 

@@ -5,26 +5,80 @@
 #include <cstdio>
 #include <string>
 
+#include "absl/flags/flag.h"
+#include "absl/strings/str_cat.h"
+#include "actor/remote/remote_actor.h"
+#include "deploy/cli/command_line.h"
+#include "deploy/cli/security_flags.h"
+#include "deploy/cli/shared_flags.h"
 #include "deploy/cli/stop_signal.h"
 
-namespace vantage {
+ABSL_FLAG(std::string, learner, "", "the learner's HOST:PORT");
+ABSL_FLAG(std::string, name, vantage::RemoteActorConfig().name,
+          "a name for logs");
+ABSL_FLAG(int, max_reconnects, vantage::RemoteActorConfig().max_reconnects,
+          "reconnection attempts (0: exit at the first failure, -1: forever)");
 
-int RunActorCommand(const RemoteActorConfig& config) {
-  if (config.num_envs < 1 || config.learner.empty()) {
-    std::fprintf(stderr,
-                 "vantage actor: --learner=HOST:PORT and --envs >= 1 are "
-                 "required\n");
-    return 2;
+namespace vantage {
+namespace {
+
+int Fail(int code, absl::string_view message) {
+  std::fprintf(stderr, "vantage actor: %s\n", std::string(message).c_str());
+  return code;
+}
+
+int RunActor(const std::vector<std::string>& args) {
+  if (!args.empty()) {
+    return Fail(kUsageError,
+                absl::StrCat("unexpected argument '", args[0], "'"));
   }
+  RemoteActorConfig config;
+  config.learner = absl::GetFlag(FLAGS_learner);
+  if (FlagGiven("env")) config.env = absl::GetFlag(FLAGS_env);
+  config.num_envs = absl::GetFlag(FLAGS_envs);
+  config.seed = absl::GetFlag(FLAGS_seed);
+  config.name = absl::GetFlag(FLAGS_name);
+  config.max_reconnects = absl::GetFlag(FLAGS_max_reconnects);
+  config.metrics_address = absl::GetFlag(FLAGS_metrics);
+  if (config.num_envs < 1 || config.learner.empty()) {
+    return Fail(kUsageError,
+                "--learner=HOST:PORT and --envs >= 1 are required");
+  }
+  absl::StatusOr<SecurityOptions> security =
+      SecurityFromFlags(/*server=*/false);
+  if (!security.ok()) return Fail(kUsageError, security.status().message());
+  config.security = *std::move(security);
   // One intra-op thread per actor: actors are many processes already.
   at::set_num_threads(1);
   const absl::Status status = RunRemoteActor(config, StopRequested());
-  if (!status.ok()) {
-    std::fprintf(stderr, "vantage actor: %s\n",
-                 std::string(status.message()).c_str());
-    return 1;
-  }
+  if (!status.ok()) return Fail(kRuntimeError, status.message());
   return 0;
+}
+
+}  // namespace
+
+Command ActorCommand() {
+  Command command;
+  command.name = "actor";
+  command.summary = "act in environments and stream segments to a learner";
+  command.usage = "vantage actor --learner=HOST:PORT [flags]";
+  command.description =
+      "Registers with a learner, steps --envs environments with the newest\n"
+      "policy and streams trajectory segments to it, reconnecting with\n"
+      "backoff when the learner goes away (its environments kept). Ends at\n"
+      "SIGINT/SIGTERM (exit 0) or when the learner refuses it or the\n"
+      "reconnects run out (exit 1).";
+  command.flags = {"learner", "env",     "envs",          "seed",
+                   "name",    "metrics", "max_reconnects"};
+  for (const std::string& name : SecurityFlagNames()) {
+    command.flags.push_back(name);
+  }
+  command.defaults = {{"env", RemoteActorConfig().env}};
+  command.example =
+      "vantage actor --learner=10.0.0.5:50051 --env=HalfCheetah --envs=8 "
+      "--auth_token_file=token";
+  command.run = RunActor;
+  return command;
 }
 
 }  // namespace vantage

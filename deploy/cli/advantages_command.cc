@@ -7,21 +7,27 @@
 #include <random>
 #include <sstream>
 
+#include "absl/flags/flag.h"
 #include "absl/status/status.h"
+#include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "absl/strings/str_replace.h"
 #include "deploy/cli/advantage_request.h"
 
+ABSL_FLAG(std::string, input, "",
+          "JSON file with one rollout and the estimator settings");
+ABSL_FLAG(bool, example, false,
+          "print every estimator on a built-in rollout instead");
+
 namespace vantage {
 namespace {
 
-constexpr int kBadInputExitCode = 2;
-
+// Everything that goes wrong here is the input's fault.
 int Fail(const absl::Status& status) {
   // One line, whatever the underlying library put in its message.
   std::fprintf(stderr, "vantage advantages: %s\n",
                absl::StrReplaceAll(status.message(), {{"\n", " "}}).c_str());
-  return kBadInputExitCode;
+  return kUsageError;
 }
 
 // 12 steps of one stream: an episode that terminates after step 4, one that
@@ -38,8 +44,6 @@ constexpr char kExampleRollout[] = R"json({
   "truncation_values": [0, 0, 0, 0, 0,  0, 0, 0, 1.1,  0, 0, 0],
   "last_value": 1.5
 })json";
-
-}  // namespace
 
 int RunAdvantagesCommand(const std::string& input_path) {
   if (input_path.empty()) {
@@ -123,6 +127,35 @@ int RunAdvantagesExample() {
       "otherwise; the critic always regresses on V + GAE.\n"
       "Try your own rollout: vantage advantages --input=FILE.json\n");
   return 0;
+}
+
+int RunAdvantages(const std::vector<std::string>& args) {
+  if (!args.empty()) {
+    return Fail(absl::InvalidArgumentError(
+        absl::StrCat("unexpected argument '", args[0], "'")));
+  }
+  if (absl::GetFlag(FLAGS_example)) return RunAdvantagesExample();
+  return RunAdvantagesCommand(absl::GetFlag(FLAGS_input));
+}
+
+}  // namespace
+
+Command AdvantagesCommand() {
+  Command command;
+  command.name = "advantages";
+  command.summary = "the estimators of one rollout, as JSON";
+  command.usage = "vantage advantages (--input=FILE.json | --example)";
+  command.description =
+      "Computes GAE, every k-step estimate of the path ensemble and the\n"
+      "biased statistic with its rho mask for one rollout given as JSON\n"
+      "(rewards, values, terminated, truncated, truncation_values,\n"
+      "last_value, gamma, lambda, ensemble, statistic, rho, seed), and prints\n"
+      "them as JSON; --example prints a table of every estimator on a\n"
+      "built-in rollout with a termination, a truncation and a rollout end.";
+  command.flags = {"input", "example"};
+  command.example = "vantage advantages --example";
+  command.run = RunAdvantages;
+  return command;
 }
 
 }  // namespace vantage

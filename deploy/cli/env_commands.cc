@@ -9,20 +9,38 @@
 #include <random>
 #include <vector>
 
+#include "absl/flags/flag.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_replace.h"
 #include "actor/envs/env_registry.h"
+#include "deploy/cli/shared_flags.h"
 #include "deploy/trained_policy.h"
+
+ABSL_FLAG(int64_t, episodes, 10, "number of episodes");
+ABSL_FLAG(std::string, checkpoint, "",
+          "a run directory or checkpoint file whose policy acts (default: a "
+          "uniform-random policy)");
+ABSL_FLAG(bool, stochastic, false,
+          "with --checkpoint: sample actions instead of the mean / mode");
 
 namespace vantage {
 namespace {
 
-constexpr int kBadInputExitCode = 2;
+struct RolloutRequest {
+  std::string env;  // may be empty with a checkpoint (the run's env)
+  int64_t episodes = 10;
+  uint64_t seed = 0;
+  std::string checkpoint;   // run directory or checkpoint file
+  bool stochastic = false;  // sample instead of the mean / mode
+};
 
-int Fail(const char* command, const absl::Status& status) {
+// `code`: kUsageError for what the flags asked for, kRuntimeError for a
+// failure while running.
+int Fail(const char* command, const absl::Status& status,
+         int code = kUsageError) {
   std::fprintf(stderr, "vantage %s: %s\n", command,
                absl::StrReplaceAll(status.message(), {{"\n", " "}}).c_str());
-  return kBadInputExitCode;
+  return code;
 }
 
 // FNV-1a over the observations' bytes: cheap, and any change shows.
@@ -40,12 +58,14 @@ class Digest {
   uint64_t hash_ = 0xcbf29ce484222325ULL;
 };
 
-}  // namespace
-
-int RunEnvsCommand() {
+int RunEnvs(const std::vector<std::string>& args) {
+  if (!args.empty()) {
+    return Fail("envs", absl::InvalidArgumentError(absl::StrCat(
+                            "unexpected argument '", args[0], "'")));
+  }
   for (const std::string& name : RegisteredEnvironments()) {
     absl::StatusOr<std::unique_ptr<Environment>> env = MakeEnvironment(name);
-    if (!env.ok()) return Fail("envs", env.status());
+    if (!env.ok()) return Fail("envs", env.status(), kRuntimeError);
     const EnvSpec& spec = (*env)->spec();
     std::printf("%s obs=[%ld] act=%s\n", name.c_str(),
                 static_cast<long>(spec.observation_size),
@@ -54,7 +74,17 @@ int RunEnvsCommand() {
   return 0;
 }
 
-int RunRolloutCommand(const RolloutRequest& request) {
+int RunRollout(const std::vector<std::string>& args) {
+  if (!args.empty()) {
+    return Fail("rollout", absl::InvalidArgumentError(absl::StrCat(
+                               "unexpected argument '", args[0], "'")));
+  }
+  RolloutRequest request;
+  request.env = absl::GetFlag(FLAGS_env);
+  request.episodes = absl::GetFlag(FLAGS_episodes);
+  request.seed = absl::GetFlag(FLAGS_seed);
+  request.checkpoint = absl::GetFlag(FLAGS_checkpoint);
+  request.stochastic = absl::GetFlag(FLAGS_stochastic);
   const int64_t episodes = request.episodes;
   const uint64_t seed = request.seed;
   std::string env_name = request.env;
@@ -98,7 +128,7 @@ int RunRolloutCommand(const RolloutRequest& request) {
     if (absl::Status status =
             env.Reset(seed * 1000003 + episode, absl::MakeSpan(observation));
         !status.ok()) {
-      return Fail("rollout", status);
+      return Fail("rollout", status, kRuntimeError);
     }
     digest.Add(observation);
     double episode_return = 0.0;
@@ -121,7 +151,7 @@ int RunRolloutCommand(const RolloutRequest& request) {
       }
       absl::StatusOr<StepResult> result =
           env.Step(action, absl::MakeSpan(observation));
-      if (!result.ok()) return Fail("rollout", result.status());
+      if (!result.ok()) return Fail("rollout", result.status(), kRuntimeError);
       digest.Add(observation);
       episode_return += result->reward;
       ++length;
@@ -144,6 +174,39 @@ int RunRolloutCommand(const RolloutRequest& request) {
       total_return / episodes, static_cast<double>(total_length) / episodes,
       static_cast<unsigned long>(digest.value()));
   return 0;
+}
+
+}  // namespace
+
+Command EnvsCommand() {
+  Command command;
+  command.name = "envs";
+  command.summary = "list the registered environments";
+  command.usage = "vantage envs";
+  command.description =
+      "One line per registered environment: its name, observation shape and\n"
+      "action space. Any of them (or mjcf:PATH) is a valid --env.";
+  command.example = "vantage envs";
+  command.run = RunEnvs;
+  return command;
+}
+
+Command RolloutCommand() {
+  Command command;
+  command.name = "rollout";
+  command.summary = "episodes of a random or a trained policy";
+  command.usage = "vantage rollout (--env=NAME | --checkpoint=RUN) [flags]";
+  command.description =
+      "Runs --episodes episodes with a uniform-random policy, or with\n"
+      "--checkpoint the policy of a run directory's newest checkpoint (its\n"
+      "mean action unless --stochastic), one line per episode, then\n"
+      "`RESULT rollout ... mean_return=R mean_length=L digest=D` (the digest\n"
+      "hashes every observation: equal digests, equal episodes).";
+  command.flags = {"env", "episodes", "seed", "checkpoint", "stochastic"};
+  command.defaults = {{"env", "the checkpoint's, else required"}};
+  command.example = "vantage rollout --checkpoint=runs/hopper --episodes=5";
+  command.run = RunRollout;
+  return command;
 }
 
 }  // namespace vantage

@@ -6,7 +6,7 @@
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
-#include "learner/service/security.h"
+#include "common/util/constant_time.h"
 
 namespace vantage {
 namespace {

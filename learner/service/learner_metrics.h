@@ -12,13 +12,7 @@
 #include <string>
 
 #include "absl/status/statusor.h"
-#include "common/util/running_total.h"
-#include "prometheus/counter.h"
-#include "prometheus/exposer.h"
-#include "prometheus/family.h"
-#include "prometheus/gauge.h"
-#include "prometheus/histogram.h"
-#include "prometheus/registry.h"
+#include "common/metrics/metrics_registry.h"
 
 namespace vantage {
 
@@ -77,10 +71,10 @@ class LearnerMetrics {
 
  private:
   LearnerMetrics();
-  prometheus::Counter& RejectedCounter(const std::string& reason);
+  // The series of one refusal reason, created on first use.
+  TotalCounter& RejectedTotal(const std::string& reason);
 
-  // Declared before the exposer, so it outlives the exposer's threads.
-  std::shared_ptr<prometheus::Registry> registry_;
+  MetricsRegistry metrics_;  // first: every series below lives in it
   prometheus::Counter& env_steps_;
   prometheus::Counter& segments_accepted_;
   prometheus::Family<prometheus::Counter>& segments_rejected_;
@@ -102,16 +96,13 @@ class LearnerMetrics {
   // Guards the totals: the learner loop and the gRPC threads both report.
   std::mutex mutex_;
   int64_t last_update_version_ = 0;
-  RunningTotal env_steps_total_;
-  RunningTotal episodes_total_;
-  RunningTotal segments_accepted_total_;
-  RunningTotal registrations_total_;
-  RunningTotal expirations_total_;
-  RunningTotal rolled_back_total_;
-  std::map<std::string, RunningTotal> rejected_totals_;
-  std::map<std::string, prometheus::Counter*> rejected_counters_;
-
-  std::unique_ptr<prometheus::Exposer> exposer_;
+  TotalCounter env_steps_total_;
+  TotalCounter episodes_total_;
+  TotalCounter segments_accepted_total_;
+  TotalCounter registrations_total_;
+  TotalCounter expirations_total_;
+  TotalCounter rolled_back_total_;
+  std::map<std::string, TotalCounter> rejected_totals_;
 };
 
 }  // namespace vantage

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "absl/strings/str_cat.h"
+#include "proto/wire_format.h"
 
 namespace vantage {
 namespace {

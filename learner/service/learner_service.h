@@ -11,17 +11,14 @@
 
 #include "absl/status/statusor.h"
 #include "absl/time/time.h"
+#include "common/net/grpc_security.h"
 #include "learner/service/actor_gateway.h"
-#include "learner/service/security.h"
 #include "proto/vantage.grpc.pb.h"
 
 namespace vantage {
 
 // absl::Status -> grpc::Status with the same code and message.
 grpc::Status ToGrpcStatus(const absl::Status& status);
-
-// The metadata entry that carries a registration's session.
-inline constexpr char kSessionMetadataKey[] = "vantage-session";
 
 // The gRPC face of an ActorGateway. Every method checks the auth token (if
 // one is required) before it reads the request, and runs in its own

@@ -171,8 +171,7 @@ TEST_F(CheckpointErrorTest, AFlippedBitInAWeightIsRefused) {
   const size_t at = bytes.find(weights);
   ASSERT_NE(at, std::string::npos);
   bytes[at + weights.size() / 2] ^= 0x01;
-  ExpectDamaged(bytes, "flipped_weight.pt", config_,
-                "fails its CRC-32 check");
+  ExpectDamaged(bytes, "flipped_weight.pt", config_, "fails its CRC-32 check");
 }
 
 // A copy cut short (a full disk, an interrupted transfer): refused as a

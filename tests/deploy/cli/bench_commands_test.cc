@@ -1,9 +1,11 @@
 // The transport benchmarks run end to end and print their RESULT lines
 // (their figures are for the README, not for assertions here).
 
+#include <cstdlib>
 #include <map>
 #include <string>
 
+#include "absl/strings/match.h"
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_split.h"
 #include "absl/strings/strip.h"
@@ -15,6 +17,7 @@ namespace vantage {
 namespace {
 
 using ::testing::HasSubstr;
+using ::testing::Not;
 
 // key=value pairs of the line starting with `prefix`.
 std::map<std::string, std::string> ResultFields(const std::string& out,
@@ -76,6 +79,21 @@ TEST(BenchCommandsTest, BadFlagsAreClearErrors) {
               HasSubstr("--envs must be >= 1"));
   EXPECT_THAT(RunVantage("bench actor --env=Nope").err,
               HasSubstr("unknown environment 'Nope'"));
+}
+
+// Google Benchmark colours its output whenever TERM is set; its escape
+// codes must not reach a pipe, where they would precede the RESULT line.
+TEST(BenchCommandsTest, ResultLinesCarryNoColourCodes) {
+  setenv("TERM", "xterm-256color", 1);
+  const Outcome outcome =
+      RunVantage("bench actor --env=Hopper --envs=1 --bench_seconds=0.2");
+  ASSERT_EQ(outcome.exit_code, 0) << outcome.err;
+  bool found = false;
+  for (absl::string_view line : absl::StrSplit(outcome.out, '\n')) {
+    found = found || absl::StartsWith(line, "RESULT actor ");
+  }
+  EXPECT_TRUE(found) << outcome.out;
+  EXPECT_THAT(outcome.out, Not(HasSubstr("\033[")));
 }
 
 }  // namespace

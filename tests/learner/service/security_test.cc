@@ -1,5 +1,3 @@
-#include "learner/service/security.h"
-
 #include <ATen/ATen.h>
 #include <grpcpp/grpcpp.h>
 #include <unistd.h>
@@ -15,10 +13,12 @@
 #include "absl/status/statusor.h"
 #include "absl/strings/str_cat.h"
 #include "common/env/environment.h"
+#include "common/net/grpc_security.h"
 #include "common/nn/networks.h"
 #include "common/nn/policy_weights.h"
 #include "common/nn/running_mean_std.h"
 #include "common/rollout/segment_queue.h"
+#include "common/util/constant_time.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
 #include "learner/service/actor_gateway.h"

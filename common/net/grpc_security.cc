@@ -1,11 +1,9 @@
-#include "learner/service/security.h"
-
-#include <fstream>
-#include <sstream>
+#include "common/net/grpc_security.h"
 
 #include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/strip.h"
+#include "common/util/constant_time.h"
 
 namespace vantage {
 namespace {
@@ -13,59 +11,7 @@ namespace {
 constexpr char kAuthorizationKey[] = "authorization";
 constexpr char kBearerPrefix[] = "Bearer ";
 
-absl::StatusOr<std::string> ReadFile(const std::string& path,
-                                     absl::string_view what) {
-  std::ifstream file(path, std::ios::binary);
-  if (!file) {
-    return absl::NotFoundError(
-        absl::StrCat("cannot read the ", what, " file ", path));
-  }
-  std::ostringstream contents;
-  contents << file.rdbuf();
-  if (file.bad()) {
-    return absl::DataLossError(
-        absl::StrCat("error reading the ", what, " file ", path));
-  }
-  return contents.str();
-}
-
 }  // namespace
-
-absl::StatusOr<std::string> ReadTokenFile(const std::string& path) {
-  absl::StatusOr<std::string> contents = ReadFile(path, "auth token");
-  if (!contents.ok()) return contents.status();
-  absl::string_view token = *contents;
-  // Editors and `echo` end the file with a newline that is not the token's.
-  absl::ConsumeSuffix(&token, "\n");
-  absl::ConsumeSuffix(&token, "\r");
-  if (token.empty()) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("the auth token file ", path, " is empty"));
-  }
-  return std::string(token);
-}
-
-absl::Status ValidateServerSecurity(const SecurityOptions& options) {
-  if (options.tls_cert_file.empty() != options.tls_key_file.empty()) {
-    return absl::InvalidArgumentError(
-        "TLS needs both --tls_cert and --tls_key (the learner's certificate "
-        "and its private key)");
-  }
-  if (!options.tls_ca_file.empty() && options.tls_cert_file.empty()) {
-    return absl::InvalidArgumentError(
-        "--tls_ca on the learner verifies client certificates and needs TLS: "
-        "give --tls_cert and --tls_key too");
-  }
-  return absl::OkStatus();
-}
-
-absl::Status ValidateClientSecurity(const SecurityOptions& options) {
-  if (options.tls_cert_file.empty() != options.tls_key_file.empty()) {
-    return absl::InvalidArgumentError(
-        "a client certificate needs both --tls_cert and --tls_key");
-  }
-  return absl::OkStatus();
-}
 
 absl::StatusOr<std::shared_ptr<grpc::ServerCredentials>> MakeServerCredentials(
     const SecurityOptions& options) {
@@ -74,14 +20,16 @@ absl::StatusOr<std::shared_ptr<grpc::ServerCredentials>> MakeServerCredentials(
   }
   if (!options.tls()) return grpc::InsecureServerCredentials();
   absl::StatusOr<std::string> cert =
-      ReadFile(options.tls_cert_file, "TLS certificate");
+      ReadSecurityFile(options.tls_cert_file, "TLS certificate");
   if (!cert.ok()) return cert.status();
-  absl::StatusOr<std::string> key = ReadFile(options.tls_key_file, "TLS key");
+  absl::StatusOr<std::string> key =
+      ReadSecurityFile(options.tls_key_file, "TLS key");
   if (!key.ok()) return key.status();
   grpc::SslServerCredentialsOptions ssl;
   ssl.pem_key_cert_pairs.push_back({*std::move(key), *std::move(cert)});
   if (!options.tls_ca_file.empty()) {
-    absl::StatusOr<std::string> ca = ReadFile(options.tls_ca_file, "TLS CA");
+    absl::StatusOr<std::string> ca =
+        ReadSecurityFile(options.tls_ca_file, "TLS CA");
     if (!ca.ok()) return ca.status();
     ssl.pem_root_certs = *std::move(ca);
     ssl.client_certificate_request =
@@ -98,15 +46,17 @@ MakeChannelCredentials(const SecurityOptions& options) {
   if (!options.tls()) return grpc::InsecureChannelCredentials();
   grpc::SslCredentialsOptions ssl;
   if (!options.tls_ca_file.empty()) {
-    absl::StatusOr<std::string> ca = ReadFile(options.tls_ca_file, "TLS CA");
+    absl::StatusOr<std::string> ca =
+        ReadSecurityFile(options.tls_ca_file, "TLS CA");
     if (!ca.ok()) return ca.status();
     ssl.pem_root_certs = *std::move(ca);
   }
   if (!options.tls_cert_file.empty()) {
     absl::StatusOr<std::string> cert =
-        ReadFile(options.tls_cert_file, "TLS certificate");
+        ReadSecurityFile(options.tls_cert_file, "TLS certificate");
     if (!cert.ok()) return cert.status();
-    absl::StatusOr<std::string> key = ReadFile(options.tls_key_file, "TLS key");
+    absl::StatusOr<std::string> key =
+        ReadSecurityFile(options.tls_key_file, "TLS key");
     if (!key.ok()) return key.status();
     ssl.pem_cert_chain = *std::move(cert);
     ssl.pem_private_key = *std::move(key);

@@ -1,0 +1,238 @@
+#include "deploy/cli/command_line.h"
+
+#include <algorithm>
+#include <cstdio>
+#include <set>
+
+#include "absl/flags/commandlineflag.h"
+#include "absl/flags/internal/parse.h"
+#include "absl/flags/parse.h"
+#include "absl/flags/reflection.h"
+#include "absl/status/status.h"
+#include "absl/strings/match.h"
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_join.h"
+#include "absl/strings/str_split.h"
+
+namespace vantage {
+namespace {
+
+// absl's own flags that read more flags; every command takes them.
+const std::set<std::string, std::less<>>& FlagSourceFlags() {
+  static const auto* names = new std::set<std::string, std::less<>>{
+      "flagfile", "fromenv", "tryfromenv"};
+  return *names;
+}
+
+bool IsHelpArgument(absl::string_view arg) {
+  return arg == "-h" || arg == "--help" || arg == "-help" ||
+         arg == "--helpfull" || arg == "-helpfull" || arg == "--helpshort" ||
+         arg == "-helpshort";
+}
+
+bool Owns(const Command& command, absl::string_view flag) {
+  return std::find(command.flags.begin(), command.flags.end(), flag) !=
+         command.flags.end();
+}
+
+absl::Status NotOwn(const Command& command, absl::string_view flag) {
+  return absl::InvalidArgumentError(
+      absl::StrCat("--", flag, " is not a flag of `vantage ", command.name,
+                   "` (see `vantage help ", command.name, "`)"));
+}
+
+// The flags on the command line itself, each checked to be the command's
+// own and to parse, so that a mistake is a message naming the command and
+// exit 2 rather than absl's exit 1. Flags inside --flagfile files are
+// checked after parsing (CheckFlagsFromFiles).
+absl::Status CheckCommandLineFlags(const Command& command, int argc,
+                                   char** argv) {
+  for (int i = 2; i < argc; ++i) {
+    absl::string_view arg = argv[i];
+    if (arg == "--") break;
+    if (arg.size() < 2 || arg[0] != '-') continue;  // an argument
+    arg.remove_prefix(arg[1] == '-' ? 2 : 1);
+    const size_t equals = arg.find('=');
+    const absl::string_view name = arg.substr(0, equals);
+    const bool has_value = equals != absl::string_view::npos;
+    if (FlagSourceFlags().count(name) > 0) {
+      if (!has_value) ++i;
+      continue;
+    }
+    absl::CommandLineFlag* flag = absl::FindCommandLineFlag(name);
+    absl::string_view flag_name = name;
+    std::string value = has_value ? std::string(arg.substr(equals + 1)) : "";
+    if (flag == nullptr && absl::StartsWith(name, "no")) {
+      absl::CommandLineFlag* negated =
+          absl::FindCommandLineFlag(name.substr(2));
+      if (negated != nullptr && negated->IsOfType<bool>() && !has_value) {
+        flag = negated;
+        flag_name = name.substr(2);
+        value = "false";
+      }
+    }
+    if (flag == nullptr || !Owns(command, flag_name)) {
+      if (flag == nullptr) {
+        return absl::InvalidArgumentError(absl::StrCat("unknown flag --", name,
+                                                       " (see `vantage help ",
+                                                       command.name, "`)"));
+      }
+      return NotOwn(command, flag_name);
+    }
+    if (!has_value && value.empty()) {
+      if (flag->IsOfType<bool>()) {
+        value = "true";
+      } else if (i + 1 < argc) {
+        value = argv[++i];
+      } else {
+        return absl::InvalidArgumentError(
+            absl::StrCat("--", name, " needs a value"));
+      }
+    }
+    // Parsing here only checks the value: absl sets it again below.
+    std::string error;
+    if (!flag->ParseFrom(value, &error)) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("--", flag_name, "=", value, ": ", error));
+    }
+  }
+  return absl::OkStatus();
+}
+
+// Flags set from a --flagfile or the environment are held to the same rule.
+absl::Status CheckFlagsFromFiles(const Command& command) {
+  std::vector<std::string> names;
+  for (const auto& [name, flag] : absl::GetAllFlags()) {
+    if (FlagSourceFlags().count(name) == 0 && FlagGiven(name) &&
+        !Owns(command, name)) {
+      names.emplace_back(name);
+    }
+  }
+  if (names.empty()) return absl::OkStatus();
+  std::sort(names.begin(), names.end());
+  return NotOwn(command, names.front());
+}
+
+const Command* Find(const std::vector<Command>& commands,
+                    absl::string_view name) {
+  for (const Command& command : commands) {
+    if (command.name == name) return &command;
+  }
+  return nullptr;
+}
+
+std::string Names(const std::vector<Command>& commands) {
+  std::vector<std::string> names;
+  for (const Command& command : commands) names.push_back(command.name);
+  return absl::StrJoin(names, ", ");
+}
+
+int Help(const std::vector<Command>& commands,
+         const std::vector<std::string>& args) {
+  if (args.empty()) {
+    std::printf("%s", OverviewHelp(commands).c_str());
+    return 0;
+  }
+  const Command* command = Find(commands, args[0]);
+  if (args.size() > 1 || command == nullptr) {
+    std::fprintf(stderr,
+                 "vantage help: name one command of: %s (or none for all)\n",
+                 Names(commands).c_str());
+    return kUsageError;
+  }
+  std::printf("%s", CommandHelp(*command).c_str());
+  return 0;
+}
+
+}  // namespace
+
+bool FlagGiven(absl::string_view name) {
+  return absl::flags_internal::WasPresentOnCommandLine(name);
+}
+
+std::string CommandHelp(const Command& command) {
+  std::string text = absl::StrCat("usage: ", command.usage, "\n\n");
+  for (absl::string_view line : absl::StrSplit(command.description, '\n')) {
+    absl::StrAppend(&text, "  ", line, "\n");
+  }
+  absl::StrAppend(&text, "\nflags:\n");
+  for (const std::string& name : command.flags) {
+    const absl::CommandLineFlag* flag = absl::FindCommandLineFlag(name);
+    if (flag == nullptr) continue;  // a programming error, caught by a test
+    const auto own = command.defaults.find(name);
+    const std::string value =
+        own != command.defaults.end() ? own->second : flag->DefaultValue();
+    absl::StrAppend(&text, "  --", name, "=", value.empty() ? "\"\"" : value,
+                    "\n");
+    absl::StrAppend(&text, "      ", flag->Help(), "\n");
+  }
+  absl::StrAppend(&text,
+                  "  --flagfile=FILE\n"
+                  "      more flags from FILE, one per line (same result as "
+                  "on the command line)\n");
+  absl::StrAppend(&text, "\nexample:\n  ", command.example, "\n");
+  return text;
+}
+
+std::string OverviewHelp(const std::vector<Command>& commands) {
+  std::string text =
+      "usage: vantage <command> [flags] [arguments]\n\ncommands:\n";
+  size_t width = 4;
+  for (const Command& command : commands) {
+    width = std::max(width, command.name.size());
+  }
+  for (const Command& command : commands) {
+    absl::StrAppend(&text, "  ", command.name,
+                    std::string(width + 2 - command.name.size(), ' '),
+                    command.summary, "\n");
+  }
+  absl::StrAppend(&text, "  help", std::string(width - 2, ' '),
+                  "this list, or `vantage help COMMAND` for one command\n");
+  return text;
+}
+
+int RunCommandLine(const std::vector<Command>& commands, int argc,
+                   char** argv) {
+  if (argc < 2 || IsHelpArgument(argv[1])) {
+    std::fprintf(argc < 2 ? stderr : stdout, "%s",
+                 OverviewHelp(commands).c_str());
+    return argc < 2 ? kUsageError : 0;
+  }
+  const std::string name = argv[1];
+  if (name == "help") {
+    return Help(commands, std::vector<std::string>(argv + 2, argv + argc));
+  }
+  const Command* command = Find(commands, name);
+  if (command == nullptr) {
+    std::fprintf(stderr, "vantage: unknown command '%s'; commands: %s, help\n",
+                 name.c_str(), Names(commands).c_str());
+    return kUsageError;
+  }
+  for (int i = 2; i < argc && std::string(argv[i]) != "--"; ++i) {
+    if (IsHelpArgument(argv[i])) {
+      std::printf("%s", CommandHelp(*command).c_str());
+      return 0;
+    }
+  }
+  std::vector<char*> arguments(argv, argv + argc);
+  if (command->take_own_arguments) command->take_own_arguments(arguments);
+  argc = static_cast<int>(arguments.size());
+  argv = arguments.data();
+  if (absl::Status status = CheckCommandLineFlags(*command, argc, argv);
+      !status.ok()) {
+    std::fprintf(stderr, "vantage %s: %s\n", name.c_str(),
+                 std::string(status.message()).c_str());
+    return kUsageError;
+  }
+  const std::vector<char*> positional = absl::ParseCommandLine(argc, argv);
+  if (absl::Status status = CheckFlagsFromFiles(*command); !status.ok()) {
+    std::fprintf(stderr, "vantage %s: %s\n", name.c_str(),
+                 std::string(status.message()).c_str());
+    return kUsageError;
+  }
+  // positional[0] is the program, positional[1] the command.
+  return command->run(
+      std::vector<std::string>(positional.begin() + 2, positional.end()));
+}
+
+}  // namespace vantage

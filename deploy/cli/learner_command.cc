@@ -1,0 +1,182 @@
+#include "deploy/cli/learner_command.h"
+
+#include <ATen/Parallel.h>
+
+#include <cmath>
+#include <cstdio>
+
+#include "absl/flags/flag.h"
+#include "absl/strings/str_cat.h"
+#include "actor/envs/env_registry.h"
+#include "deploy/cli/run_flags.h"
+#include "deploy/cli/security_flags.h"
+#include "deploy/cli/shared_flags.h"
+#include "deploy/cli/stop_signal.h"
+#include "deploy/cli/train_command.h"
+#include "deploy/learner_server.h"
+#include "learner/service/actor_gateway.h"
+
+ABSL_FLAG(std::string, listen, "127.0.0.1:0",
+          "HOST:PORT to serve actors on (port 0: a free one)");
+ABSL_FLAG(std::string, port_file, "", "write the bound port here once serving");
+// What clients can make a learner hold; defaults from the structs that use
+// them (docs/security.md explains each).
+ABSL_FLAG(int64_t, max_live_actors, vantage::GatewayLimits().max_live_actors,
+          "registrations held at once (more: RESOURCE_EXHAUSTED)");
+ABSL_FLAG(int64_t, max_envs_per_actor,
+          vantage::GatewayLimits().max_envs_per_actor,
+          "env slots one registration may claim");
+ABSL_FLAG(int64_t, max_live_env_slots,
+          vantage::GatewayLimits().max_live_env_slots,
+          "env slots over all live registrations");
+ABSL_FLAG(double, actor_expiry_s,
+          absl::ToDoubleSeconds(vantage::GatewayLimits().actor_expiry),
+          "a registration with no open call for this long expires");
+ABSL_FLAG(double, idle_stream_timeout_s,
+          absl::ToDoubleSeconds(vantage::ServiceLimits().idle_stream_timeout),
+          "a segment stream silent for this long is cancelled");
+ABSL_FLAG(double, max_abs_observation,
+          vantage::ValueLimits().max_abs_observation,
+          "segments with a larger |observation| are refused");
+ABSL_FLAG(double, max_abs_action, vantage::ValueLimits().max_abs_action,
+          "segments with a larger |action| are refused");
+ABSL_FLAG(double, max_abs_reward, vantage::ValueLimits().max_abs_reward,
+          "segments with a larger |reward| are refused");
+ABSL_FLAG(double, max_abs_log_prob, vantage::ValueLimits().max_abs_log_prob,
+          "segments with a larger |behaviour log-prob| are refused");
+ABSL_FLAG(int, max_server_threads,
+          vantage::LearnerServerConfig().max_server_threads,
+          "gRPC server threads (each open call holds one)");
+ABSL_FLAG(int64_t, max_grpc_memory_mb,
+          vantage::LearnerServerConfig().max_grpc_memory_bytes >> 20,
+          "memory gRPC may use for its buffers, MiB");
+
+namespace vantage {
+namespace {
+
+int Fail(int code, absl::string_view message) {
+  std::fprintf(stderr, "vantage learner: %s\n", std::string(message).c_str());
+  return code;
+}
+
+// The limit flags; out-of-range values are errors naming the flag.
+absl::Status ReadLimits(LearnerServerConfig& server) {
+  GatewayLimits& limits = server.limits;
+  limits.max_live_actors = absl::GetFlag(FLAGS_max_live_actors);
+  limits.max_envs_per_actor = absl::GetFlag(FLAGS_max_envs_per_actor);
+  limits.max_live_env_slots = absl::GetFlag(FLAGS_max_live_env_slots);
+  limits.actor_expiry = absl::Seconds(absl::GetFlag(FLAGS_actor_expiry_s));
+  limits.values.max_abs_observation = absl::GetFlag(FLAGS_max_abs_observation);
+  limits.values.max_abs_action = absl::GetFlag(FLAGS_max_abs_action);
+  limits.values.max_abs_reward = absl::GetFlag(FLAGS_max_abs_reward);
+  limits.values.max_abs_log_prob = absl::GetFlag(FLAGS_max_abs_log_prob);
+  server.service_limits.idle_stream_timeout =
+      absl::Seconds(absl::GetFlag(FLAGS_idle_stream_timeout_s));
+  server.max_server_threads = absl::GetFlag(FLAGS_max_server_threads);
+  server.max_grpc_memory_bytes = absl::GetFlag(FLAGS_max_grpc_memory_mb) << 20;
+  if (absl::Status status = limits.Validate(); !status.ok()) return status;
+  if (!(server.service_limits.idle_stream_timeout > absl::ZeroDuration())) {
+    return absl::InvalidArgumentError("--idle_stream_timeout_s must be > 0");
+  }
+  if (server.max_server_threads < 8) {
+    return absl::InvalidArgumentError("--max_server_threads must be >= 8");
+  }
+  if (absl::GetFlag(FLAGS_max_grpc_memory_mb) < 1) {
+    return absl::InvalidArgumentError("--max_grpc_memory_mb must be >= 1");
+  }
+  return absl::OkStatus();
+}
+
+int RunLearner(const std::vector<std::string>& args) {
+  if (!args.empty()) {
+    return Fail(kUsageError,
+                absl::StrCat("unexpected argument '", args[0], "'"));
+  }
+  absl::StatusOr<RunRequest> request = RunRequestFromFlags();
+  if (!request.ok()) return Fail(kUsageError, request.status().message());
+  // A learner is the distributed run's, whatever a config file says.
+  if (request->resume.empty()) request->flags.set_mode("distributed");
+  absl::StatusOr<ResolvedRun> resolved = ResolveRunRequest(*request);
+  if (!resolved.ok()) return Fail(kUsageError, resolved.status().message());
+  if (resolved->config.mode() != "distributed") {
+    return Fail(kUsageError,
+                absl::StrCat(request->resume,
+                             " holds a local run; continue it with `vantage "
+                             "train --resume=",
+                             request->resume, "`"));
+  }
+  if (absl::Status status = CheckRunCanStart(*resolved); !status.ok()) {
+    return Fail(kUsageError, status.message());
+  }
+  LearnerServerConfig server;
+  if (absl::Status status = ReadLimits(server); !status.ok()) {
+    return Fail(kUsageError, status.message());
+  }
+  absl::StatusOr<SecurityOptions> security = SecurityFromFlags(/*server=*/true);
+  if (!security.ok()) return Fail(kUsageError, security.status().message());
+  at::set_num_threads(1);
+  // The learner's own configuration pins the environment; no actor's
+  // registration decides it.
+  absl::StatusOr<std::unique_ptr<Environment>> env =
+      MakeEnvironment(resolved->config.env());
+  if (!env.ok()) return Fail(kUsageError, env.status().message());
+  server.training = resolved->local;
+  server.run_config = resolved->config;
+  server.spec = (*env)->spec();
+  server.listen = absl::GetFlag(FLAGS_listen);
+  server.port_file = absl::GetFlag(FLAGS_port_file);
+  server.security = *std::move(security);
+  server.metrics_address = absl::GetFlag(FLAGS_metrics);
+  ProgressRow last;
+  last.mean_return = std::nan("");
+  const absl::Status status =
+      RunLearnerServer(server, StopRequested(), [&](const ProgressRow& row) {
+        last = row;
+        std::fprintf(stderr,
+                     "learner: update %ld steps %ld return(last100) %.1f "
+                     "%.0f steps/s\n",
+                     static_cast<long>(row.stats.policy_version),
+                     static_cast<long>(row.stats.env_steps), row.mean_return,
+                     row.steps_per_second);
+      });
+  if (!status.ok()) return Fail(kRuntimeError, status.message());
+  PrintTrainResult(resolved->config, last);
+  return 0;
+}
+
+}  // namespace
+
+Command LearnerCommand() {
+  Command command;
+  command.name = "learner";
+  command.summary = "serve actors over gRPC and train on their segments";
+  command.usage = "vantage learner [flags]";
+  command.description =
+      "The learner of a distributed run: registers actors (`vantage actor`),\n"
+      "trains on the segments they stream and publishes every new policy\n"
+      "version, until --steps are done or SIGINT/SIGTERM (which writes a\n"
+      "last checkpoint). It takes the run's settings like `vantage train`\n"
+      "(its batch is --actors x --envs_per_actor rollouts) and pins the\n"
+      "environment: actors must register exactly its spec. The limits bound\n"
+      "what clients can make it hold (docs/security.md).";
+  command.flags = RunFlagNames(/*with_mode=*/false);
+  for (const char* name :
+       {"listen", "port_file", "metrics", "max_live_actors",
+        "max_envs_per_actor", "max_live_env_slots", "actor_expiry_s",
+        "idle_stream_timeout_s", "max_abs_observation", "max_abs_action",
+        "max_abs_reward", "max_abs_log_prob", "max_server_threads",
+        "max_grpc_memory_mb"}) {
+    command.flags.push_back(name);
+  }
+  for (const std::string& name : SecurityFlagNames()) {
+    command.flags.push_back(name);
+  }
+  command.defaults = RunFlagDefaults(/*with_mode=*/false);
+  command.example =
+      "vantage learner --env=HalfCheetah --actors=4 --envs_per_actor=8 "
+      "--listen=0.0.0.0:50051 --auth_token_file=token --run_dir=runs/hc";
+  command.run = RunLearner;
+  return command;
+}
+
+}  // namespace vantage

@@ -1,0 +1,35 @@
+#ifndef VANTAGE_DEPLOY_CLI_RUN_FLAGS_H_
+#define VANTAGE_DEPLOY_CLI_RUN_FLAGS_H_
+
+// The flags that describe a training run (proto/run_config.proto), read by
+// `vantage train` and `vantage learner`: one flag per RunConfig field plus
+// --config, --run_dir and --resume.
+
+#include <map>
+#include <string>
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "deploy/cli/run_request.h"
+
+namespace vantage {
+
+// The names of the run flags; `with_mode` adds --mode (train only: a
+// learner is always the distributed one).
+std::vector<std::string> RunFlagNames(bool with_mode);
+
+// What each absent run flag means, from ResolveRunConfig itself; a default
+// that depends on the algorithm lists each one's, and `with_mode` adds what
+// differs under --mode=local.
+std::map<std::string, std::string> RunFlagDefaults(bool with_mode);
+
+// A field's value as its flag would spell it ("" when absent or unknown).
+std::string RunConfigFieldText(const pb::RunConfig& config,
+                               const std::string& name);
+
+// The given run flags; an unparsable list entry is an error naming it.
+absl::StatusOr<RunRequest> RunRequestFromFlags();
+
+}  // namespace vantage
+
+#endif  // VANTAGE_DEPLOY_CLI_RUN_FLAGS_H_

@@ -1,0 +1,91 @@
+#include "deploy/cli/run_request.h"
+
+#include <cstdio>
+#include <vector>
+
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_join.h"
+#include "deploy/run_config.h"
+
+namespace vantage {
+namespace {
+
+// The given config file (if any) with the given flags on top.
+absl::StatusOr<pb::RunConfig> MergeFlags(const RunRequest& request) {
+  pb::RunConfig config;
+  if (!request.config_file.empty()) {
+    absl::StatusOr<pb::RunConfig> file = ReadRunConfigFile(request.config_file);
+    if (!file.ok()) return file.status();
+    config = *file;
+  }
+  // A repeated field given as a flag replaces the file's list.
+  if (request.flags.ensemble_size() > 0) config.clear_ensemble();
+  if (request.flags.hidden_size() > 0) config.clear_hidden();
+  config.MergeFrom(request.flags);
+  return config;
+}
+
+// Resuming continues the run exactly as configured; flags that would change
+// it are refused rather than silently ignored.
+absl::Status CheckNoOverrides(const pb::RunConfig& flags) {
+  std::vector<std::string> given;
+  const auto* descriptor = flags.GetDescriptor();
+  const auto* reflection = flags.GetReflection();
+  for (int i = 0; i < descriptor->field_count(); ++i) {
+    const auto* field = descriptor->field(i);
+    if (field->is_repeated() ? reflection->FieldSize(flags, field) > 0
+                             : reflection->HasField(flags, field)) {
+      given.push_back(absl::StrCat("--", field->name()));
+    }
+  }
+  if (given.empty()) return absl::OkStatus();
+  return absl::InvalidArgumentError(
+      absl::StrCat("--resume continues the run as its config.json says; drop ",
+                   absl::StrJoin(given, ", ")));
+}
+
+}  // namespace
+
+absl::StatusOr<ResolvedRun> ResolveRunRequest(const RunRequest& request) {
+  pb::RunConfig given;
+  if (!request.resume.empty()) {
+    if (!request.config_file.empty() || !request.run_dir.empty()) {
+      return absl::InvalidArgumentError(
+          "--resume takes the run directory's own config; drop --config and "
+          "--run_dir");
+    }
+    if (absl::Status status = CheckNoOverrides(request.flags); !status.ok()) {
+      return status;
+    }
+    absl::StatusOr<pb::RunConfig> saved =
+        ReadRunConfigFile(request.resume + "/config.json");
+    if (!saved.ok()) return saved.status();
+    given = *saved;
+  } else {
+    absl::StatusOr<pb::RunConfig> merged = MergeFlags(request);
+    if (!merged.ok()) return merged.status();
+    given = *merged;
+  }
+  absl::StatusOr<pb::RunConfig> config = ResolveRunConfig(given);
+  if (!config.ok()) return config.status();
+  ResolvedRun run;
+  run.config = *config;
+  run.local = ToLocalTrainingConfig(*config);
+  run.local.config_json = RunConfigToJson(*config);
+  run.local.run_dir = request.resume.empty() ? request.run_dir : request.resume;
+  run.local.resume = !request.resume.empty();
+  run.local.checkpoint_every = config->checkpoint_every();
+  run.local.keep_checkpoints = config->keep_checkpoints();
+  return run;
+}
+
+void PrintTrainResult(const pb::RunConfig& config, const ProgressRow& last) {
+  std::printf(
+      "RESULT train env=%s algo=%s estimator=%s rho=%g steps=%ld "
+      "mean_return=%.1f elapsed_s=%.1f sps=%.0f\n",
+      config.env().c_str(), config.algo().c_str(), config.estimator().c_str(),
+      config.rho(), static_cast<long>(last.stats.env_steps), last.mean_return,
+      last.elapsed_seconds, last.steps_per_second);
+}
+
+}  // namespace vantage

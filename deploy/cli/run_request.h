@@ -1,0 +1,43 @@
+#ifndef VANTAGE_DEPLOY_CLI_RUN_REQUEST_H_
+#define VANTAGE_DEPLOY_CLI_RUN_REQUEST_H_
+
+// A training run as `vantage train` and `vantage learner` are asked for it
+// (a config file, the flags given on top, or a run to resume), and the one
+// resolved configuration that comes out.
+
+#include <string>
+
+#include "absl/status/statusor.h"
+#include "deploy/local_training.h"
+#include "deploy/run_directory.h"
+#include "proto/run_config.pb.h"
+
+namespace vantage {
+
+struct RunRequest {
+  // The fields whose flags were given (command line, --flagfile,
+  // --fromenv); the others stay absent and take the defaults.
+  pb::RunConfig flags;
+  std::string config_file;  // --config: JSON RunConfig under the flags
+  std::string run_dir;      // --run_dir: where the run is recorded
+  std::string resume;       // --resume: a run directory to continue
+};
+
+struct ResolvedRun {
+  pb::RunConfig config;  // every field set
+  LocalTrainingConfig local;
+};
+
+// The config file (if any) under the given flags, or the resumed run's own
+// config.json (then no flag may change it), resolved and checked. Every
+// error is the request's: InvalidArgument or NotFound naming the flag or
+// file.
+absl::StatusOr<ResolvedRun> ResolveRunRequest(const RunRequest& request);
+
+// `RESULT train env=.. algo=.. estimator=.. rho=.. steps=.. mean_return=..
+// elapsed_s=.. sps=..` on stdout, the line scripts and tests read.
+void PrintTrainResult(const pb::RunConfig& config, const ProgressRow& last);
+
+}  // namespace vantage
+
+#endif  // VANTAGE_DEPLOY_CLI_RUN_REQUEST_H_

@@ -1,0 +1,11 @@
+#include "deploy/cli/shared_flags.h"
+
+#include "absl/flags/flag.h"
+
+ABSL_FLAG(std::string, env, "",
+          "environment name (see `vantage envs`) or mjcf:PATH");
+ABSL_FLAG(int, envs, 1, "environments stepped together");
+ABSL_FLAG(uint64_t, seed, 0, "random seed");
+ABSL_FLAG(std::string, metrics, "",
+          "serve Prometheus metrics on PORT (127.0.0.1) or HOST:PORT (port "
+          "0: a free one, printed on stderr); empty: none");
