@@ -10,8 +10,7 @@
 
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
-#include "deploy/run_recorder.h"
-#include "deploy/run_resume.h"
+#include "deploy/training_run.h"
 #include "learner/service/actor_gateway.h"
 #include "learner/service/learner_metrics.h"
 #include "learner/service/learner_service.h"
@@ -95,50 +94,32 @@ absl::Status RunLearnerServer(
   }
   const EnvSpec& spec = config.spec;
   // A resumed run knows its learner and the actor ids it handed out before
-  // any actor registers.
-  std::optional<RunDirectory> run;
-  std::unique_ptr<LearnerCore> learner;
+  // any actor registers; a new run's directory is made before serving, so a
+  // taken one fails fast.
   int64_t first_actor_id = 0;
-  double elapsed_before = 0.0;
+  absl::StatusOr<std::unique_ptr<TrainingRun>> run = TrainingRun::Open(
+      training, learner_config_for(spec),
+      [&](const std::string& path, const CheckpointExtras& extras) {
+        absl::StatusOr<ServerCheckpointState> state =
+            ReadServerState(path, extras);
+        if (!state.ok()) return state.status();
+        if (absl::Status same = CheckSameSpec(spec, state->spec); !same.ok()) {
+          return absl::InvalidArgumentError(
+              absl::StrCat(path, " was written for another version of ",
+                           spec.name, ": ", same.message()));
+        }
+        first_actor_id = state->next_actor_id;
+        return absl::OkStatus();
+      });
+  if (!run.ok()) return run.status();
+  LearnerCore& learner = (*run)->learner();
   if (training.resume) {
-    absl::StatusOr<RunDirectory> opened = RunDirectory::Open(training.run_dir);
-    if (!opened.ok()) return opened.status();
-    run = *std::move(opened);
-    absl::StatusOr<ResumePoint> resumed = ResumeFromNewestCheckpoint(
-        *run,
-        [&](const std::string& path, const CheckpointExtras& extras)
-            -> absl::StatusOr<std::unique_ptr<LearnerCore>> {
-          absl::StatusOr<ServerCheckpointState> state =
-              ReadServerState(path, extras);
-          if (!state.ok()) return state.status();
-          if (absl::Status same = CheckSameSpec(spec, state->spec);
-              !same.ok()) {
-            return absl::InvalidArgumentError(
-                absl::StrCat(path, " was written for another version of ",
-                             spec.name, ": ", same.message()));
-          }
-          absl::StatusOr<std::unique_ptr<LearnerCore>> loaded =
-              ReadCheckpoint(path, learner_config_for(spec));
-          if (loaded.ok()) first_actor_id = state->next_actor_id;
-          return loaded;
-        });
-    if (!resumed.ok()) return resumed.status();
-    learner = std::move(resumed->learner);
-    elapsed_before = resumed->elapsed_seconds;
     std::fprintf(stderr,
                  "learner: resuming %s from policy version %ld (%ld env "
                  "steps)\n",
                  training.run_dir.c_str(),
-                 static_cast<long>(learner->policy_version()),
-                 static_cast<long>(learner->env_steps()));
-  }
-
-  // A new run's directory before serving: a taken one fails fast.
-  if (!training.resume && !training.run_dir.empty()) {
-    absl::StatusOr<RunDirectory> made =
-        RunDirectory::Create(training.run_dir, training.config_json);
-    if (!made.ok()) return made.status();
-    run = *std::move(made);
+                 static_cast<long>(learner.policy_version()),
+                 static_cast<long>(learner.env_steps()));
   }
 
   // Room for two whole batches: asynchronous actors keep acting for the
@@ -233,54 +214,38 @@ absl::Status RunLearnerServer(
     return stop ? absl::OkStatus() : status;
   };
 
-  if (learner == nullptr) {
-    absl::StatusOr<std::unique_ptr<LearnerCore>> created =
-        LearnerCore::Create(learner_config_for(spec));
-    if (!created.ok()) return finish(created.status());
-    learner = *std::move(created);
-  }
-  RecorderConfig recorder_config;
-  recorder_config.config_json = training.config_json;
-  recorder_config.checkpoint_every = training.checkpoint_every;
-  recorder_config.keep_checkpoints = training.keep_checkpoints;
-  recorder_config.total_env_steps = training.total_env_steps;
-  recorder_config.elapsed_before = elapsed_before;
-  recorder_config.steps_before = learner->env_steps();
-  RunRecorder recorder(std::move(run), recorder_config);
   auto server_state = [&]() -> absl::StatusOr<CheckpointExtras> {
     return ServerStateExtras(spec, gateway.next_actor_id());
   };
 
-  gateway.Publish(learner->CurrentWeights());
-  while (learner->env_steps() < training.total_env_steps && !stop) {
-    absl::StatusOr<UpdateStats> stats = learner->RunUpdate(queue);
-    if (!stats.ok() && stop) break;
-    if (!stats.ok()) return finish(stats.status());
-    gateway.Publish(learner->CurrentWeights());
+  gateway.Publish(learner.CurrentWeights());
+  while (!(*run)->done() && !stop) {
+    absl::StatusOr<ProgressRow> row = (*run)->Update(queue, server_state);
+    if (!row.ok() && stop) break;
+    if (!row.ok()) return finish(row.status());
+    gateway.Publish(learner.CurrentWeights());
     {
       std::lock_guard<std::mutex> lock(expired_mutex);
-      for (int64_t actor_id : expired) learner->ForgetActor(actor_id);
+      for (int64_t actor_id : expired) learner.ForgetActor(actor_id);
       expired.clear();
     }
-    buffered_steps = learner->buffered_steps();
-    absl::StatusOr<ProgressRow> row =
-        recorder.Record(*learner, *stats, server_state);
-    if (!row.ok()) return finish(row.status());
+    buffered_steps = learner.buffered_steps();
     if (metrics != nullptr) {
-      for (int64_t lag : stats->rollout_policy_lags) {
+      const UpdateStats& stats = row->stats;
+      for (int64_t lag : stats.rollout_policy_lags) {
         metrics->RecordPolicyLag(lag);
       }
-      metrics->RecordUpdate(stats->policy_version, stats->env_steps,
-                            stats->episodes, stats->update_seconds,
+      metrics->RecordUpdate(stats.policy_version, stats.env_steps,
+                            stats.episodes, stats.update_seconds,
                             row->mean_return, row->steps_per_second);
-      metrics->RecordRolledBackUpdates(stats->rolled_back_updates);
+      metrics->RecordRolledBackUpdates(stats.rolled_back_updates);
       record_gateway();
     }
     on_update(*row);
   }
   // Stopped by a signal (a scheduler's preemption): keep every update.
   if (stop) {
-    if (absl::Status status = recorder.CheckpointNow(*learner, server_state);
+    if (absl::Status status = (*run)->CheckpointNow(server_state);
         !status.ok()) {
       std::fprintf(stderr, "learner: no checkpoint at the stop: %s\n",
                    std::string(status.message()).c_str());

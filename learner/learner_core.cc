@@ -86,6 +86,13 @@ double LearnerCore::MeanRecentReturn() const {
          recent_returns_.size();
 }
 
+void LearnerCore::NoteRejection(const Segment& segment,
+                                const absl::Status& why) {
+  if (!first_rejection_.empty()) return;
+  first_rejection_ = absl::StrCat("actor ", segment.actor_id, " slot ",
+                                  segment.env_slot, ": ", why.message());
+}
+
 absl::StatusOr<UpdateStats> LearnerCore::RunUpdate(SegmentSource& source) {
   // In sync mode (lag 0) only the current version's steps train.
   const int64_t min_version = config_.max_policy_lag < 0
@@ -104,11 +111,17 @@ absl::StatusOr<UpdateStats> LearnerCore::RunUpdate(SegmentSource& source) {
   while (static_cast<int64_t>(pending_.size()) < config_.rollouts_per_batch) {
     absl::StatusOr<Segment> segment = source.Receive();
     if (!segment.ok()) return segment.status();
-    if (!ValidateSegment(*segment, config_.spec, config_.max_segment_steps,
-                         config_.value_limits)
-             .ok() ||
-        segment->policy_version > version_) {
+    absl::Status valid =
+        ValidateSegment(*segment, config_.spec, config_.max_segment_steps,
+                        config_.value_limits);
+    if (valid.ok() && segment->policy_version > version_) {
+      valid = absl::FailedPreconditionError(
+          absl::StrCat("policy version ", segment->policy_version,
+                       " is not published yet (newest ", version_, ")"));
+    }
+    if (!valid.ok()) {
       ++rejected_;
+      NoteRejection(*segment, valid);
       continue;
     }
     if (segment->policy_version < min_version) {
@@ -128,8 +141,14 @@ absl::StatusOr<UpdateStats> LearnerCore::RunUpdate(SegmentSource& source) {
             : 8 * config_.horizon * config_.rollouts_per_batch;
     stitcher_.EvictDownTo(std::max<int64_t>(0, budget - segment->steps()),
                           segment->actor_id, segment->env_slot);
-    if (!stitcher_.Add(std::move(*segment)).ok()) {
+    const int64_t actor_id = segment->actor_id;
+    const int64_t env_slot = segment->env_slot;
+    if (absl::Status added = stitcher_.Add(std::move(*segment)); !added.ok()) {
       ++rejected_;
+      if (first_rejection_.empty()) {
+        first_rejection_ = absl::StrCat("actor ", actor_id, " slot ", env_slot,
+                                        ": ", added.message());
+      }
       continue;
     }
     for (double r : returns) {
@@ -217,6 +236,8 @@ absl::StatusOr<UpdateStats> LearnerCore::RunUpdate(SegmentSource& source) {
   stats.explained_variance =
       1.0 - (residual.var() / (targets.var() + 1e-8)).item<double>();
   stats.rejected_segments = rejected_;
+  stats.first_rejection = std::move(first_rejection_);
+  first_rejection_.clear();
   stats.stale_segments = stale_segments_;
   stats.stale_steps = stale_steps_;
   stats.evicted_steps = stitcher_.stats().evicted_steps;

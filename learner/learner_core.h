@@ -63,9 +63,13 @@ struct UpdateStats {
   double mean_abs_bias = 0.0;    // mean |biased - GAE|
   double explained_variance = 0.0;
   int64_t rejected_segments = 0;  // so far, any reason (stale included)
-  int64_t stale_segments = 0;     // so far, too old a policy version
-  int64_t stale_steps = 0;        // so far, dropped for their version
-  int64_t evicted_steps = 0;      // so far, dropped to stay in budget
+  // Why the first segment this update refused was refused (what
+  // ValidateSegment or the stitcher said, with the segment's actor and
+  // slot); empty if it refused none. Stale segments are only counted.
+  std::string first_rejection;
+  int64_t stale_segments = 0;  // so far, too old a policy version
+  int64_t stale_steps = 0;     // so far, dropped for their version
+  int64_t evicted_steps = 0;   // so far, dropped to stay in budget
   // This update produced a non-finite loss or parameter (or too large a
   // gradient) and was undone: the networks, the optimiser state and the
   // reward scaler are as before it, the batch is dropped, the version still
@@ -129,6 +133,8 @@ class LearnerCore {
 
  private:
   explicit LearnerCore(const LearnerConfig& config);
+  // Keeps the first refusal's reason of the update being gathered.
+  void NoteRejection(const Segment& segment, const absl::Status& why);
 
   const LearnerConfig config_;
   PolicyNetwork policy_;
@@ -142,6 +148,7 @@ class LearnerCore {
   int64_t version_ = 0;
   int64_t env_steps_ = 0;
   int64_t rejected_ = 0;
+  std::string first_rejection_;  // of the update being gathered
   int64_t stale_segments_ = 0;
   int64_t stale_steps_ = 0;
   int64_t episodes_ = 0;

@@ -11,6 +11,22 @@ namespace {
 constexpr char kAuthorizationKey[] = "authorization";
 constexpr char kBearerPrefix[] = "Bearer ";
 
+struct CertificateAndKey {
+  std::string certificate;
+  std::string key;
+};
+
+absl::StatusOr<CertificateAndKey> ReadCertificateAndKey(
+    const SecurityOptions& options) {
+  absl::StatusOr<std::string> cert =
+      ReadSecurityFile(options.tls_cert_file, "TLS certificate");
+  if (!cert.ok()) return cert.status();
+  absl::StatusOr<std::string> key =
+      ReadSecurityFile(options.tls_key_file, "TLS key");
+  if (!key.ok()) return key.status();
+  return CertificateAndKey{*std::move(cert), *std::move(key)};
+}
+
 }  // namespace
 
 absl::StatusOr<std::shared_ptr<grpc::ServerCredentials>> MakeServerCredentials(
@@ -19,14 +35,11 @@ absl::StatusOr<std::shared_ptr<grpc::ServerCredentials>> MakeServerCredentials(
     return status;
   }
   if (!options.tls()) return grpc::InsecureServerCredentials();
-  absl::StatusOr<std::string> cert =
-      ReadSecurityFile(options.tls_cert_file, "TLS certificate");
-  if (!cert.ok()) return cert.status();
-  absl::StatusOr<std::string> key =
-      ReadSecurityFile(options.tls_key_file, "TLS key");
-  if (!key.ok()) return key.status();
+  absl::StatusOr<CertificateAndKey> own = ReadCertificateAndKey(options);
+  if (!own.ok()) return own.status();
   grpc::SslServerCredentialsOptions ssl;
-  ssl.pem_key_cert_pairs.push_back({*std::move(key), *std::move(cert)});
+  ssl.pem_key_cert_pairs.push_back(
+      {std::move(own->key), std::move(own->certificate)});
   if (!options.tls_ca_file.empty()) {
     absl::StatusOr<std::string> ca =
         ReadSecurityFile(options.tls_ca_file, "TLS CA");
@@ -52,14 +65,10 @@ MakeChannelCredentials(const SecurityOptions& options) {
     ssl.pem_root_certs = *std::move(ca);
   }
   if (!options.tls_cert_file.empty()) {
-    absl::StatusOr<std::string> cert =
-        ReadSecurityFile(options.tls_cert_file, "TLS certificate");
-    if (!cert.ok()) return cert.status();
-    absl::StatusOr<std::string> key =
-        ReadSecurityFile(options.tls_key_file, "TLS key");
-    if (!key.ok()) return key.status();
-    ssl.pem_cert_chain = *std::move(cert);
-    ssl.pem_private_key = *std::move(key);
+    absl::StatusOr<CertificateAndKey> own = ReadCertificateAndKey(options);
+    if (!own.ok()) return own.status();
+    ssl.pem_cert_chain = std::move(own->certificate);
+    ssl.pem_private_key = std::move(own->key);
   }
   return grpc::SslCredentials(ssl);
 }

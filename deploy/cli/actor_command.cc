@@ -23,15 +23,10 @@ namespace vantage {
 namespace {
 
 int Fail(int code, absl::string_view message) {
-  std::fprintf(stderr, "vantage actor: %s\n", std::string(message).c_str());
-  return code;
+  return CommandFailure("actor", code, std::string(message));
 }
 
-int RunActor(const std::vector<std::string>& args) {
-  if (!args.empty()) {
-    return Fail(kUsageError,
-                absl::StrCat("unexpected argument '", args[0], "'"));
-  }
+int RunActor(const std::vector<std::string>&) {
   RemoteActorConfig config;
   config.learner = absl::GetFlag(FLAGS_learner);
   if (FlagGiven("env")) config.env = absl::GetFlag(FLAGS_env);

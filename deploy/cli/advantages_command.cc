@@ -24,10 +24,8 @@ namespace {
 
 // Everything that goes wrong here is the input's fault.
 int Fail(const absl::Status& status) {
-  // One line, whatever the underlying library put in its message.
-  std::fprintf(stderr, "vantage advantages: %s\n",
-               absl::StrReplaceAll(status.message(), {{"\n", " "}}).c_str());
-  return kUsageError;
+  return CommandFailure("advantages", kUsageError,
+                        std::string(status.message()));
 }
 
 // 12 steps of one stream: an episode that terminates after step 4, one that
@@ -129,11 +127,7 @@ int RunAdvantagesExample() {
   return 0;
 }
 
-int RunAdvantages(const std::vector<std::string>& args) {
-  if (!args.empty()) {
-    return Fail(absl::InvalidArgumentError(
-        absl::StrCat("unexpected argument '", args[0], "'")));
-  }
+int RunAdvantages(const std::vector<std::string>&) {
   if (absl::GetFlag(FLAGS_example)) return RunAdvantagesExample();
   return RunAdvantagesCommand(absl::GetFlag(FLAGS_input));
 }

@@ -130,6 +130,7 @@ Command BenchCommand() {
       {"envs", absl::StrCat("actor: ", kActorBenchEnvs)}};
   command.example = "vantage bench env --env=Hopper";
   command.take_own_arguments = InitializeGoogleBenchmark;
+  command.takes_arguments = true;
   command.run = RunBench;
   return command;
 }

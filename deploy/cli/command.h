@@ -35,9 +35,17 @@ struct Command {
   // command) before absl parses the flags: Google Benchmark's
   // --benchmark_* under `vantage bench`. May be empty.
   std::function<void(std::vector<char*>& argv)> take_own_arguments;
+  // Whether it takes positional arguments after its name (`vantage bench
+  // NAME`); if not, any is a usage error before it runs.
+  bool takes_arguments = false;
   // Runs with the positional arguments after the command's name.
   std::function<int(const std::vector<std::string>& args)> run;
 };
+
+// Prints "vantage COMMAND: MESSAGE" as one line on stderr and returns
+// `code`: how every command reports what ended it.
+int CommandFailure(const std::string& command, int code,
+                   const std::string& message);
 
 }  // namespace vantage
 

@@ -12,6 +12,7 @@
 #include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_join.h"
+#include "absl/strings/str_replace.h"
 #include "absl/strings/str_split.h"
 
 namespace vantage {
@@ -146,6 +147,13 @@ int Help(const std::vector<Command>& commands,
 
 }  // namespace
 
+int CommandFailure(const std::string& command, int code,
+                   const std::string& message) {
+  std::fprintf(stderr, "vantage %s: %s\n", command.c_str(),
+               absl::StrReplaceAll(message, {{"\n", " "}}).c_str());
+  return code;
+}
+
 bool FlagGiven(absl::string_view name) {
   return absl::flags_internal::WasPresentOnCommandLine(name);
 }
@@ -220,19 +228,20 @@ int RunCommandLine(const std::vector<Command>& commands, int argc,
   argv = arguments.data();
   if (absl::Status status = CheckCommandLineFlags(*command, argc, argv);
       !status.ok()) {
-    std::fprintf(stderr, "vantage %s: %s\n", name.c_str(),
-                 std::string(status.message()).c_str());
-    return kUsageError;
+    return CommandFailure(name, kUsageError, std::string(status.message()));
   }
   const std::vector<char*> positional = absl::ParseCommandLine(argc, argv);
   if (absl::Status status = CheckFlagsFromFiles(*command); !status.ok()) {
-    std::fprintf(stderr, "vantage %s: %s\n", name.c_str(),
-                 std::string(status.message()).c_str());
-    return kUsageError;
+    return CommandFailure(name, kUsageError, std::string(status.message()));
   }
   // positional[0] is the program, positional[1] the command.
-  return command->run(
-      std::vector<std::string>(positional.begin() + 2, positional.end()));
+  const std::vector<std::string> args(positional.begin() + 2,
+                                      positional.end());
+  if (!args.empty() && !command->takes_arguments) {
+    return CommandFailure(name, kUsageError,
+                          absl::StrCat("unexpected argument '", args[0], "'"));
+  }
+  return command->run(args);
 }
 
 }  // namespace vantage

@@ -38,9 +38,7 @@ struct RolloutRequest {
 // failure while running.
 int Fail(const char* command, const absl::Status& status,
          int code = kUsageError) {
-  std::fprintf(stderr, "vantage %s: %s\n", command,
-               absl::StrReplaceAll(status.message(), {{"\n", " "}}).c_str());
-  return code;
+  return CommandFailure(command, code, std::string(status.message()));
 }
 
 // FNV-1a over the observations' bytes: cheap, and any change shows.
@@ -58,11 +56,7 @@ class Digest {
   uint64_t hash_ = 0xcbf29ce484222325ULL;
 };
 
-int RunEnvs(const std::vector<std::string>& args) {
-  if (!args.empty()) {
-    return Fail("envs", absl::InvalidArgumentError(absl::StrCat(
-                            "unexpected argument '", args[0], "'")));
-  }
+int RunEnvs(const std::vector<std::string>&) {
   for (const std::string& name : RegisteredEnvironments()) {
     absl::StatusOr<std::unique_ptr<Environment>> env = MakeEnvironment(name);
     if (!env.ok()) return Fail("envs", env.status(), kRuntimeError);
@@ -74,11 +68,7 @@ int RunEnvs(const std::vector<std::string>& args) {
   return 0;
 }
 
-int RunRollout(const std::vector<std::string>& args) {
-  if (!args.empty()) {
-    return Fail("rollout", absl::InvalidArgumentError(absl::StrCat(
-                               "unexpected argument '", args[0], "'")));
-  }
+int RunRollout(const std::vector<std::string>&) {
   RolloutRequest request;
   request.env = absl::GetFlag(FLAGS_env);
   request.episodes = absl::GetFlag(FLAGS_episodes);

@@ -55,8 +55,7 @@ namespace vantage {
 namespace {
 
 int Fail(int code, absl::string_view message) {
-  std::fprintf(stderr, "vantage learner: %s\n", std::string(message).c_str());
-  return code;
+  return CommandFailure("learner", code, std::string(message));
 }
 
 // The limit flags; out-of-range values are errors naming the flag.
@@ -87,11 +86,7 @@ absl::Status ReadLimits(LearnerServerConfig& server) {
   return absl::OkStatus();
 }
 
-int RunLearner(const std::vector<std::string>& args) {
-  if (!args.empty()) {
-    return Fail(kUsageError,
-                absl::StrCat("unexpected argument '", args[0], "'"));
-  }
+int RunLearner(const std::vector<std::string>&) {
   absl::StatusOr<RunRequest> request = RunRequestFromFlags();
   if (!request.ok()) return Fail(kUsageError, request.status().message());
   // A learner is the distributed run's, whatever a config file says.

@@ -22,8 +22,7 @@ namespace vantage {
 namespace {
 
 int Fail(int code, absl::string_view message) {
-  std::fprintf(stderr, "vantage train: %s\n", std::string(message).c_str());
-  return code;
+  return CommandFailure("train", code, std::string(message));
 }
 
 std::string Duration(double seconds) {
@@ -110,11 +109,7 @@ int RunLocal(const ResolvedRun& run) {
   return 0;
 }
 
-int RunTrain(const std::vector<std::string>& args) {
-  if (!args.empty()) {
-    return Fail(kUsageError,
-                absl::StrCat("unexpected argument '", args[0], "'"));
-  }
+int RunTrain(const std::vector<std::string>&) {
   absl::StatusOr<RunRequest> request = RunRequestFromFlags();
   if (!request.ok()) return Fail(kUsageError, request.status().message());
   absl::StatusOr<ResolvedRun> run = ResolveRunRequest(*request);

@@ -1,5 +1,5 @@
 // The transport benchmarks run end to end and print their RESULT lines
-// (their figures are for the README, not for assertions here).
+// (their figures are for docs/benchmarks.md, not for assertions here).
 
 #include <cstdlib>
 #include <map>

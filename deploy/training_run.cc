@@ -1,0 +1,89 @@
+#include "deploy/training_run.h"
+
+#include <cstdio>
+#include <optional>
+#include <utility>
+
+#include "deploy/run_directory.h"
+#include "deploy/run_resume.h"
+
+namespace vantage {
+
+TrainingRun::TrainingRun(std::unique_ptr<LearnerCore> learner,
+                         RunRecorder recorder, int64_t total_env_steps)
+    : learner_(std::move(learner)),
+      recorder_(std::move(recorder)),
+      total_env_steps_(total_env_steps) {}
+
+absl::StatusOr<std::unique_ptr<TrainingRun>> TrainingRun::Open(
+    const LocalTrainingConfig& config, const LearnerConfig& learner_config,
+    const RestoreExtras& restore) {
+  std::optional<RunDirectory> run;
+  std::unique_ptr<LearnerCore> learner;
+  double elapsed_before = 0.0;
+  if (config.resume) {
+    absl::StatusOr<RunDirectory> opened = RunDirectory::Open(config.run_dir);
+    if (!opened.ok()) return opened.status();
+    run = *std::move(opened);
+    absl::StatusOr<ResumePoint> resumed = ResumeFromNewestCheckpoint(
+        *run,
+        [&](const std::string& path, const CheckpointExtras& extras)
+            -> absl::StatusOr<std::unique_ptr<LearnerCore>> {
+          absl::StatusOr<std::unique_ptr<LearnerCore>> loaded =
+              ReadCheckpoint(path, learner_config);
+          if (!loaded.ok() || !restore) return loaded;
+          if (absl::Status status = restore(path, extras); !status.ok()) {
+            return status;
+          }
+          return loaded;
+        });
+    if (!resumed.ok()) return resumed.status();
+    learner = std::move(resumed->learner);
+    elapsed_before = resumed->elapsed_seconds;
+  } else {
+    if (!config.run_dir.empty()) {
+      absl::StatusOr<RunDirectory> created =
+          RunDirectory::Create(config.run_dir, config.config_json);
+      if (!created.ok()) return created.status();
+      run = *std::move(created);
+    }
+    absl::StatusOr<std::unique_ptr<LearnerCore>> created =
+        LearnerCore::Create(learner_config);
+    if (!created.ok()) return created.status();
+    learner = *std::move(created);
+  }
+  RecorderConfig recorder;
+  recorder.config_json = config.config_json;
+  recorder.checkpoint_every = config.checkpoint_every;
+  recorder.keep_checkpoints = config.keep_checkpoints;
+  recorder.total_env_steps = config.total_env_steps;
+  recorder.elapsed_before = elapsed_before;
+  recorder.steps_before = learner->env_steps();
+  const int64_t total = config.total_env_steps;
+  return std::unique_ptr<TrainingRun>(new TrainingRun(
+      std::move(learner), RunRecorder(std::move(run), recorder), total));
+}
+
+bool TrainingRun::done() const {
+  return learner_->env_steps() >= total_env_steps_;
+}
+
+absl::StatusOr<ProgressRow> TrainingRun::Update(SegmentQueue& queue,
+                                                const SaveExtras& save) {
+  absl::StatusOr<UpdateStats> stats = learner_->RunUpdate(queue);
+  if (!stats.ok()) return stats.status();
+  // A segment that reached the learner and was refused there is a bug of
+  // its sender (the gateway refuses bad ones at the door): say why.
+  if (!stats->first_rejection.empty()) {
+    std::fprintf(stderr, "learner: refused a segment (%ld so far): %s\n",
+                 static_cast<long>(stats->rejected_segments),
+                 stats->first_rejection.c_str());
+  }
+  return recorder_.Record(*learner_, *stats, save);
+}
+
+absl::Status TrainingRun::CheckpointNow(const SaveExtras& save) {
+  return recorder_.CheckpointNow(*learner_, save);
+}
+
+}  // namespace vantage

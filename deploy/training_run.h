@@ -1,0 +1,64 @@
+#ifndef VANTAGE_DEPLOY_TRAINING_RUN_H_
+#define VANTAGE_DEPLOY_TRAINING_RUN_H_
+
+// The life of one training run that local and distributed training share:
+// its run directory created (or opened to resume), its learner created (or
+// loaded from the newest checkpoint that loads), and every update recorded
+// (a progress row, checkpoints). Only where segments come from differs: an
+// in-process actor (deploy/local_training.h) or the gRPC service
+// (deploy/learner_server.h) fills the queue each update consumes.
+
+#include <functional>
+#include <memory>
+#include <string>
+
+#include "absl/status/statusor.h"
+#include "common/rollout/segment_queue.h"
+#include "deploy/local_training.h"
+#include "deploy/run_recorder.h"
+#include "learner/checkpoint.h"
+#include "learner/learner_core.h"
+
+namespace vantage {
+
+class TrainingRun {
+ public:
+  // What the caller keeps in a checkpoint besides the learner (the local
+  // actor's state, the server's spec and next actor id); called only when
+  // one is written.
+  using SaveExtras = std::function<absl::StatusOr<CheckpointExtras>()>;
+  // Restores the caller's own state from a checkpoint whose learner loaded;
+  // an error makes a resume try the checkpoint before it.
+  using RestoreExtras = std::function<absl::Status(
+      const std::string& path, const CheckpointExtras& extras)>;
+
+  // A new run (its directory, if `config.run_dir` is set, must not hold
+  // one) or, with `config.resume`, the run in `config.run_dir` continued
+  // from its newest checkpoint that loads with `learner` and `restore`.
+  static absl::StatusOr<std::unique_ptr<TrainingRun>> Open(
+      const LocalTrainingConfig& config, const LearnerConfig& learner,
+      const RestoreExtras& restore);
+
+  LearnerCore& learner() { return *learner_; }
+  // The run's environment steps are done.
+  bool done() const;
+
+  // One update from `queue` (blocking until it holds a batch), recorded.
+  absl::StatusOr<ProgressRow> Update(SegmentQueue& queue,
+                                     const SaveExtras& save);
+  // A checkpoint now unless the current version has one (see
+  // RunRecorder::CheckpointNow): a run stopped by a signal loses nothing.
+  absl::Status CheckpointNow(const SaveExtras& save);
+
+ private:
+  TrainingRun(std::unique_ptr<LearnerCore> learner, RunRecorder recorder,
+              int64_t total_env_steps);
+
+  std::unique_ptr<LearnerCore> learner_;
+  RunRecorder recorder_;
+  const int64_t total_env_steps_;
+};
+
+}  // namespace vantage
+
+#endif  // VANTAGE_DEPLOY_TRAINING_RUN_H_
