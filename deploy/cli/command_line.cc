@@ -235,8 +235,7 @@ int RunCommandLine(const std::vector<Command>& commands, int argc,
     return CommandFailure(name, kUsageError, std::string(status.message()));
   }
   // positional[0] is the program, positional[1] the command.
-  const std::vector<std::string> args(positional.begin() + 2,
-                                      positional.end());
+  const std::vector<std::string> args(positional.begin() + 2, positional.end());
   if (!args.empty() && !command->takes_arguments) {
     return CommandFailure(name, kUsageError,
                           absl::StrCat("unexpected argument '", args[0], "'"));
