@@ -27,6 +27,7 @@
 #include "tests/deploy/cli/run_vantage.h"
 #include "tests/fakes/http_get.h"
 #include "tests/fakes/learner_process.h"
+#include "tests/fakes/pendulum_spec.h"
 #include "tests/fakes/run_files.h"
 
 namespace vantage {
@@ -36,23 +37,10 @@ using ::testing::AnyOf;
 using ::testing::HasSubstr;
 
 constexpr char kToken[] = "adversarial-test-token";
-// InvertedPendulum's spec, as an honest actor registers it.
-constexpr int64_t kObs = 4;
+constexpr int64_t kObs = kPendulumObservationSize;
 constexpr int64_t kSegmentSteps = 8;
 // How much the learner's resident memory may grow over a whole attack.
 constexpr int64_t kRssBoundBytes = 150 << 20;
-
-pb::EnvSpec PendulumSpec() {
-  pb::EnvSpec spec;
-  spec.set_name("InvertedPendulum");
-  spec.set_observation_size(kObs);
-  spec.set_action_size(1);
-  spec.add_action_low(-3.0);
-  spec.add_action_high(3.0);
-  spec.set_max_episode_steps(1000);
-  spec.set_control_dt(0.04);
-  return spec;
-}
 
 pb::Tensor FloatTensor(std::vector<int64_t> shape, float value) {
   pb::Tensor tensor;
@@ -196,7 +184,7 @@ class AdversarialTest : public ::testing::Test {
 
   static Registered RegisterAttacker() {
     pb::RegisterRequest request;
-    *request.mutable_spec() = PendulumSpec();
+    *request.mutable_spec() = PendulumSpecProto();
     request.set_num_envs(1);
     Registered registered;
     const grpc::Status status = Register(request, &registered);
@@ -315,13 +303,13 @@ TEST_F(AdversarialTest, TheSpecIsTheLearnersNotTheCallers) {
        "differs in observation_size"},
   };
   for (const Case& c : cases) {
-    *request.mutable_spec() = PendulumSpec();
+    *request.mutable_spec() = PendulumSpecProto();
     c.change(*request.mutable_spec());
     const grpc::Status status = Register(request);
     EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
     EXPECT_THAT(status.error_message(), HasSubstr(c.message));
   }
-  *request.mutable_spec() = PendulumSpec();
+  *request.mutable_spec() = PendulumSpecProto();
   request.set_num_envs(1000000);
   EXPECT_EQ(Register(request).error_code(), grpc::StatusCode::INVALID_ARGUMENT);
   ExpectTrainingGoesOn();
@@ -329,7 +317,7 @@ TEST_F(AdversarialTest, TheSpecIsTheLearnersNotTheCallers) {
 
 TEST_F(AdversarialTest, BigMessagesBeforeAuthenticationCostNothing) {
   pb::RegisterRequest huge;
-  *huge.mutable_spec() = PendulumSpec();
+  *huge.mutable_spec() = PendulumSpecProto();
   huge.set_actor_name(std::string(200 << 20, 'x'));
   std::vector<std::future<grpc::Status>> calls;
   for (int i = 0; i < 8; ++i) {
@@ -412,7 +400,7 @@ TEST_F(AdversarialTest, GarbageOnAStreamIsAnErrorAndCounted) {
 
 TEST_F(AdversarialTest, RegistrationFloodsHitTheLimitAndExpire) {
   pb::RegisterRequest request;
-  *request.mutable_spec() = PendulumSpec();
+  *request.mutable_spec() = PendulumSpecProto();
   request.set_num_envs(1);
   int granted = 0;
   grpc::Status status;
@@ -421,8 +409,14 @@ TEST_F(AdversarialTest, RegistrationFloodsHitTheLimitAndExpire) {
   EXPECT_THAT(status.error_message(), HasSubstr("at most 8 actors"));
   EXPECT_LE(granted, 7);  // the real actor holds one of the 8
   // Silent registrations expire (--actor_expiry_s=2) and make room again;
-  // the real actor's, with its calls open, does not.
-  std::this_thread::sleep_for(std::chrono::seconds(4));
+  // the real actor's, with its calls open, does not. Polled rather than
+  // slept: a loaded machine may take longer than the expiry to notice.
+  const auto deadline =
+      std::chrono::steady_clock::now() + std::chrono::seconds(20);
+  while (Metric("vantage_learner_live_actors") != 1 &&
+         std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  }
   EXPECT_EQ(Metric("vantage_learner_live_actors"), 1);
   EXPECT_GE(Metric("vantage_learner_registration_expirations_total"), granted);
   EXPECT_TRUE(Register(request).ok());

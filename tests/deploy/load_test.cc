@@ -22,6 +22,7 @@
 #include "proto/vantage.pb.h"
 #include "tests/deploy/cli/run_vantage.h"
 #include "tests/fakes/learner_process.h"
+#include "tests/fakes/pendulum_spec.h"
 #include "tests/fakes/run_files.h"
 
 namespace vantage {
@@ -83,14 +84,7 @@ TEST(LoadTest, IdleStreamsAndSilentActorsDoNotSlowTraining) {
   for (int i = 0; i < kSilentActors; ++i) {
     auto stub = pb::Learner::NewStub(channels[i % kChannels]);
     pb::RegisterRequest request;
-    pb::EnvSpec& spec = *request.mutable_spec();
-    spec.set_name("InvertedPendulum");
-    spec.set_observation_size(4);
-    spec.set_action_size(1);
-    spec.add_action_low(-3.0);
-    spec.add_action_high(3.0);
-    spec.set_max_episode_steps(1000);
-    spec.set_control_dt(0.04);
+    *request.mutable_spec() = PendulumSpecProto();
     request.set_num_envs(1);
     grpc::ClientContext context;
     pb::RegisterResponse response;

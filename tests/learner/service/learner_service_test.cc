@@ -35,6 +35,7 @@
 #include "proto/vantage.pb.h"
 #include "proto/wire_format.h"
 #include "tests/fakes/bit_equal.h"
+#include "tests/fakes/pendulum_spec.h"
 
 namespace vantage {
 namespace {
@@ -42,24 +43,11 @@ namespace {
 using ::testing::HasSubstr;
 
 constexpr int64_t kNoLimit = std::numeric_limits<int64_t>::max();
-constexpr int64_t kObs = 4;
-constexpr int64_t kAct = 1;
+constexpr int64_t kObs = kPendulumObservationSize;
+constexpr int64_t kAct = kPendulumActionSize;
 // Guards every call so that a server that never answers fails the test
 // instead of hanging it.
 constexpr auto kRpcDeadline = std::chrono::seconds(30);
-
-EnvSpec Spec() {
-  EnvSpec spec;
-  spec.name = "InvertedPendulum";
-  spec.observation_size = kObs;
-  spec.discrete = false;
-  spec.action_size = kAct;
-  spec.action_low = {-3.0};
-  spec.action_high = {3.0};
-  spec.max_episode_steps = 1000;
-  spec.control_dt = 0.04;
-  return spec;
-}
 
 pb::RegisterRequest Request(const EnvSpec& spec) {
   pb::RegisterRequest request;
@@ -83,7 +71,7 @@ pb::RunConfig RunConfig() {
 PolicyWeights MakeWeights(int64_t version) {
   NetworkConfig network;
   network.hidden = {8};
-  PolicyNetwork policy(Spec(), network);
+  PolicyNetwork policy(PendulumSpec(), network);
   RunningMeanStd normalizer(kObs);
   EXPECT_TRUE(normalizer
                   .Update(at::arange(3 * kObs, at::kFloat).reshape({3, kObs}) *
@@ -206,7 +194,7 @@ class LearnerServiceTest : public ::testing::Test {
   static GatewayConfig DefaultConfig() {
     GatewayConfig config;
     config.run_config = RunConfig();
-    config.spec = Spec();
+    config.spec = PendulumSpec();
     config.max_segment_steps = 8;
     config.max_policy_lag = 0;
     return config;
@@ -224,7 +212,7 @@ class LearnerServiceTest : public ::testing::Test {
     Start(std::move(config), capacity);
     gateway_->Publish(MakeWeights(0));
     pb::RegisterResponse response;
-    const grpc::Status status = Register(Spec(), &response);
+    const grpc::Status status = Register(PendulumSpec(), &response);
     ASSERT_TRUE(status.ok()) << status.error_message();
     ASSERT_EQ(response.actor_id(), 0);
     session_ = response.session();
@@ -294,7 +282,7 @@ TEST_F(LearnerServiceTest, RegisterMatchesThePinnedSpecAndNumbersActors) {
   std::set<std::string> sessions;
   for (int64_t expected_id : {0, 1, 2}) {
     pb::RegisterResponse response;
-    const grpc::Status status = Register(Spec(), &response);
+    const grpc::Status status = Register(PendulumSpec(), &response);
     ASSERT_TRUE(status.ok()) << status.error_message();
     EXPECT_EQ(response.actor_id(), expected_id);
     EXPECT_EQ(response.run_config().SerializeAsString(),
@@ -316,29 +304,29 @@ TEST_F(LearnerServiceTest, RegisterWithAnotherSpecNamesTheField) {
   Start();
   gateway_->Publish(MakeWeights(0));
   pb::RegisterResponse response;
-  ASSERT_TRUE(Register(Spec(), &response).ok());
+  ASSERT_TRUE(Register(PendulumSpec(), &response).ok());
 
-  EnvSpec wider = Spec();
+  EnvSpec wider = PendulumSpec();
   wider.observation_size = 5;
   grpc::Status status = Register(wider, &response);
   EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
   EXPECT_THAT(status.error_message(), HasSubstr("observation_size"));
 
-  EnvSpec bounds = Spec();
+  EnvSpec bounds = PendulumSpec();
   bounds.action_high = {2.0};
   status = Register(bounds, &response);
   EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
   EXPECT_THAT(status.error_message(), HasSubstr("action_high"));
 
   // A spec no environment can have is refused before it is compared.
-  EnvSpec broken = Spec();
+  EnvSpec broken = PendulumSpec();
   broken.action_low = {4.0};
   status = Register(broken, &response);
   EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
 
   // Refusals take no actor id.
   pb::RegisterResponse second;
-  status = Register(Spec(), &second);
+  status = Register(PendulumSpec(), &second);
   ASSERT_TRUE(status.ok()) << status.error_message();
   EXPECT_EQ(second.actor_id(), 1);
   EXPECT_EQ(gateway_->counters().registrations, 2);
@@ -348,7 +336,7 @@ TEST_F(LearnerServiceTest, RegisterWithAnotherSpecNamesTheField) {
 TEST_F(LearnerServiceTest, RegisterForAnotherEnvironmentIsRefused) {
   Start();
   gateway_->Publish(MakeWeights(0));
-  EnvSpec hopper = Spec();
+  EnvSpec hopper = PendulumSpec();
   hopper.name = "Hopper";
   pb::RegisterResponse response;
   const grpc::Status status = Register(hopper, &response);
@@ -356,7 +344,7 @@ TEST_F(LearnerServiceTest, RegisterForAnotherEnvironmentIsRefused) {
   EXPECT_THAT(status.error_message(),
               HasSubstr("this learner trains InvertedPendulum"));
   // The right environment still registers as actor 0.
-  ASSERT_TRUE(Register(Spec(), &response).ok());
+  ASSERT_TRUE(Register(PendulumSpec(), &response).ok());
   EXPECT_EQ(response.actor_id(), 0);
 }
 
@@ -372,7 +360,7 @@ TEST_F(LearnerServiceTest, RegisterWaitsForTheFirstWeights) {
     gateway_->Publish(weights);
   });
   pb::RegisterResponse response;
-  const grpc::Status status = Register(Spec(), &response);
+  const grpc::Status status = Register(PendulumSpec(), &response);
   publisher.join();
   ASSERT_TRUE(status.ok()) << status.error_message();
   EXPECT_EQ(response.actor_id(), 0);
@@ -383,7 +371,7 @@ TEST_F(LearnerServiceTest, RegisterIsUnavailableWhenNoWeightsArrive) {
   Start();
   const auto begin = std::chrono::steady_clock::now();
   absl::StatusOr<pb::RegisterResponse> response =
-      gateway_->Register(Request(Spec()), absl::Milliseconds(100));
+      gateway_->Register(Request(PendulumSpec()), absl::Milliseconds(100));
   const auto waited = std::chrono::steady_clock::now() - begin;
   EXPECT_TRUE(absl::IsUnavailable(response.status())) << response.status();
   EXPECT_GE(waited, std::chrono::milliseconds(90));
@@ -586,11 +574,11 @@ TEST_F(LearnerServiceTest, RegistrationsStopAtTheLimits) {
   Start(config);
   gateway_->Publish(MakeWeights(0));
   pb::RegisterResponse response;
-  ASSERT_TRUE(Register(Spec(), &response).ok());      // 2 slots
-  grpc::Status status = Register(Spec(), &response);  // 4 > 3 slots
+  ASSERT_TRUE(Register(PendulumSpec(), &response).ok());      // 2 slots
+  grpc::Status status = Register(PendulumSpec(), &response);  // 4 > 3 slots
   EXPECT_EQ(status.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED);
   EXPECT_THAT(status.error_message(), HasSubstr("3 env slots"));
-  pb::RegisterRequest one = Request(Spec());
+  pb::RegisterRequest one = Request(PendulumSpec());
   one.set_num_envs(1);
   grpc::ClientContext context;
   SetDeadline(context);

@@ -26,35 +26,23 @@
 #include "proto/vantage.grpc.pb.h"
 #include "proto/vantage.pb.h"
 #include "proto/wire_format.h"
+#include "tests/fakes/pendulum_spec.h"
 
 namespace vantage {
 namespace {
 
 using ::testing::HasSubstr;
 
-constexpr int64_t kObs = 4;
+constexpr int64_t kObs = kPendulumObservationSize;
 constexpr char kToken[] = "s3cret-token-0123456789";
 // Guards every call so that a server that never answers fails the test
 // instead of hanging it.
 constexpr auto kRpcDeadline = std::chrono::seconds(30);
 
-EnvSpec Spec() {
-  EnvSpec spec;
-  spec.name = "InvertedPendulum";
-  spec.observation_size = kObs;
-  spec.discrete = false;
-  spec.action_size = 1;
-  spec.action_low = {-3.0};
-  spec.action_high = {3.0};
-  spec.max_episode_steps = 1000;
-  spec.control_dt = 0.04;
-  return spec;
-}
-
 PolicyWeights MakeWeights(int64_t version) {
   NetworkConfig network;
   network.hidden = {8};
-  PolicyNetwork policy(Spec(), network);
+  PolicyNetwork policy(PendulumSpec(), network);
   RunningMeanStd normalizer(kObs);
   return ExportPolicyWeights(*policy, normalizer, version);
 }
@@ -237,7 +225,7 @@ TEST_F(SecurityTest, StreamingCallsAndRegistrationCheckTheTokenToo) {
     grpc::ClientContext context;
     context.set_deadline(std::chrono::system_clock::now() + kRpcDeadline);
     pb::RegisterRequest request;
-    EnvSpecToProto(Spec(), request.mutable_spec());
+    EnvSpecToProto(PendulumSpec(), request.mutable_spec());
     request.set_num_envs(1);
     pb::RegisterResponse response;
     EXPECT_EQ(stub->Register(&context, request, &response).error_code(),
