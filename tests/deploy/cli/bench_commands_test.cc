@@ -79,6 +79,10 @@ TEST(BenchCommandsTest, BadFlagsAreClearErrors) {
               HasSubstr("--envs must be >= 1"));
   EXPECT_THAT(RunVantage("bench actor --env=Nope").err,
               HasSubstr("unknown environment 'Nope'"));
+  const Outcome unknown = RunVantage("bench nothing");
+  EXPECT_EQ(unknown.exit_code, 2);
+  EXPECT_THAT(unknown.err,
+              HasSubstr("name one benchmark of: actor, advantages"));
 }
 
 // Google Benchmark colours its output whenever TERM is set; its escape
