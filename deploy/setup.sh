@@ -30,24 +30,7 @@ packages=(
   libminizip-dev
 )
 
-missing=()
-for pkg in "${packages[@]}"; do
-  if ! dpkg-query -W -f='${Status}' "${pkg}" 2>/dev/null | grep -q "install ok installed"; then
-    missing+=("${pkg}")
-  fi
-done
-
-if [[ ${#missing[@]} -gt 0 ]]; then
-  echo "setup.sh: installing ${missing[*]}"
-  sudo_cmd=()
-  if [[ "$(id -u)" -ne 0 ]]; then
-    command -v sudo >/dev/null || { echo "setup.sh: need root or sudo to install ${missing[*]}" >&2; exit 1; }
-    sudo_cmd=(sudo)
-  fi
-  "${sudo_cmd[@]}" apt-get update -qq
-  DEBIAN_FRONTEND=noninteractive "${sudo_cmd[@]}" apt-get install -y -qq \
-    --no-install-recommends "${missing[@]}"
-fi
+"${repo_root}/deploy/install_packages.sh" setup.sh "${packages[@]}"
 
 cmake -S "${repo_root}" -B "${build_dir}" -G Ninja -DCMAKE_BUILD_TYPE="${build_type}"
 cmake --build "${build_dir}"

@@ -27,23 +27,7 @@ fi
 # The rest of the toolchain comes from deploy/setup.sh; this adds clang and
 # its sanitizer and libFuzzer runtimes.
 packages=(clang-14 libclang-rt-14-dev)
-missing=()
-for pkg in "${packages[@]}"; do
-  if ! dpkg-query -W -f='${Status}' "${pkg}" 2>/dev/null | grep -q "install ok installed"; then
-    missing+=("${pkg}")
-  fi
-done
-if [[ ${#missing[@]} -gt 0 ]]; then
-  echo "run_fuzzers.sh: installing ${missing[*]}"
-  sudo_cmd=()
-  if [[ "$(id -u)" -ne 0 ]]; then
-    command -v sudo >/dev/null || { echo "run_fuzzers.sh: need root or sudo to install ${missing[*]}" >&2; exit 1; }
-    sudo_cmd=(sudo)
-  fi
-  "${sudo_cmd[@]}" apt-get update -qq
-  DEBIAN_FRONTEND=noninteractive "${sudo_cmd[@]}" apt-get install -y -qq \
-    --no-install-recommends "${missing[@]}"
-fi
+"${repo_root}/deploy/install_packages.sh" run_fuzzers.sh "${packages[@]}"
 
 cmake -S "${repo_root}" -B "${build_dir}" -G Ninja -DCMAKE_BUILD_TYPE=Release \
   -DCMAKE_CXX_COMPILER=clang++-14 -DVANTAGE_BUILD_FUZZERS=ON \
