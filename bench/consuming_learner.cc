@@ -11,8 +11,8 @@ GatewayConfig MakeGatewayConfig(const pb::RunConfig& run_config,
   GatewayConfig config;
   config.run_config = run_config;
   config.spec = spec;
-  config.run_config.set_sync(false);
-  config.max_segment_steps = run_config.segment_length();
+  config.run_config.mutable_distributed()->set_sync(false);
+  config.max_segment_steps = run_config.training().segment_length();
   config.max_policy_lag = -1;  // nothing is too stale to be ingested
   return config;
 }
@@ -25,7 +25,7 @@ ConsumingLearner::ConsumingLearner(const pb::RunConfig& run_config,
     : queue_(64),
       gateway_(MakeGatewayConfig(run_config, spec), queue_),
       service_(gateway_),
-      stitcher_(run_config.horizon()),
+      stitcher_(run_config.training().horizon()),
       weights_(std::move(weights)),
       steps_per_version_(steps_per_version) {}
 

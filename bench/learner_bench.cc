@@ -14,7 +14,7 @@
 #include <random>
 
 #include "bench/fastest.h"
-#include "learner/algorithms/ppo.h"
+#include "learner/algorithms/ppo/ppo_updater.h"
 #include "learner/update_guard.h"
 
 namespace vantage {

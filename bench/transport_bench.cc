@@ -46,13 +46,14 @@ int Fail(const char* bench, const absl::Status& status) {
 
 pb::RunConfig BenchRunConfig(const std::string& env) {
   pb::RunConfig run;
-  run.set_env(env);
-  run.set_horizon(2048);
-  run.set_segment_length(kSegmentLength);
-  run.set_sync(false);
-  run.set_max_policy_lag(4);
-  run.add_hidden(64);
-  run.add_hidden(64);
+  pb::TrainingSettings& training = *run.mutable_training();
+  training.set_env(env);
+  training.set_horizon(2048);
+  training.set_segment_length(kSegmentLength);
+  training.add_hidden(64);
+  training.add_hidden(64);
+  run.mutable_distributed()->set_sync(false);
+  run.mutable_distributed()->set_max_policy_lag(4);
   return run;
 }
 
@@ -256,8 +257,9 @@ int RunActorBenchmark(const std::string& env_name, int envs, double seconds) {
   const EnvSpec spec = (*probe)->spec();
   const pb::RunConfig run = BenchRunConfig(env_name);
   absl::StatusOr<std::unique_ptr<ConsumingLearner>> learner =
-      ConsumingLearner::Start(run, spec, FreshWeights(spec),
-                              /*steps_per_version=*/run.horizon() * envs);
+      ConsumingLearner::Start(
+          run, spec, FreshWeights(spec),
+          /*steps_per_version=*/run.training().horizon() * envs);
   if (!learner.ok()) return Fail("actor", learner.status());
   RemoteActorConfig config;
   config.learner = absl::StrCat("127.0.0.1:", (*learner)->port());

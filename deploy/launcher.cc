@@ -151,26 +151,26 @@ absl::Status RunDistributedTraining(const LaunchConfig& config,
         "the learner ended before serving (", Describe(learner_status), ")"));
   }
   std::fprintf(stderr, "launcher: learner on port %s, starting %d actors\n",
-               port.c_str(), run.actors());
+               port.c_str(), run.distributed().actors());
 
   auto start_actor = [&](int i) {
     std::vector<std::string> args = {
         "actor",
         "--learner=127.0.0.1:" + port,
-        "--env=" + run.env(),
-        absl::StrCat("--envs=", run.envs_per_actor()),
-        absl::StrCat("--seed=", run.seed() + i),
+        "--env=" + run.training().env(),
+        absl::StrCat("--envs=", run.distributed().envs_per_actor()),
+        absl::StrCat("--seed=", run.training().seed() + i),
         absl::StrCat("--name=actor-", i)};
     args.insert(args.end(), security_args.begin(), security_args.end());
     return Spawn(args);
   };
-  std::vector<pid_t> actors(run.actors(), -1);
+  std::vector<pid_t> actors(run.distributed().actors(), -1);
   auto everyone = [&] {
     std::vector<pid_t> all = actors;
     all.push_back(*learner);
     return all;
   };
-  for (int i = 0; i < run.actors(); ++i) {
+  for (int i = 0; i < run.distributed().actors(); ++i) {
     absl::StatusOr<pid_t> pid = start_actor(i);
     if (!pid.ok()) {
       Terminate(everyone(), std::chrono::seconds(10));
@@ -220,7 +220,7 @@ absl::Status RunDistributedTraining(const LaunchConfig& config,
       }
       continue;
     }
-    for (int i = 0; done > 0 && i < run.actors(); ++i) {
+    for (int i = 0; done > 0 && i < run.distributed().actors(); ++i) {
       if (actors[i] != done) continue;
       if (actor_restarts >= config.max_actor_restarts) {
         actors[i] = -1;

@@ -85,7 +85,8 @@ absl::Status RunLearnerServer(
   const LocalTrainingConfig& training = config.training;
   auto learner_config_for = [&](const EnvSpec& spec) {
     LearnerConfig learner_config = MakeLearnerConfig(training, spec);
-    learner_config.max_segment_steps = config.run_config.segment_length();
+    learner_config.max_segment_steps =
+        config.run_config.training().segment_length();
     learner_config.value_limits = config.limits.values;
     return learner_config;
   };
@@ -129,21 +130,23 @@ absl::Status RunLearnerServer(
   const int64_t batch_segments =
       training.num_envs *
       (training.learner.horizon /
-       std::max<int64_t>(1, config.run_config.segment_length()));
+       std::max<int64_t>(1, config.run_config.training().segment_length()));
   SegmentQueue queue(
       static_cast<size_t>(std::max<int64_t>(8, 2 * batch_segments)));
   GatewayConfig gateway_config;
   gateway_config.run_config = config.run_config;
-  gateway_config.max_segment_steps = config.run_config.segment_length();
-  gateway_config.max_policy_lag = config.run_config.max_policy_lag();
+  gateway_config.max_segment_steps =
+      config.run_config.training().segment_length();
+  gateway_config.max_policy_lag =
+      config.run_config.distributed().max_policy_lag();
   gateway_config.first_actor_id = first_actor_id;
   gateway_config.spec = spec;
   gateway_config.limits = config.limits;
   ActorGateway gateway(gateway_config, queue);
   // Nothing larger than the run's largest valid segment is ever read.
   ServiceLimits service_limits = config.service_limits;
-  service_limits.max_segment_message_bytes =
-      MaxSegmentMessageBytes(spec, config.run_config.segment_length());
+  service_limits.max_segment_message_bytes = MaxSegmentMessageBytes(
+      spec, config.run_config.training().segment_length());
   LearnerService service(gateway, service_limits);
   ServerOptions options;
   options.listen = config.listen;

@@ -15,7 +15,7 @@ namespace vantage {
 struct LocalTrainingConfig {
   std::string env = "InvertedPendulum";
   int num_envs = 1;
-  int64_t total_env_steps = 300000;
+  int64_t total_env_steps = 150000;
   uint64_t seed = 0;
   LearnerConfig learner;  // spec, rollouts_per_batch and total steps filled in
   // Steps per segment (must divide learner.horizon; 0: the horizon). The

@@ -2,6 +2,7 @@
 
 #include <google/protobuf/util/json_util.h>
 
+#include <algorithm>
 #include <fstream>
 #include <sstream>
 
@@ -9,6 +10,7 @@
 #include "absl/strings/str_join.h"
 #include "common/advantage/advantage_config.h"
 #include "learner/algorithms/algorithm.h"
+#include "proto/flat_run_config.pb.h"
 
 namespace vantage {
 namespace {
@@ -17,159 +19,223 @@ absl::Status Invalid(absl::string_view flag, absl::string_view rule) {
   return absl::InvalidArgumentError(absl::StrCat("--", flag, " ", rule));
 }
 
+// An actor sends segments of at most this many steps (or one horizon).
+constexpr int64_t kSegmentSteps = 128;
+
+absl::Status ResolveDistributed(pb::RunConfig& c) {
+  pb::TrainingSettings& t = *c.mutable_training();
+  pb::DistributedSettings& d = *c.mutable_distributed();
+  // Two actor processes by default; a batch given as --envs alone is
+  // split over them (over one actor if it does not split evenly).
+  if (!d.has_actors()) {
+    const int64_t per_actor = d.has_envs_per_actor() ? d.envs_per_actor() : 0;
+    if (t.has_envs() && per_actor > 0) {
+      d.set_actors(static_cast<int32_t>(t.envs() / per_actor));
+    } else {
+      d.set_actors(t.has_envs() && t.envs() % 2 != 0 ? 1 : 2);
+    }
+  }
+  if (!d.has_envs_per_actor()) {
+    d.set_envs_per_actor(
+        t.has_envs() ? static_cast<int32_t>(t.envs() / std::max(1, d.actors()))
+                     : 1);
+  }
+  if (d.actors() < 1 || d.actors() > 256) {
+    return Invalid("actors", "must be in [1, 256]");
+  }
+  if (d.envs_per_actor() < 1 || d.envs_per_actor() > 4096) {
+    return Invalid("envs_per_actor", "must be in [1, 4096]");
+  }
+  // At most 256 x 4096: the product fits an int32.
+  const int32_t streams = d.actors() * d.envs_per_actor();
+  if (streams > 4096) {
+    return Invalid("envs_per_actor",
+                   absl::StrCat("makes --actors x --envs_per_actor = ", streams,
+                                " streams, more than 4096"));
+  }
+  // The learner's batch holds one rollout per actor environment.
+  if (t.has_envs() && t.envs() != streams) {
+    return Invalid("envs",
+                   absl::StrCat("is the learner's batch of --actors x "
+                                "--envs_per_actor = ",
+                                streams, " streams in a distributed run"));
+  }
+  t.set_envs(streams);
+  if (!d.has_sync()) d.set_sync(true);
+  if (!d.has_max_policy_lag()) {
+    d.set_max_policy_lag(d.sync() ? 0 : 4);
+  }
+  if (d.sync() && d.max_policy_lag() != 0) {
+    return Invalid("max_policy_lag", "must be 0 with --sync");
+  }
+  if (d.max_policy_lag() < 0) return Invalid("max_policy_lag", "must be >= 0");
+  if (d.sync() && t.horizon() % t.segment_length() != 0) {
+    return Invalid("segment_length",
+                   "must divide --horizon in a --sync run (each actor sends "
+                   "exactly one horizon per policy version)");
+  }
+  return absl::OkStatus();
+}
+
+// The fields of an older run's flat config.json in their sections; the
+// flat fields whose meaning depended on the algorithm go to its section.
+absl::StatusOr<pb::RunConfig> FromFlat(const pb::FlatRunConfig& flat) {
+  pb::RunConfig c;
+  if (flat.has_mode()) c.set_mode(flat.mode());
+  pb::TrainingSettings& t = *c.mutable_training();
+  if (flat.has_env()) t.set_env(flat.env());
+  if (flat.has_seed()) t.set_seed(flat.seed());
+  if (flat.has_steps()) t.set_steps(flat.steps());
+  if (flat.has_envs()) t.set_envs(flat.envs());
+  if (flat.has_horizon()) t.set_horizon(flat.horizon());
+  t.mutable_hidden()->CopyFrom(flat.hidden());
+  if (flat.has_scale_rewards()) t.set_scale_rewards(flat.scale_rewards());
+  if (flat.has_segment_length()) t.set_segment_length(flat.segment_length());
+  pb::AdvantageSettings& a = *c.mutable_advantage();
+  if (flat.has_estimator()) a.set_estimator(flat.estimator());
+  if (flat.has_rho()) a.set_rho(flat.rho());
+  a.mutable_ensemble()->CopyFrom(flat.ensemble());
+  if (flat.has_gamma()) a.set_gamma(flat.gamma());
+  if (flat.has_gae_lambda()) a.set_gae_lambda(flat.gae_lambda());
+  const std::string algo = flat.has_algo() ? flat.algo() : "ppo";
+  if (absl::Status status = SelectAlgorithm(algo, c); !status.ok()) {
+    return Invalid("algo:", status.message());
+  }
+  if (algo == "a2c") {
+    pb::A2cSettings& s = *c.mutable_a2c();
+    // A2C updated over horizon / 5 minibatches whatever minibatches said.
+    const int64_t steps = A2cConfig().steps_per_minibatch;
+    if (flat.has_horizon() && flat.horizon() % steps == 0) {
+      s.set_n(static_cast<int32_t>(flat.horizon() / steps));
+    } else if (flat.has_minibatches()) {
+      s.set_n(flat.minibatches());
+    }
+    if (flat.has_learning_rate()) s.set_learning_rate(flat.learning_rate());
+    if (flat.has_entropy_coef()) s.set_entropy_coef(flat.entropy_coef());
+  } else if (algo == "trpo") {
+    pb::TrpoSettings& s = *c.mutable_trpo();
+    if (flat.has_max_kl()) s.set_max_kl(flat.max_kl());
+    if (flat.has_learning_rate()) {
+      s.set_value_learning_rate(flat.learning_rate());
+    }
+    if (flat.has_entropy_coef()) s.set_entropy_coef(flat.entropy_coef());
+  } else if (algo == "ppo") {
+    pb::PpoSettings& s = *c.mutable_ppo();
+    if (flat.has_epochs()) s.set_epochs(flat.epochs());
+    if (flat.has_minibatches()) s.set_minibatches(flat.minibatches());
+    if (flat.has_learning_rate()) s.set_learning_rate(flat.learning_rate());
+    if (flat.has_entropy_coef()) s.set_entropy_coef(flat.entropy_coef());
+  }
+  pb::RecordingSettings& r = *c.mutable_recording();
+  if (flat.has_checkpoint_every()) {
+    r.set_checkpoint_every(flat.checkpoint_every());
+  }
+  if (flat.has_keep_checkpoints()) {
+    r.set_keep_checkpoints(flat.keep_checkpoints());
+  }
+  // A local run's flat config held (unused) synchronous settings.
+  if (c.mode() != "local") {
+    pb::DistributedSettings& d = *c.mutable_distributed();
+    if (flat.has_actors()) d.set_actors(flat.actors());
+    if (flat.has_envs_per_actor()) d.set_envs_per_actor(flat.envs_per_actor());
+    if (flat.has_sync()) d.set_sync(flat.sync());
+    if (flat.has_max_policy_lag()) d.set_max_policy_lag(flat.max_policy_lag());
+  }
+  return c;
+}
+
 }  // namespace
 
 absl::StatusOr<pb::RunConfig> ResolveRunConfig(const pb::RunConfig& given) {
   pb::RunConfig c = given;
   // The main job is the distributed one; --mode=local keeps one process.
   if (!c.has_mode()) c.set_mode("distributed");
-  if (!c.has_env()) c.set_env("InvertedPendulum");
-  if (!c.has_algo()) c.set_algo("ppo");
-  if (!c.has_estimator()) c.set_estimator("maxabs");
-  if (!c.has_rho()) c.set_rho(0.4);
-  if (c.ensemble_size() == 0) {
-    for (int64_t k : {1, 16, 64, 2048}) c.add_ensemble(k);
-  }
-  if (!c.has_steps()) c.set_steps(150000);
-  if (!c.has_seed()) c.set_seed(0);
-  if (c.has_envs() && (c.envs() < 1 || c.envs() > 4096)) {
-    return Invalid("envs", "must be in [1, 4096]");
-  }
-  if (c.mode() == "distributed") {
-    // Two actor processes by default; a batch given as --envs alone is
-    // split over them (over one actor if it does not split evenly).
-    if (!c.has_actors()) {
-      const int64_t per_actor = c.has_envs_per_actor() ? c.envs_per_actor() : 0;
-      if (c.has_envs() && per_actor > 0) {
-        c.set_actors(static_cast<int32_t>(c.envs() / per_actor));
-      } else {
-        c.set_actors(c.has_envs() && c.envs() % 2 != 0 ? 1 : 2);
-      }
-    }
-    if (!c.has_envs_per_actor()) {
-      c.set_envs_per_actor(
-          c.has_envs()
-              ? static_cast<int32_t>(c.envs() / std::max(1, c.actors()))
-              : 1);
-    }
-    if (c.actors() < 1 || c.actors() > 256) {
-      return Invalid("actors", "must be in [1, 256]");
-    }
-    if (c.envs_per_actor() < 1 || c.envs_per_actor() > 4096) {
-      return Invalid("envs_per_actor", "must be in [1, 4096]");
-    }
-    // At most 256 x 4096: the product fits an int32.
-    const int32_t streams = c.actors() * c.envs_per_actor();
-    if (streams > 4096) {
-      return Invalid("envs_per_actor",
-                     absl::StrCat("makes --actors x --envs_per_actor = ",
-                                  streams, " streams, more than 4096"));
-    }
-    // The learner's batch holds one rollout per actor environment.
-    if (c.has_envs() && c.envs() != streams) {
-      return Invalid("envs",
-                     absl::StrCat("is the learner's batch of --actors x "
-                                  "--envs_per_actor = ",
-                                  streams, " streams in a distributed run"));
-    }
-    c.set_envs(streams);
-  } else {
-    c.clear_actors();
-    c.clear_envs_per_actor();
-  }
-  if (!c.has_envs()) c.set_envs(1);
   if (c.mode() != "local" && c.mode() != "distributed") {
     return Invalid("mode:", absl::StrCat("unknown mode '", c.mode(),
                                          "'; available: local, distributed"));
   }
-  AlgorithmConfig algorithms;
-  algorithms.name = c.algo();
-  if (absl::Status status = algorithms.Validate(); !status.ok()) {
+  AlgorithmConfig algorithm = AlgorithmConfigOf(c);
+  if (absl::Status status = algorithm.Validate(); !status.ok()) {
     return Invalid("algo:", status.message());
   }
-  const bool ppo = c.algo() == "ppo";
-  const bool a2c = c.algo() == "a2c";
-  if (!c.has_minibatches()) {
-    c.set_minibatches(ppo ? algorithms.ppo.minibatches : 4);
-  }
-  if (c.minibatches() < 1) return Invalid("minibatches", "must be >= 1");
-  if (!c.has_horizon()) {
-    c.set_horizon(ppo   ? 2048
-                  : a2c ? int64_t{algorithms.a2c.steps_per_minibatch} *
-                              c.minibatches()
-                        : 1024);
-  }
-  if (!c.has_epochs()) c.set_epochs(algorithms.ppo.epochs);
-  if (!c.has_learning_rate()) {
-    c.set_learning_rate(ppo   ? algorithms.ppo.learning_rate
-                        : a2c ? algorithms.a2c.learning_rate
-                              : algorithms.trpo.value_learning_rate);
-  }
-  if (!c.has_gamma()) c.set_gamma(0.99);
-  // The baselines' choices: GAE 0.95 for PPO, 0.98 for TRPO, plain n-step
-  // returns (lambda 1) for A2C.
-  if (!c.has_gae_lambda()) c.set_gae_lambda(ppo ? 0.95 : a2c ? 1.0 : 0.98);
-  if (!c.has_entropy_coef()) {
-    c.set_entropy_coef(a2c ? algorithms.a2c.entropy_coef : 0.0);
-  }
-  if (c.hidden_size() == 0) {
-    for (int64_t h : NetworkConfig().hidden) c.add_hidden(h);
-  }
-  if (!c.has_scale_rewards()) c.set_scale_rewards(false);
-  if (!c.has_max_kl()) c.set_max_kl(algorithms.trpo.max_kl);
-  if (!c.has_checkpoint_every()) c.set_checkpoint_every(10);
-  if (!c.has_keep_checkpoints()) c.set_keep_checkpoints(3);
-  if (!c.has_sync()) c.set_sync(true);
-  if (!c.has_max_policy_lag()) c.set_max_policy_lag(c.sync() ? 0 : 4);
-  if (!c.has_segment_length()) {
-    c.set_segment_length(std::min<int64_t>(128, c.horizon()));
-  }
+  SetAlgorithmSettings(algorithm, c);
+  const AlgorithmRunDefaults run_defaults = RunDefaultsOf(algorithm);
 
-  absl::StatusOr<Statistic> statistic = ParseStatistic(c.estimator());
-  if (!statistic.ok())
-    return Invalid("estimator:", statistic.status().message());
-  if (c.steps() < 1) return Invalid("steps", "must be >= 1");
-  if (c.envs() < 1 || c.envs() > 4096) {
+  const LocalTrainingConfig local;
+  pb::TrainingSettings& t = *c.mutable_training();
+  if (!t.has_env()) t.set_env(local.env);
+  if (!t.has_seed()) t.set_seed(local.seed);
+  if (!t.has_steps()) t.set_steps(local.total_env_steps);
+  if (t.steps() < 1) return Invalid("steps", "must be >= 1");
+  if (t.has_envs() && (t.envs() < 1 || t.envs() > 4096)) {
     return Invalid("envs", "must be in [1, 4096]");
   }
-  if (c.horizon() < 1) return Invalid("horizon", "must be >= 1");
-  if (a2c && c.horizon() % algorithms.a2c.steps_per_minibatch != 0) {
-    return Invalid("horizon", absl::StrCat("must be a multiple of a2c's ",
-                                           algorithms.a2c.steps_per_minibatch,
-                                           "-step minibatches"));
+  if (!t.has_horizon()) t.set_horizon(run_defaults.horizon);
+  if (t.horizon() < 1) return Invalid("horizon", "must be >= 1");
+  if (run_defaults.fixes_horizon && t.horizon() != run_defaults.horizon) {
+    return Invalid(
+        "horizon",
+        absl::StrCat("is ", t.horizon(), " but ", algorithm.name,
+                     "'s own settings make it ", run_defaults.horizon,
+                     "; change those (see `vantage help train`)"));
   }
-  if (c.epochs() < 1) return Invalid("epochs", "must be >= 1");
-  if (!(c.learning_rate() > 0)) return Invalid("learning_rate", "must be > 0");
-  if (!(c.entropy_coef() >= 0)) return Invalid("entropy_coef", "must be >= 0");
-  if (!(c.max_kl() > 0)) return Invalid("max_kl", "must be > 0");
-  for (int64_t h : c.hidden()) {
+  if (t.hidden_size() == 0) {
+    for (int64_t h : local.learner.network.hidden) t.add_hidden(h);
+  }
+  for (int64_t h : t.hidden()) {
     if (h < 1) return Invalid("hidden", "sizes must be >= 1");
   }
-  if (c.checkpoint_every() < 1)
-    return Invalid("checkpoint_every", "must be >= 1");
-  if (c.sync() && c.max_policy_lag() != 0) {
-    return Invalid("max_policy_lag", "must be 0 with --sync");
+  if (!t.has_scale_rewards()) t.set_scale_rewards(local.learner.scale_rewards);
+  if (!t.has_segment_length()) {
+    t.set_segment_length(std::min(kSegmentSteps, t.horizon()));
   }
-  if (c.max_policy_lag() < 0) return Invalid("max_policy_lag", "must be >= 0");
-  if (c.segment_length() < 1 || c.segment_length() > c.horizon()) {
+  if (t.segment_length() < 1 || t.segment_length() > t.horizon()) {
     return Invalid("segment_length", "must be in [1, --horizon]");
   }
-  if (c.sync() && c.horizon() % c.segment_length() != 0) {
-    return Invalid("segment_length",
-                   "must divide --horizon in a --sync run (each actor sends "
-                   "exactly one horizon per policy version)");
+
+  const AdvantageConfig advantage;
+  pb::AdvantageSettings& a = *c.mutable_advantage();
+  if (!a.has_estimator()) a.set_estimator(StatisticName(advantage.statistic));
+  absl::StatusOr<Statistic> statistic = ParseStatistic(a.estimator());
+  if (!statistic.ok()) {
+    return Invalid("estimator:", statistic.status().message());
   }
-  if (c.keep_checkpoints() < 1)
+  if (!a.has_rho()) a.set_rho(advantage.rho);
+  if (a.ensemble_size() == 0) {
+    for (int64_t k : advantage.ensemble) a.add_ensemble(k);
+  }
+  if (!a.has_gamma()) a.set_gamma(advantage.gamma);
+  if (!a.has_gae_lambda()) a.set_gae_lambda(run_defaults.gae_lambda);
+
+  if (c.mode() == "distributed") {
+    if (absl::Status status = ResolveDistributed(c); !status.ok()) {
+      return status;
+    }
+  } else {
+    if (c.has_distributed()) {
+      return absl::InvalidArgumentError(
+          "--mode=local runs one strictly on-policy process: drop the "
+          "distributed settings (--actors, --envs_per_actor, --sync, "
+          "--max_policy_lag)");
+    }
+    if (!t.has_envs()) t.set_envs(local.num_envs);
+  }
+
+  pb::RecordingSettings& r = *c.mutable_recording();
+  if (!r.has_checkpoint_every()) r.set_checkpoint_every(local.checkpoint_every);
+  if (!r.has_keep_checkpoints()) r.set_keep_checkpoints(local.keep_checkpoints);
+  if (r.checkpoint_every() < 1) {
+    return Invalid("checkpoint_every", "must be >= 1");
+  }
+  if (r.keep_checkpoints() < 1) {
     return Invalid("keep_checkpoints", "must be >= 1");
+  }
   // The estimator's own rules (gamma, lambda, rho, ensemble).
-  const LocalTrainingConfig local = ToLocalTrainingConfig(c);
-  if (absl::Status status = local.learner.advantage.Validate(); !status.ok()) {
+  const LocalTrainingConfig resolved = ToLocalTrainingConfig(c);
+  if (absl::Status status = resolved.learner.advantage.Validate();
+      !status.ok()) {
     return absl::InvalidArgumentError(
         absl::StrCat("estimator settings: ", status.message()));
-  }
-  if (absl::Status status = local.learner.algorithm.Validate(); !status.ok()) {
-    return absl::InvalidArgumentError(
-        absl::StrCat(c.algo(), " settings: ", status.message()));
   }
   return c;
 }
@@ -178,11 +244,13 @@ absl::StatusOr<pb::RunConfig> ParseRunConfigJson(const std::string& json) {
   pb::RunConfig config;
   const auto status =
       google::protobuf::util::JsonStringToMessage(json, &config);
-  if (!status.ok()) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("run config: ", status.message().as_string()));
+  if (status.ok()) return config;
+  pb::FlatRunConfig flat;
+  if (google::protobuf::util::JsonStringToMessage(json, &flat).ok()) {
+    return FromFlat(flat);
   }
-  return config;
+  return absl::InvalidArgumentError(
+      absl::StrCat("run config: ", status.message().as_string()));
 }
 
 absl::StatusOr<pb::RunConfig> ReadRunConfigFile(const std::string& path) {
@@ -210,38 +278,31 @@ std::string RunConfigToJson(const pb::RunConfig& config) {
 }
 
 LocalTrainingConfig ToLocalTrainingConfig(const pb::RunConfig& c) {
+  const pb::TrainingSettings& t = c.training();
   LocalTrainingConfig local;
-  local.env = c.env();
-  local.num_envs = c.envs();
-  local.total_env_steps = c.steps();
-  local.seed = c.seed();
+  local.env = t.env();
+  local.num_envs = t.envs();
+  local.total_env_steps = t.steps();
+  local.seed = t.seed();
+  local.segment_length = t.segment_length();
+  local.checkpoint_every = c.recording().checkpoint_every();
+  local.keep_checkpoints = c.recording().keep_checkpoints();
   LearnerConfig& learner = local.learner;
-  learner.horizon = c.horizon();
-  learner.max_policy_lag = c.max_policy_lag();
-  local.segment_length = c.segment_length();
-  learner.scale_rewards = c.scale_rewards();
-  learner.network.hidden.assign(c.hidden().begin(), c.hidden().end());
+  learner.horizon = t.horizon();
+  learner.max_policy_lag = c.distributed().max_policy_lag();
+  learner.scale_rewards = t.scale_rewards();
+  learner.network.hidden.assign(t.hidden().begin(), t.hidden().end());
+  const pb::AdvantageSettings& a = c.advantage();
   AdvantageConfig& advantage = learner.advantage;
-  if (absl::StatusOr<Statistic> statistic = ParseStatistic(c.estimator());
+  if (absl::StatusOr<Statistic> statistic = ParseStatistic(a.estimator());
       statistic.ok()) {
     advantage.statistic = *statistic;
   }
-  advantage.rho = c.rho();
-  advantage.gamma = c.gamma();
-  advantage.lambda = c.gae_lambda();
-  advantage.ensemble.assign(c.ensemble().begin(), c.ensemble().end());
-  AlgorithmConfig& algorithm = learner.algorithm;
-  algorithm.name = c.algo();
-  algorithm.ppo.minibatches = c.minibatches();
-  algorithm.ppo.epochs = c.epochs();
-  algorithm.ppo.learning_rate = c.learning_rate();
-  algorithm.ppo.entropy_coef = c.entropy_coef();
-  algorithm.a2c.minibatches = c.minibatches();
-  algorithm.a2c.learning_rate = c.learning_rate();
-  algorithm.a2c.entropy_coef = c.entropy_coef();
-  algorithm.trpo.value_learning_rate = c.learning_rate();
-  algorithm.trpo.entropy_coef = c.entropy_coef();
-  algorithm.trpo.max_kl = c.max_kl();
+  advantage.rho = a.rho();
+  advantage.gamma = a.gamma();
+  advantage.lambda = a.gae_lambda();
+  advantage.ensemble.assign(a.ensemble().begin(), a.ensemble().end());
+  learner.algorithm = AlgorithmConfigOf(c);
   return local;
 }
 

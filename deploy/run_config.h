@@ -12,12 +12,17 @@
 
 namespace vantage {
 
-// Fills every absent field with its default (some depend on the
-// algorithm) and checks every value; the message names the field as the
-// `vantage train` flag of the same name.
+// Fills every absent field of the run's sections with its default (taken
+// from the component that owns it: LocalTrainingConfig, LearnerConfig,
+// AdvantageConfig, NetworkConfig, the algorithm's config and its
+// AlgorithmRunDefaults) and checks every value; a message names the field
+// by its `vantage train` flag.
 absl::StatusOr<pb::RunConfig> ResolveRunConfig(const pb::RunConfig& given);
 
-// Parses a JSON RunConfig (unknown keys and wrong types are errors).
+// Parses a JSON RunConfig (unknown keys and wrong types are errors). A
+// config.json in the flat format of older runs is converted (see
+// proto/flat_run_config.proto), so their run directories and checkpoints
+// still load.
 absl::StatusOr<pb::RunConfig> ReadRunConfigFile(const std::string& path);
 absl::StatusOr<pb::RunConfig> ParseRunConfigJson(const std::string& json);
 // Every field, with the proto's field names.

@@ -113,11 +113,11 @@ class Session {
       ActorConfig actor_config;
       actor_config.env = config_.env;
       actor_config.num_envs = config_.num_envs;
-      actor_config.segment_length = run.segment_length();
+      actor_config.segment_length = run.training().segment_length();
       actor_config.seed = config_.seed;
       actor_config.actor_id = response.actor_id();
-      actor_config.network.hidden.assign(run.hidden().begin(),
-                                         run.hidden().end());
+      actor_config.network.hidden.assign(run.training().hidden().begin(),
+                                         run.training().hidden().end());
       absl::StatusOr<std::unique_ptr<ActorCore>> created =
           ActorCore::Create(actor_config);
       if (!created.ok()) return created.status();
@@ -161,10 +161,12 @@ class Session {
     // learning (one horizon ahead leaves the learner waiting whenever an
     // actor is slowed down), and never so far ahead that its segments
     // would grow stale or memory would grow.
-    const int64_t rounds_per_horizon =
-        std::max<int64_t>(1, run.horizon() / run.segment_length());
+    const int64_t rounds_per_horizon = std::max<int64_t>(
+        1, run.training().horizon() / run.training().segment_length());
     const int64_t ahead =
-        run.sync() ? 0 : std::min<int64_t>(2, run.max_policy_lag());
+        run.distributed().sync()
+            ? 0
+            : std::min<int64_t>(2, run.distributed().max_policy_lag());
     const int64_t first_version = actor->policy_version();
     int64_t rounds = 0;
     absl::Status status;

@@ -30,14 +30,17 @@ struct Statistic {
 absl::StatusOr<Statistic> ParseStatistic(absl::string_view name);
 std::string StatisticName(const Statistic& statistic);
 
+// The defaults are a training run's: the paper's maxabs over {1, 16, 64,
+// 2048} with rho 0.4 (lambda's default is the algorithm's, see
+// learner/algorithms/run_defaults.h).
 struct AdvantageConfig {
   double gamma = 0.99;
   double lambda = 0.95;
   // The ensemble index set E; any order, no duplicates.
   std::vector<int64_t> ensemble = {1, 16, 64, 2048};
-  Statistic statistic;
+  Statistic statistic = {StatisticKind::kMaxAbs, 0};
   // Probability that a sample's policy advantage is the biased one.
-  double rho = 0.0;
+  double rho = 0.4;
 
   // gamma in (0,1], lambda in [0,1], rho in [0,1], E non-empty with
   // distinct positive members, and for order:d, d in 1..|E|.

@@ -84,11 +84,12 @@ int RunRollout(const std::vector<std::string>&) {
         LoadTrainedPolicy(request.checkpoint);
     if (!loaded.ok()) return Fail("rollout", loaded.status());
     trained = *std::move(loaded);
-    if (env_name.empty()) env_name = trained->config.env();
-    if (env_name != trained->config.env()) {
-      return Fail("rollout", absl::InvalidArgumentError(absl::StrCat(
-                                 "the checkpoint's policy was trained on ",
-                                 trained->config.env(), ", not ", env_name)));
+    if (env_name.empty()) env_name = trained->config.training().env();
+    if (env_name != trained->config.training().env()) {
+      return Fail("rollout",
+                  absl::InvalidArgumentError(absl::StrCat(
+                      "the checkpoint's policy was trained on ",
+                      trained->config.training().env(), ", not ", env_name)));
     }
     std::printf("policy: %s (version %ld, %s actions)\n",
                 trained->checkpoint_path.c_str(),

@@ -113,7 +113,7 @@ int RunLearner(const std::vector<std::string>&) {
   // The learner's own configuration pins the environment; no actor's
   // registration decides it.
   absl::StatusOr<std::unique_ptr<Environment>> env =
-      MakeEnvironment(resolved->config.env());
+      MakeEnvironment(resolved->config.training().env());
   if (!env.ok()) return Fail(kUsageError, env.status().message());
   server.training = resolved->local;
   server.run_config = resolved->config;

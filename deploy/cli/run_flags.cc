@@ -4,56 +4,52 @@
 #include <google/protobuf/message.h>
 
 #include "absl/flags/flag.h"
+#include "absl/flags/reflection.h"
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "absl/strings/str_join.h"
+#include "absl/strings/str_split.h"
 #include "deploy/cli/command_line.h"
-#include "deploy/cli/shared_flags.h"
 #include "deploy/run_config.h"
 #include "learner/algorithms/algorithm.h"
 
 // Every default is ResolveRunConfig's (see RunFlagDefaults): a flag's own
 // default below is never read, since only given flags enter the config.
+// --env, --envs and --seed are the shared flags (deploy/cli/shared_flags).
 ABSL_FLAG(std::string, mode, "",
           "distributed (a learner and --actors actor processes over gRPC on "
           "this machine) | local (one process)");
-ABSL_FLAG(int, actors, 0, "distributed: actor processes");
-ABSL_FLAG(int, envs_per_actor, 0, "distributed: environments per actor");
-ABSL_FLAG(std::string, algo, "", "ppo | a2c | trpo");
+ABSL_FLAG(std::string, algo, "",
+          "ppo | a2c | trpo (a --config file's settings of another "
+          "algorithm are dropped)");
+ABSL_FLAG(int64_t, steps, 0, "environment steps of the run");
+ABSL_FLAG(int64_t, horizon, 0, "rollout length per environment and update");
+ABSL_FLAG(std::vector<std::string>, hidden, {},
+          "hidden layer sizes of the policy and value networks");
+ABSL_FLAG(bool, scale_rewards, false,
+          "divide rewards by the running std of discounted returns");
+ABSL_FLAG(int64_t, segment_length, 0,
+          "steps per segment an actor sends (divides --horizon with --sync)");
 ABSL_FLAG(std::string, estimator, "",
           "the biased statistic: gae (none) | max | min | maxabs | order:D");
 ABSL_FLAG(double, rho, 0, "probability of the biased estimate per sample");
 ABSL_FLAG(std::vector<std::string>, ensemble, {},
           "the path ensemble's k-step lengths, comma-separated");
-ABSL_FLAG(int64_t, steps, 0, "environment steps of the run");
-ABSL_FLAG(int64_t, horizon, 0, "rollout length per environment and update");
-ABSL_FLAG(int, minibatches, 0,
-          "ppo: minibatches per epoch; a2c: n of the paper's 5n trick "
-          "(5n-step rollouts updated as n 5-step minibatches)");
-ABSL_FLAG(int, epochs, 0, "ppo: epochs per update");
-ABSL_FLAG(double, learning_rate, 0,
-          "ppo: Adam, a2c: RMSProp (both decayed linearly), trpo: the value "
-          "function's Adam");
 ABSL_FLAG(double, gamma, 0, "discount");
-ABSL_FLAG(double, gae_lambda, 0, "GAE lambda");
-ABSL_FLAG(double, entropy_coef, 0, "entropy bonus coefficient");
-ABSL_FLAG(std::vector<std::string>, hidden, {},
-          "hidden layer sizes of the policy and value networks");
-ABSL_FLAG(bool, scale_rewards, false,
-          "divide rewards by the running std of discounted returns");
-ABSL_FLAG(double, max_kl, 0, "trpo: the trust region's KL bound");
+ABSL_FLAG(double, gae_lambda, 0, "lambda of the normal (GAE) estimate");
+ABSL_FLAG(int, actors, 0, "distributed: actor processes");
+ABSL_FLAG(int, envs_per_actor, 0, "distributed: environments per actor");
+ABSL_FLAG(bool, sync, true,
+          "distributed: each batch only from the current policy version "
+          "(actors wait for it); --nosync: asynchronous within "
+          "--max_policy_lag");
+ABSL_FLAG(int64_t, max_policy_lag, 0,
+          "distributed, asynchronous: segments older than this many versions "
+          "are dropped and counted");
 ABSL_FLAG(int, checkpoint_every, 0,
           "updates between checkpoints (with --run_dir)");
 ABSL_FLAG(int, keep_checkpoints, 0, "newest checkpoints kept");
-ABSL_FLAG(bool, sync, true,
-          "each batch only from the current policy version (actors wait for "
-          "it); --nosync: asynchronous within --max_policy_lag");
-ABSL_FLAG(int64_t, max_policy_lag, 0,
-          "asynchronous: segments older than this many versions are dropped "
-          "and counted");
-ABSL_FLAG(int64_t, segment_length, 0,
-          "steps per segment an actor sends (divides --horizon with --sync)");
 ABSL_FLAG(std::string, config, "",
           "a JSON run config (as a run directory's config.json); the flags "
           "given override it");
@@ -62,60 +58,190 @@ ABSL_FLAG(std::string, run_dir, "",
 ABSL_FLAG(std::string, resume, "",
           "continue the run in this directory from its newest checkpoint");
 
+// The algorithms' settings (learner/algorithms/<name>/<name>_config.h).
+ABSL_FLAG(int, ppo_epochs, 0, "ppo: epochs per update");
+ABSL_FLAG(int, ppo_minibatches, 0, "ppo: minibatches per epoch");
+ABSL_FLAG(double, ppo_learning_rate, 0,
+          "ppo: Adam's learning rate, decayed linearly to 0");
+ABSL_FLAG(double, ppo_clip, 0, "ppo: the ratio's clip range");
+ABSL_FLAG(double, ppo_entropy_coef, 0, "ppo: entropy bonus coefficient");
+ABSL_FLAG(double, ppo_value_coef, 0, "ppo: value loss coefficient");
+ABSL_FLAG(double, ppo_max_grad_norm, 0, "ppo: global gradient norm clip");
+ABSL_FLAG(bool, ppo_normalize_advantages, true,
+          "ppo: normalise advantages per minibatch (after rho mixing)");
+ABSL_FLAG(int, a2c_n, 0,
+          "a2c: n of the paper's trick: rollouts of a2c_steps_per_minibatch "
+          "x n steps updated as n minibatches (n = 1: the original A2C); "
+          "sets --horizon");
+ABSL_FLAG(int, a2c_steps_per_minibatch, 0, "a2c: steps per minibatch");
+ABSL_FLAG(double, a2c_learning_rate, 0,
+          "a2c: RMSProp's learning rate, decayed linearly to 0");
+ABSL_FLAG(double, a2c_entropy_coef, 0, "a2c: entropy bonus coefficient");
+ABSL_FLAG(double, a2c_value_coef, 0, "a2c: value loss coefficient");
+ABSL_FLAG(double, a2c_max_grad_norm, 0, "a2c: global gradient norm clip");
+ABSL_FLAG(double, trpo_max_kl, 0, "trpo: the trust region's mean-KL bound");
+ABSL_FLAG(int, trpo_cg_iterations, 0, "trpo: conjugate gradient iterations");
+ABSL_FLAG(double, trpo_cg_damping, 0, "trpo: Fisher-vector product damping");
+ABSL_FLAG(double, trpo_entropy_coef, 0, "trpo: entropy bonus coefficient");
+ABSL_FLAG(double, trpo_value_learning_rate, 0,
+          "trpo: the value function's Adam learning rate");
+ABSL_FLAG(int, trpo_value_epochs, 0, "trpo: value function epochs per update");
+
 namespace vantage {
 namespace {
 
+using google::protobuf::Descriptor;
 using google::protobuf::FieldDescriptor;
+using google::protobuf::Message;
 
-// Appends the integers of a list flag; an entry that is none is an error.
-template <typename Repeated>
-absl::Status ParseIntegers(const char* name,
-                           const std::vector<std::string>& values,
-                           Repeated& out) {
-  for (const std::string& text : values) {
-    int64_t value = 0;
-    if (!absl::SimpleAtoi(text, &value)) {
-      return absl::InvalidArgumentError(
-          absl::StrCat("--", name, " entry '", text, "' is not an integer"));
-    }
-    out.Add(value);
+// One flag of a run-config field: `field` of the section `section`
+// (a RunConfig message field) or of RunConfig itself (section null).
+struct RunFlag {
+  std::string name;
+  const FieldDescriptor* section = nullptr;
+  const FieldDescriptor* field = nullptr;
+  bool algorithm() const {
+    return section != nullptr && section->containing_oneof() != nullptr;
   }
-  return absl::OkStatus();
+};
+
+const std::vector<RunFlag>& RunFlags() {
+  static const auto* flags = [] {
+    auto* all = new std::vector<RunFlag>;
+    const Descriptor* run = pb::RunConfig::descriptor();
+    for (int i = 0; i < run->field_count(); ++i) {
+      const FieldDescriptor* section = run->field(i);
+      if (section->message_type() == nullptr) {
+        all->push_back({section->name(), nullptr, section});
+        continue;
+      }
+      const bool algorithm = section->containing_oneof() != nullptr;
+      const Descriptor* fields = section->message_type();
+      for (int j = 0; j < fields->field_count(); ++j) {
+        const FieldDescriptor* field = fields->field(j);
+        all->push_back({algorithm
+                            ? absl::StrCat(section->name(), "_", field->name())
+                            : field->name(),
+                        section, field});
+      }
+    }
+    return all;
+  }();
+  return *flags;
 }
 
-std::string RunConfigFieldTextOf(const pb::RunConfig& config,
-                                 const FieldDescriptor& field) {
+const RunFlag* FindRunFlag(const std::string& name) {
+  for (const RunFlag& flag : RunFlags()) {
+    if (flag.name == name) return &flag;
+  }
+  return nullptr;
+}
+
+// The message holding the flag's field, or null when its section is absent.
+const Message* Holder(const pb::RunConfig& config, const RunFlag& flag) {
+  if (flag.section == nullptr) return &config;
   const auto* reflection = config.GetReflection();
+  if (!reflection->HasField(config, flag.section)) return nullptr;
+  return &reflection->GetMessage(config, flag.section);
+}
+
+std::string FieldText(const Message& message, const FieldDescriptor& field) {
+  const auto* reflection = message.GetReflection();
   if (field.is_repeated()) {
     std::vector<std::string> values;
-    for (int i = 0; i < reflection->FieldSize(config, &field); ++i) {
+    for (int i = 0; i < reflection->FieldSize(message, &field); ++i) {
       values.push_back(
-          absl::StrCat(reflection->GetRepeatedInt64(config, &field, i)));
+          absl::StrCat(reflection->GetRepeatedInt64(message, &field, i)));
     }
     return absl::StrJoin(values, ",");
   }
-  if (!reflection->HasField(config, &field)) return "";
+  if (!reflection->HasField(message, &field)) return "";
   switch (field.cpp_type()) {
     case FieldDescriptor::CPPTYPE_STRING:
-      return reflection->GetString(config, &field);
+      return reflection->GetString(message, &field);
     case FieldDescriptor::CPPTYPE_BOOL:
-      return reflection->GetBool(config, &field) ? "true" : "false";
+      return reflection->GetBool(message, &field) ? "true" : "false";
     case FieldDescriptor::CPPTYPE_DOUBLE:
-      return absl::StrFormat("%g", reflection->GetDouble(config, &field));
+      return absl::StrFormat("%g", reflection->GetDouble(message, &field));
     case FieldDescriptor::CPPTYPE_INT32:
-      return absl::StrCat(reflection->GetInt32(config, &field));
+      return absl::StrCat(reflection->GetInt32(message, &field));
     case FieldDescriptor::CPPTYPE_INT64:
-      return absl::StrCat(reflection->GetInt64(config, &field));
+      return absl::StrCat(reflection->GetInt64(message, &field));
     case FieldDescriptor::CPPTYPE_UINT64:
-      return absl::StrCat(reflection->GetUInt64(config, &field));
+      return absl::StrCat(reflection->GetUInt64(message, &field));
     default:
       return "?";
   }
 }
 
+// Sets the flag's field from the flag's value as absl prints it.
+absl::Status SetField(const RunFlag& flag, const std::string& text,
+                      pb::RunConfig& config) {
+  Message* message =
+      flag.section == nullptr
+          ? &config
+          : config.GetReflection()->MutableMessage(&config, flag.section);
+  const auto* reflection = message->GetReflection();
+  const FieldDescriptor* field = flag.field;
+  auto bad = [&](absl::string_view what) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("--", flag.name, " '", text, "' ", what));
+  };
+  if (field->is_repeated()) {
+    reflection->ClearField(message, field);
+    for (absl::string_view entry :
+         absl::StrSplit(text, ',', absl::SkipEmpty())) {
+      int64_t value = 0;
+      if (!absl::SimpleAtoi(entry, &value)) {
+        return absl::InvalidArgumentError(absl::StrCat(
+            "--", flag.name, " entry '", entry, "' is not an integer"));
+      }
+      reflection->AddInt64(message, field, value);
+    }
+    return absl::OkStatus();
+  }
+  switch (field->cpp_type()) {
+    case FieldDescriptor::CPPTYPE_STRING:
+      reflection->SetString(message, field, text);
+      return absl::OkStatus();
+    case FieldDescriptor::CPPTYPE_BOOL: {
+      bool value = false;
+      if (!absl::SimpleAtob(text, &value)) return bad("is not a boolean");
+      reflection->SetBool(message, field, value);
+      return absl::OkStatus();
+    }
+    case FieldDescriptor::CPPTYPE_DOUBLE: {
+      double value = 0;
+      if (!absl::SimpleAtod(text, &value)) return bad("is not a number");
+      reflection->SetDouble(message, field, value);
+      return absl::OkStatus();
+    }
+    case FieldDescriptor::CPPTYPE_INT32: {
+      int32_t value = 0;
+      if (!absl::SimpleAtoi(text, &value)) return bad("is not an integer");
+      reflection->SetInt32(message, field, value);
+      return absl::OkStatus();
+    }
+    case FieldDescriptor::CPPTYPE_INT64: {
+      int64_t value = 0;
+      if (!absl::SimpleAtoi(text, &value)) return bad("is not an integer");
+      reflection->SetInt64(message, field, value);
+      return absl::OkStatus();
+    }
+    case FieldDescriptor::CPPTYPE_UINT64: {
+      uint64_t value = 0;
+      if (!absl::SimpleAtoi(text, &value)) return bad("is not an integer");
+      reflection->SetUInt64(message, field, value);
+      return absl::OkStatus();
+    }
+    default:
+      return bad("has a type no flag reads");
+  }
+}
+
 pb::RunConfig Resolved(const std::string& algo, const std::string& mode) {
   pb::RunConfig given;
-  if (!algo.empty()) given.set_algo(algo);
+  if (!algo.empty()) (void)SelectAlgorithm(algo, given);
   if (!mode.empty()) given.set_mode(mode);
   // The defaults resolve by construction; a failure is a programming error
   // that the help test catches as an empty default.
@@ -126,18 +252,23 @@ pb::RunConfig Resolved(const std::string& algo, const std::string& mode) {
 }  // namespace
 
 std::string RunConfigFieldText(const pb::RunConfig& config,
-                               const std::string& name) {
-  const FieldDescriptor* field =
-      pb::RunConfig::descriptor()->FindFieldByName(name);
-  return field == nullptr ? "" : RunConfigFieldTextOf(config, *field);
+                               const std::string& flag) {
+  if (flag == "algo") return AlgorithmNameOf(config);
+  const RunFlag* run_flag = FindRunFlag(flag);
+  if (run_flag == nullptr) return "";
+  const Message* holder = Holder(config, *run_flag);
+  return holder == nullptr ? "" : FieldText(*holder, *run_flag->field);
 }
 
 std::vector<std::string> RunFlagNames(bool with_mode) {
   std::vector<std::string> names;
-  const auto* descriptor = pb::RunConfig::descriptor();
-  for (int i = 0; i < descriptor->field_count(); ++i) {
-    const std::string& name = descriptor->field(i)->name();
-    if (name != "mode" || with_mode) names.push_back(name);
+  for (const RunFlag& flag : RunFlags()) {
+    if (flag.name == "mode") {
+      if (with_mode) names.push_back(flag.name);
+      names.push_back("algo");
+      continue;
+    }
+    names.push_back(flag.name);
   }
   for (const char* name : {"config", "run_dir", "resume"}) {
     names.push_back(name);
@@ -149,91 +280,78 @@ std::map<std::string, std::string> RunFlagDefaults(bool with_mode) {
   const pb::RunConfig standard = Resolved("", "");
   const pb::RunConfig local = Resolved("", "local");
   std::map<std::string, std::string> defaults;
-  const auto* descriptor = pb::RunConfig::descriptor();
-  for (int i = 0; i < descriptor->field_count(); ++i) {
-    const FieldDescriptor& field = *descriptor->field(i);
-    std::string text = RunConfigFieldTextOf(standard, field);
-    defaults[field.name()] = text;
+  defaults["algo"] = AlgorithmNameOf(standard);
+  for (const RunFlag& flag : RunFlags()) {
+    if (flag.algorithm()) {
+      // Only its own algorithm reads it.
+      defaults[flag.name] =
+          RunConfigFieldText(Resolved(flag.section->name(), ""), flag.name);
+      continue;
+    }
+    std::string text = RunConfigFieldText(standard, flag.name);
     // Varying a flag shows nothing about its own default.
-    if (field.name() == "algo" || field.name() == "mode") continue;
-    std::vector<std::string> by_algorithm;
-    bool differs = false;
-    for (const std::string& algo : AlgorithmNames()) {
-      const std::string value = RunConfigFieldTextOf(Resolved(algo, ""), field);
-      differs = differs || value != text;
-      by_algorithm.push_back(absl::StrCat(algo, ": ", value));
+    if (flag.name != "mode") {
+      std::vector<std::string> by_algorithm;
+      bool differs = false;
+      for (const std::string& algo : AlgorithmNames()) {
+        const std::string value =
+            RunConfigFieldText(Resolved(algo, ""), flag.name);
+        differs = differs || value != text;
+        by_algorithm.push_back(absl::StrCat(algo, ": ", value));
+      }
+      if (differs) text = absl::StrJoin(by_algorithm, "; ");
+      const std::string in_local = RunConfigFieldText(local, flag.name);
+      if (with_mode && in_local != RunConfigFieldText(standard, flag.name)) {
+        absl::StrAppend(&text, " (--mode=local: ",
+                        in_local.empty() ? "unused" : in_local, ")");
+      }
     }
-    if (differs) text = absl::StrJoin(by_algorithm, "; ");
-    const std::string in_local = RunConfigFieldTextOf(local, field);
-    if (with_mode && in_local != RunConfigFieldTextOf(standard, field)) {
-      absl::StrAppend(&text, " (--mode=local: ",
-                      in_local.empty() ? "unused" : in_local, ")");
-    }
-    defaults[field.name()] = text;
+    defaults[flag.name] = text;
   }
   return defaults;
 }
 
 absl::StatusOr<RunRequest> RunRequestFromFlags() {
   RunRequest request;
-  pb::RunConfig& c = request.flags;
-  if (FlagGiven("mode")) c.set_mode(absl::GetFlag(FLAGS_mode));
-  if (FlagGiven("env")) c.set_env(absl::GetFlag(FLAGS_env));
-  if (FlagGiven("algo")) c.set_algo(absl::GetFlag(FLAGS_algo));
-  if (FlagGiven("estimator")) c.set_estimator(absl::GetFlag(FLAGS_estimator));
-  if (FlagGiven("rho")) c.set_rho(absl::GetFlag(FLAGS_rho));
-  if (FlagGiven("ensemble")) {
-    if (absl::Status status = ParseIntegers(
-            "ensemble", absl::GetFlag(FLAGS_ensemble), *c.mutable_ensemble());
+  if (FlagGiven("algo")) {
+    request.algo = absl::GetFlag(FLAGS_algo);
+    request.given_flags.push_back("algo");
+    if (absl::Status status = SelectAlgorithm(request.algo, request.flags);
+        !status.ok()) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("--algo: ", status.message()));
+    }
+  }
+  const RunFlag* algorithm_flag = nullptr;
+  for (const RunFlag& flag : RunFlags()) {
+    if (!FlagGiven(flag.name)) continue;
+    request.given_flags.push_back(flag.name);
+    if (flag.algorithm()) {
+      const std::string& algo = flag.section->name();
+      if (!request.algo.empty() && algo != request.algo) {
+        return absl::InvalidArgumentError(
+            absl::StrCat("--", flag.name, " is a ", algo,
+                         " setting; this run's --algo is ", request.algo));
+      }
+      if (algorithm_flag != nullptr &&
+          algorithm_flag->section != flag.section) {
+        return absl::InvalidArgumentError(absl::StrCat(
+            "--", algorithm_flag->name, " and --", flag.name,
+            " are settings of two algorithms; choose one with --algo"));
+      }
+      algorithm_flag = &flag;
+    }
+    const absl::CommandLineFlag* absl_flag =
+        absl::FindCommandLineFlag(flag.name);
+    if (absl_flag == nullptr) {
+      return absl::InternalError(
+          absl::StrCat("run-config field ", flag.name, " has no flag"));
+    }
+    if (absl::Status status =
+            SetField(flag, absl_flag->CurrentValue(), request.flags);
         !status.ok()) {
       return status;
     }
-  }
-  if (FlagGiven("steps")) c.set_steps(absl::GetFlag(FLAGS_steps));
-  if (FlagGiven("seed")) c.set_seed(absl::GetFlag(FLAGS_seed));
-  if (FlagGiven("envs")) c.set_envs(absl::GetFlag(FLAGS_envs));
-  if (FlagGiven("horizon")) c.set_horizon(absl::GetFlag(FLAGS_horizon));
-  if (FlagGiven("minibatches")) {
-    c.set_minibatches(absl::GetFlag(FLAGS_minibatches));
-  }
-  if (FlagGiven("epochs")) c.set_epochs(absl::GetFlag(FLAGS_epochs));
-  if (FlagGiven("learning_rate")) {
-    c.set_learning_rate(absl::GetFlag(FLAGS_learning_rate));
-  }
-  if (FlagGiven("gamma")) c.set_gamma(absl::GetFlag(FLAGS_gamma));
-  if (FlagGiven("gae_lambda")) {
-    c.set_gae_lambda(absl::GetFlag(FLAGS_gae_lambda));
-  }
-  if (FlagGiven("entropy_coef")) {
-    c.set_entropy_coef(absl::GetFlag(FLAGS_entropy_coef));
-  }
-  if (FlagGiven("hidden")) {
-    if (absl::Status status = ParseIntegers(
-            "hidden", absl::GetFlag(FLAGS_hidden), *c.mutable_hidden());
-        !status.ok()) {
-      return status;
-    }
-  }
-  if (FlagGiven("scale_rewards")) {
-    c.set_scale_rewards(absl::GetFlag(FLAGS_scale_rewards));
-  }
-  if (FlagGiven("max_kl")) c.set_max_kl(absl::GetFlag(FLAGS_max_kl));
-  if (FlagGiven("checkpoint_every")) {
-    c.set_checkpoint_every(absl::GetFlag(FLAGS_checkpoint_every));
-  }
-  if (FlagGiven("keep_checkpoints")) {
-    c.set_keep_checkpoints(absl::GetFlag(FLAGS_keep_checkpoints));
-  }
-  if (FlagGiven("sync")) c.set_sync(absl::GetFlag(FLAGS_sync));
-  if (FlagGiven("actors")) c.set_actors(absl::GetFlag(FLAGS_actors));
-  if (FlagGiven("envs_per_actor")) {
-    c.set_envs_per_actor(absl::GetFlag(FLAGS_envs_per_actor));
-  }
-  if (FlagGiven("max_policy_lag")) {
-    c.set_max_policy_lag(absl::GetFlag(FLAGS_max_policy_lag));
-  }
-  if (FlagGiven("segment_length")) {
-    c.set_segment_length(absl::GetFlag(FLAGS_segment_length));
   }
   request.config_file = absl::GetFlag(FLAGS_config);
   request.run_dir = absl::GetFlag(FLAGS_run_dir);

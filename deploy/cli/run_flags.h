@@ -2,8 +2,10 @@
 #define VANTAGE_DEPLOY_CLI_RUN_FLAGS_H_
 
 // The flags that describe a training run (proto/run_config.proto), read by
-// `vantage train` and `vantage learner`: one flag per RunConfig field plus
-// --config, --run_dir and --resume.
+// `vantage train` and `vantage learner`: one flag per field of the run's
+// sections, named as the field (an algorithm's fields prefixed with the
+// algorithm: ppo.epochs is --ppo_epochs), --algo choosing the algorithm,
+// plus --config, --run_dir and --resume.
 
 #include <map>
 #include <string>
@@ -14,8 +16,8 @@
 
 namespace vantage {
 
-// The names of the run flags; `with_mode` adds --mode (train only: a
-// learner is always the distributed one).
+// The names of the run flags in the order of their sections; `with_mode`
+// adds --mode (train only: a learner is always the distributed one).
 std::vector<std::string> RunFlagNames(bool with_mode);
 
 // What each absent run flag means, from ResolveRunConfig itself; a default
@@ -23,11 +25,13 @@ std::vector<std::string> RunFlagNames(bool with_mode);
 // differs under --mode=local.
 std::map<std::string, std::string> RunFlagDefaults(bool with_mode);
 
-// A field's value as its flag would spell it ("" when absent or unknown).
+// A resolved field's value as its flag would spell it ("" when absent or
+// unknown); `flag` is the flag's name (e.g. "horizon", "ppo_epochs").
 std::string RunConfigFieldText(const pb::RunConfig& config,
-                               const std::string& name);
+                               const std::string& flag);
 
-// The given run flags; an unparsable list entry is an error naming it.
+// The given run flags; an unparsable value, or a setting of an algorithm
+// other than --algo's, is an error naming the flag.
 absl::StatusOr<RunRequest> RunRequestFromFlags();
 
 }  // namespace vantage

@@ -6,6 +6,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_join.h"
 #include "deploy/run_config.h"
+#include "learner/algorithms/algorithm.h"
 
 namespace vantage {
 namespace {
@@ -18,27 +19,35 @@ absl::StatusOr<pb::RunConfig> MergeFlags(const RunRequest& request) {
     if (!file.ok()) return file.status();
     config = *file;
   }
+  const pb::RunConfig& flags = request.flags;
+  if (request.algo.empty() &&
+      flags.algorithm_case() != pb::RunConfig::ALGORITHM_NOT_SET &&
+      config.algorithm_case() != pb::RunConfig::ALGORITHM_NOT_SET &&
+      flags.algorithm_case() != config.algorithm_case()) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "the flags set ", AlgorithmNameOf(flags), " settings but ",
+        request.config_file, " holds ", AlgorithmNameOf(config),
+        " settings; add --algo=", AlgorithmNameOf(flags), " to switch"));
+  }
   // A repeated field given as a flag replaces the file's list.
-  if (request.flags.ensemble_size() > 0) config.clear_ensemble();
-  if (request.flags.hidden_size() > 0) config.clear_hidden();
-  config.MergeFrom(request.flags);
+  if (flags.training().hidden_size() > 0) {
+    config.mutable_training()->clear_hidden();
+  }
+  if (flags.advantage().ensemble_size() > 0) {
+    config.mutable_advantage()->clear_ensemble();
+  }
+  config.MergeFrom(flags);
   return config;
 }
 
 // Resuming continues the run exactly as configured; flags that would change
 // it are refused rather than silently ignored.
-absl::Status CheckNoOverrides(const pb::RunConfig& flags) {
+absl::Status CheckNoOverrides(const RunRequest& request) {
+  if (request.given_flags.empty()) return absl::OkStatus();
   std::vector<std::string> given;
-  const auto* descriptor = flags.GetDescriptor();
-  const auto* reflection = flags.GetReflection();
-  for (int i = 0; i < descriptor->field_count(); ++i) {
-    const auto* field = descriptor->field(i);
-    if (field->is_repeated() ? reflection->FieldSize(flags, field) > 0
-                             : reflection->HasField(flags, field)) {
-      given.push_back(absl::StrCat("--", field->name()));
-    }
+  for (const std::string& name : request.given_flags) {
+    given.push_back(absl::StrCat("--", name));
   }
-  if (given.empty()) return absl::OkStatus();
   return absl::InvalidArgumentError(
       absl::StrCat("--resume continues the run as its config.json says; drop ",
                    absl::StrJoin(given, ", ")));
@@ -54,7 +63,7 @@ absl::StatusOr<ResolvedRun> ResolveRunRequest(const RunRequest& request) {
           "--resume takes the run directory's own config; drop --config and "
           "--run_dir");
     }
-    if (absl::Status status = CheckNoOverrides(request.flags); !status.ok()) {
+    if (absl::Status status = CheckNoOverrides(request); !status.ok()) {
       return status;
     }
     absl::StatusOr<pb::RunConfig> saved =
@@ -74,8 +83,6 @@ absl::StatusOr<ResolvedRun> ResolveRunRequest(const RunRequest& request) {
   run.local.config_json = RunConfigToJson(*config);
   run.local.run_dir = request.resume.empty() ? request.run_dir : request.resume;
   run.local.resume = !request.resume.empty();
-  run.local.checkpoint_every = config->checkpoint_every();
-  run.local.keep_checkpoints = config->keep_checkpoints();
   return run;
 }
 
@@ -83,8 +90,9 @@ void PrintTrainResult(const pb::RunConfig& config, const ProgressRow& last) {
   std::printf(
       "RESULT train env=%s algo=%s estimator=%s rho=%g steps=%ld "
       "mean_return=%.1f elapsed_s=%.1f sps=%.0f\n",
-      config.env().c_str(), config.algo().c_str(), config.estimator().c_str(),
-      config.rho(), static_cast<long>(last.stats.env_steps), last.mean_return,
+      config.training().env().c_str(), AlgorithmNameOf(config).c_str(),
+      config.advantage().estimator().c_str(), config.advantage().rho(),
+      static_cast<long>(last.stats.env_steps), last.mean_return,
       last.elapsed_seconds, last.steps_per_second);
 }
 

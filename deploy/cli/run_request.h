@@ -6,6 +6,7 @@
 // resolved configuration that comes out.
 
 #include <string>
+#include <vector>
 
 #include "absl/status/statusor.h"
 #include "deploy/local_training.h"
@@ -18,6 +19,11 @@ struct RunRequest {
   // The fields whose flags were given (command line, --flagfile,
   // --fromenv); the others stay absent and take the defaults.
   pb::RunConfig flags;
+  std::vector<std::string> given_flags;  // their names, for messages
+  // --algo, if given: it switches a config file's algorithm (dropping the
+  // file's settings of the other one); else the flags' algorithm settings
+  // must be the file's algorithm's.
+  std::string algo;
   std::string config_file;  // --config: JSON RunConfig under the flags
   std::string run_dir;      // --run_dir: where the run is recorded
   std::string resume;       // --resume: a run directory to continue

@@ -17,6 +17,7 @@
 #include "deploy/launcher.h"
 #include "deploy/local_training.h"
 #include "deploy/run_directory.h"
+#include "learner/algorithms/algorithm.h"
 
 namespace vantage {
 namespace {
@@ -53,11 +54,13 @@ int RunDistributed(const ResolvedRun& run) {
   std::printf(
       "%s %s with %s, estimator %s (rho %g), %ld steps, seed %lu: "
       "1 learner + %d actors x %d envs over gRPC%s%s\n",
-      run.local.resume ? "resuming" : "training", run.config.env().c_str(),
-      run.config.algo().c_str(), run.config.estimator().c_str(),
-      run.config.rho(), static_cast<long>(run.config.steps()),
-      static_cast<unsigned long>(run.config.seed()), run.config.actors(),
-      run.config.envs_per_actor(),
+      run.local.resume ? "resuming" : "training",
+      run.config.training().env().c_str(), AlgorithmNameOf(run.config).c_str(),
+      run.config.advantage().estimator().c_str(), run.config.advantage().rho(),
+      static_cast<long>(run.config.training().steps()),
+      static_cast<unsigned long>(run.config.training().seed()),
+      run.config.distributed().actors(),
+      run.config.distributed().envs_per_actor(),
       run.local.run_dir.empty() ? "" : ", run directory ",
       run.local.run_dir.c_str());
   std::fflush(stdout);
@@ -77,11 +80,12 @@ int RunLocal(const ResolvedRun& run) {
   std::printf(
       "%s %s with %s, estimator %s (rho %g, ensemble %s), %ld steps, seed "
       "%lu%s%s\n",
-      local.resume ? "resuming" : "training", config.env().c_str(),
-      config.algo().c_str(), config.estimator().c_str(), config.rho(),
-      absl::StrJoin(config.ensemble(), ",").c_str(),
-      static_cast<long>(config.steps()),
-      static_cast<unsigned long>(config.seed()),
+      local.resume ? "resuming" : "training", config.training().env().c_str(),
+      AlgorithmNameOf(config).c_str(), config.advantage().estimator().c_str(),
+      config.advantage().rho(),
+      absl::StrJoin(config.advantage().ensemble(), ",").c_str(),
+      static_cast<long>(config.training().steps()),
+      static_cast<unsigned long>(config.training().seed()),
       local.run_dir.empty() ? "" : ", run directory ", local.run_dir.c_str());
   std::fflush(stdout);
   const bool terminal = ::isatty(STDOUT_FILENO) == 1;
@@ -91,15 +95,17 @@ int RunLocal(const ResolvedRun& run) {
       RunLocalTraining(local, [&](const ProgressRow& progress) {
         last = progress;
         if (!terminal) return true;
-        const double remaining = (config.steps() - progress.stats.env_steps) /
-                                 progress.steps_per_second;
+        const double remaining =
+            (config.training().steps() - progress.stats.env_steps) /
+            progress.steps_per_second;
         std::printf(
             "\r\033[Kupdate %ld  steps %ld/%ld  %.0f steps/s  "
             "return(last100) %.1f  ETA %s",
             static_cast<long>(progress.stats.policy_version),
             static_cast<long>(progress.stats.env_steps),
-            static_cast<long>(config.steps()), progress.steps_per_second,
-            progress.mean_return, Duration(remaining).c_str());
+            static_cast<long>(config.training().steps()),
+            progress.steps_per_second, progress.mean_return,
+            Duration(remaining).c_str());
         std::fflush(stdout);
         return true;
       });
@@ -125,7 +131,7 @@ int RunTrain(const std::vector<std::string>&) {
 
 absl::Status CheckRunCanStart(const ResolvedRun& run) {
   if (absl::StatusOr<std::unique_ptr<Environment>> env =
-          MakeEnvironment(run.config.env());
+          MakeEnvironment(run.config.training().env());
       !env.ok()) {
     return env.status();
   }

@@ -7,12 +7,16 @@
 
 #include "absl/status/statusor.h"
 #include "common/nn/networks.h"
-#include "learner/algorithms/a2c.h"
+#include "learner/algorithms/a2c/a2c_config.h"
 #include "learner/algorithms/policy_updater.h"
-#include "learner/algorithms/ppo.h"
-#include "learner/algorithms/trpo.h"
+#include "learner/algorithms/ppo/ppo_config.h"
+#include "learner/algorithms/run_defaults.h"
+#include "learner/algorithms/trpo/trpo_config.h"
 
 namespace vantage {
+namespace pb {
+class RunConfig;
+}  // namespace pb
 
 // Which algorithm updates the networks, with every algorithm's settings
 // (only the named one's are used).
@@ -30,6 +34,21 @@ std::vector<std::string> AlgorithmNames();
 
 absl::StatusOr<std::unique_ptr<PolicyUpdater>> MakePolicyUpdater(
     const AlgorithmConfig& config, PolicyNetwork policy, ValueNetwork value);
+
+// What the named algorithm's defaults choose outside its own section.
+AlgorithmRunDefaults RunDefaultsOf(const AlgorithmConfig& config);
+
+// The algorithm section of a run config (its `algorithm` oneof, one field
+// per algorithm, named as the algorithm).
+// The algorithm a run config names; "ppo" when it names none.
+std::string AlgorithmNameOf(const pb::RunConfig& run);
+// Names `name` with no settings of its own; an unknown name lists the
+// valid ones.
+absl::Status SelectAlgorithm(const std::string& name, pb::RunConfig& run);
+// The named algorithm's section over its defaults (not yet validated).
+AlgorithmConfig AlgorithmConfigOf(const pb::RunConfig& run);
+// Every field of the named algorithm's settings, into its section.
+void SetAlgorithmSettings(const AlgorithmConfig& config, pb::RunConfig& run);
 
 }  // namespace vantage
 

@@ -65,7 +65,7 @@ TEST(LearningTest, PpoMaxAbsBalancesTheInvertedPendulum) {
 TEST(LearningTest, A2cMaxAbsLearnsTheInvertedPendulum) {
   LocalTrainingConfig config = InvertedPendulum("a2c", 60000, 1);
   config.num_envs = 8;
-  config.learner.algorithm.a2c.minibatches = 4;
+  config.learner.algorithm.a2c.n = 4;
   config.learner.horizon = config.learner.algorithm.a2c.horizon();
   config.learner.advantage.lambda = 1.0;
   EXPECT_GE(BestMeanReturn(config), 150.0);

@@ -42,7 +42,7 @@ LocalTrainingConfig SmallRun(const std::string& algorithm, uint64_t seed,
   config.learner.algorithm.name = algorithm;
   config.learner.algorithm.ppo.minibatches = 8;
   config.learner.algorithm.ppo.epochs = 2;
-  config.learner.algorithm.a2c.minibatches = 4;
+  config.learner.algorithm.a2c.n = 4;
   config.learner.advantage.statistic = *ParseStatistic("max");
   config.learner.advantage.rho = 0.5;
   // Reward scaling carries state across updates (per-stream returns), so

@@ -17,17 +17,18 @@ absl::StatusOr<pb::RunConfig> Resolve(const std::string& json) {
 
 TEST(RunConfigTest, DistributedBatchIsActorsTimesEnvsPerActor) {
   absl::StatusOr<pb::RunConfig> config =
-      Resolve(R"({"actors": 3, "envs_per_actor": 4})");
+      Resolve(R"({"distributed": {"actors": 3, "envs_per_actor": 4}})");
   ASSERT_TRUE(config.ok()) << config.status();
-  EXPECT_EQ(config->envs(), 12);
+  EXPECT_EQ(config->training().envs(), 12);
 }
 
 // actors x envs_per_actor used to overflow an int32 (undefined behaviour,
 // found by tests/fuzz/run_config_fuzzer's UBSan build).
 TEST(RunConfigTest, TooManyEnvsPerActorAreRefused) {
   for (const std::string& json :
-       {std::string(R"({"envs_per_actor": 2147483647})"),
-        std::string(R"({"actors": 256, "envs_per_actor": 4097})")}) {
+       {std::string(R"({"distributed": {"envs_per_actor": 2147483647}})"),
+        std::string(
+            R"({"distributed": {"actors": 256, "envs_per_actor": 4097}})")}) {
     const absl::Status status = Resolve(json).status();
     EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument) << json;
     EXPECT_THAT(std::string(status.message()),
@@ -35,11 +36,97 @@ TEST(RunConfigTest, TooManyEnvsPerActorAreRefused) {
         << json;
   }
   const absl::Status status =
-      Resolve(R"({"actors": 256, "envs_per_actor": 4096})").status();
+      Resolve(R"({"distributed": {"actors": 256, "envs_per_actor": 4096}})")
+          .status();
   EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument);
   EXPECT_THAT(std::string(status.message()),
               HasSubstr("--envs_per_actor makes --actors x --envs_per_actor = "
                         "1048576 streams, more than 4096"));
+}
+
+// Each default comes from the component that owns it.
+TEST(RunConfigTest, DefaultsAreTheComponentsOwn) {
+  absl::StatusOr<pb::RunConfig> config = Resolve("{}");
+  ASSERT_TRUE(config.ok()) << config.status();
+  const LocalTrainingConfig local;
+  EXPECT_EQ(config->mode(), "distributed");
+  EXPECT_EQ(config->training().env(), local.env);
+  EXPECT_EQ(config->training().steps(), local.total_env_steps);
+  EXPECT_EQ(config->advantage().rho(), AdvantageConfig().rho);
+  EXPECT_EQ(config->advantage().estimator(), "maxabs");
+  EXPECT_EQ(config->ppo().minibatches(), PpoConfig().minibatches);
+  EXPECT_EQ(config->recording().checkpoint_every(), local.checkpoint_every);
+  // Only the chosen algorithm's section is there.
+  EXPECT_EQ(config->algorithm_case(), pb::RunConfig::kPpo);
+  absl::StatusOr<pb::RunConfig> a2c = Resolve(R"({"a2c": {"n": 3}})");
+  ASSERT_TRUE(a2c.ok()) << a2c.status();
+  EXPECT_EQ(a2c->training().horizon(), 15);
+  EXPECT_EQ(a2c->advantage().gae_lambda(), 1.0);
+  EXPECT_EQ(a2c->a2c().entropy_coef(), A2cConfig().entropy_coef);
+  absl::StatusOr<pb::RunConfig> local_run = Resolve(R"({"mode": "local"})");
+  ASSERT_TRUE(local_run.ok()) << local_run.status();
+  EXPECT_FALSE(local_run->has_distributed());
+  EXPECT_EQ(local_run->training().envs(), local.num_envs);
+}
+
+TEST(RunConfigTest, AResolvedConfigSurvivesItsJson) {
+  for (const std::string& json :
+       {std::string("{}"), std::string(R"({"mode": "local", "trpo": {}})"),
+        std::string(R"({"a2c": {"n": 2}, "distributed": {"sync": false}})")}) {
+    absl::StatusOr<pb::RunConfig> config = Resolve(json);
+    ASSERT_TRUE(config.ok()) << config.status();
+    absl::StatusOr<pb::RunConfig> again =
+        ParseRunConfigJson(RunConfigToJson(*config));
+    ASSERT_TRUE(again.ok()) << again.status();
+    EXPECT_EQ(again->SerializeAsString(), config->SerializeAsString()) << json;
+  }
+}
+
+// A run directory's config.json from before the sections: the fields
+// whose meaning depended on the algorithm land in its section.
+TEST(RunConfigTest, FlatConfigsOfOlderRunsAreConverted) {
+  absl::StatusOr<pb::RunConfig> a2c = Resolve(
+      R"({"mode": "local", "env": "Hopper", "algo": "a2c", "envs": 4,
+          "horizon": 20, "minibatches": 4, "learning_rate": 0.001,
+          "entropy_coef": 0.02, "epochs": 10, "max_kl": 0.01, "sync": true,
+          "max_policy_lag": "0", "estimator": "min", "rho": 0.3,
+          "ensemble": ["1", "5", "20"], "checkpoint_every": 5})");
+  ASSERT_TRUE(a2c.ok()) << a2c.status();
+  EXPECT_EQ(a2c->a2c().n(), 4);
+  EXPECT_EQ(a2c->a2c().learning_rate(), 0.001);
+  EXPECT_EQ(a2c->a2c().entropy_coef(), 0.02);
+  EXPECT_EQ(a2c->training().env(), "Hopper");
+  EXPECT_EQ(a2c->training().horizon(), 20);
+  EXPECT_EQ(a2c->advantage().estimator(), "min");
+  EXPECT_EQ(a2c->advantage().ensemble_size(), 3);
+  EXPECT_EQ(a2c->recording().checkpoint_every(), 5);
+  EXPECT_FALSE(a2c->has_distributed());
+
+  absl::StatusOr<pb::RunConfig> trpo =
+      Resolve(R"({"algo": "trpo", "learning_rate": 0.002, "max_kl": 0.02,
+                  "actors": 2, "envs_per_actor": 3, "sync": false})");
+  ASSERT_TRUE(trpo.ok()) << trpo.status();
+  EXPECT_EQ(trpo->trpo().value_learning_rate(), 0.002);
+  EXPECT_EQ(trpo->trpo().max_kl(), 0.02);
+  EXPECT_EQ(trpo->training().envs(), 6);
+  EXPECT_FALSE(trpo->distributed().sync());
+  EXPECT_EQ(trpo->distributed().max_policy_lag(), 4);
+
+  absl::StatusOr<pb::RunConfig> ppo =
+      Resolve(R"({"minibatches": 8, "epochs": 3, "learning_rate": 0.01})");
+  ASSERT_TRUE(ppo.ok()) << ppo.status();
+  EXPECT_EQ(ppo->ppo().minibatches(), 8);
+  EXPECT_EQ(ppo->ppo().epochs(), 3);
+  EXPECT_EQ(ppo->ppo().learning_rate(), 0.01);
+
+  const absl::StatusOr<pb::RunConfig> unknown =
+      ParseRunConfigJson(R"({"algo": "sac"})");
+  EXPECT_THAT(std::string(unknown.status().message()),
+              HasSubstr("unknown algorithm 'sac'"));
+  // Neither format: the message is the current format's.
+  const absl::StatusOr<pb::RunConfig> neither =
+      ParseRunConfigJson(R"({"trainin": {}})");
+  EXPECT_THAT(std::string(neither.status().message()), HasSubstr("trainin"));
 }
 
 }  // namespace

@@ -50,7 +50,7 @@ LearnerConfig FuzzLearnerConfig(const std::string& algorithm) {
   config.algorithm.name = algorithm;
   config.algorithm.ppo.minibatches = 2;
   config.algorithm.ppo.epochs = 1;
-  config.algorithm.a2c.minibatches = 2;
+  config.algorithm.a2c.n = 2;
   return config;
 }
 

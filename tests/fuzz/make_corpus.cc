@@ -101,7 +101,7 @@ void WriteCheckpoints(const std::filesystem::path& dir) {
     Check((*learner)->RunUpdate(queue).status());
     pb::RunConfig run;
     run.set_mode("local");
-    run.set_algo(algorithm);
+    Check(SelectAlgorithm(algorithm, run));
     absl::StatusOr<pb::RunConfig> resolved = ResolveRunConfig(run);
     Check(resolved.status());
     const std::string path = (dir / (algorithm + ".pt")).string();

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "absl/algorithm/container.h"
 #include "absl/strings/match.h"
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
@@ -17,6 +18,7 @@
 #include "deploy/run_config.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
+#include "learner/algorithms/algorithm.h"
 #include "tests/deploy/cli/run_vantage.h"
 #include "tests/fakes/run_files.h"
 
@@ -125,7 +127,8 @@ TEST(CommandLineTest, AFlagOfAnotherCommandIsAOneLineUsageError) {
 TEST(CommandLineTest, AFlagfileIsTheCommandLine) {
   const std::string flags =
       "--mode=local --steps=512 --horizon=128 --envs=2 --seed=5 "
-      "--estimator=max --rho=0.7 --ensemble=1,8,32 --nosync";
+      "--estimator=max --rho=0.7 --ensemble=1,8,32 --ppo_epochs=3 "
+      "--ppo_minibatches=4";
   const std::string direct = FreshRun("direct");
   ASSERT_EQ(RunVantage("train " + flags + " --run_dir=" + direct).exit_code, 0);
   std::string lines;
@@ -140,6 +143,7 @@ TEST(CommandLineTest, AFlagfileIsTheCommandLine) {
   EXPECT_EQ(ReadFile(from_file + "/config.json"),
             ReadFile(direct + "/config.json"));
   EXPECT_THAT(ReadFile(direct + "/config.json"), HasSubstr("\"rho\": 0.7"));
+  EXPECT_THAT(ReadFile(direct + "/config.json"), HasSubstr("\"epochs\": 3"));
   EXPECT_EQ(DeterministicProgress(from_file), DeterministicProgress(direct));
   // A flagfile is held to the command's flags too.
   const Outcome foreign =
@@ -161,10 +165,20 @@ TEST(CommandLineTest, HelpDefaultsAreTheRunsConfigAndBehaviour) {
     absl::StatusOr<pb::RunConfig> config =
         ReadRunConfigFile(run + "/config.json");
     ASSERT_TRUE(config.ok()) << config.status();
-    const auto* descriptor = pb::RunConfig::descriptor();
-    for (int i = 0; i < descriptor->field_count(); ++i) {
-      const std::string name = descriptor->field(i)->name();
-      if (name == "mode" || name == "algo" || name == "steps") continue;
+    for (const std::string& name : RunFlagNames(/*with_mode=*/true)) {
+      if (name == "mode" || name == "algo" || name == "steps" ||
+          name == "config" || name == "run_dir" || name == "resume") {
+        continue;
+      }
+      // Another algorithm's settings are not in this run's config.
+      const size_t prefix = name.find('_');
+      if (prefix != std::string::npos &&
+          absl::c_linear_search(AlgorithmNames(), name.substr(0, prefix))) {
+        if (name.substr(0, prefix) != algo) {
+          EXPECT_EQ(RunConfigFieldText(*config, name), "") << algo << name;
+          continue;
+        }
+      }
       ASSERT_EQ(help.count(name), 1u) << name;
       std::string expected = help.at(name);
       // "ppo: 2048; a2c: 20; trpo: 1024 (--mode=local: 1)": this run's part.
@@ -187,7 +201,8 @@ TEST(CommandLineTest, HelpDefaultsAreTheRunsConfigAndBehaviour) {
     int64_t steps = 0;
     ASSERT_TRUE(absl::SimpleAtoi(rows[1].substr(0, rows[1].find(',')), &steps))
         << rows[1];
-    EXPECT_EQ(steps, config->envs() * config->horizon()) << algo;
+    EXPECT_EQ(steps, config->training().envs() * config->training().horizon())
+        << algo;
   }
 }
 

@@ -30,25 +30,57 @@ RunRequest FromJson(const std::string& json) {
 
 TEST(RunRequestTest, BadSettingsNameTheirFlag) {
   const std::pair<std::string, std::string> cases[] = {
-      {R"({"algo": "sac"})",
-       "--algo: unknown algorithm 'sac'; available: a2c, ppo, trpo"},
       {R"({"mode": "cluster"})", "--mode: unknown mode 'cluster'"},
-      {R"({"estimator": "median"})", "unknown statistic 'median'"},
-      {R"({"rho": 1.5})", "rho must be in [0, 1]"},
-      {R"({"steps": 0})", "--steps must be >= 1"},
-      {R"({"envs": 0})", "--envs must be in [1, 4096]"},
-      {R"({"algo": "a2c", "horizon": 12})", "--horizon must be a multiple"},
-      {R"({"hidden": [64, 0]})", "--hidden sizes must be >= 1"},
-      {R"({"sync": true, "max_policy_lag": 2})",
+      {R"({"advantage": {"estimator": "median"}})",
+       "unknown statistic 'median'"},
+      {R"({"advantage": {"rho": 1.5}})", "rho must be in [0, 1]"},
+      {R"({"training": {"steps": 0}})", "--steps must be >= 1"},
+      {R"({"training": {"envs": 0}})", "--envs must be in [1, 4096]"},
+      {R"({"a2c": {}, "training": {"horizon": 12}})",
+       "--horizon is 12 but a2c's own settings make it 20"},
+      {R"({"a2c": {"n": 0}})", "a2c.n must be >= 1"},
+      {R"({"ppo": {"epochs": 0}})", "ppo.epochs must be >= 1"},
+      {R"({"trpo": {"max_kl": 0}})", "trpo.max_kl must be > 0"},
+      {R"({"training": {"hidden": [64, 0]}})", "--hidden sizes must be >= 1"},
+      {R"({"distributed": {"sync": true, "max_policy_lag": 2}})",
        "--max_policy_lag must be 0 with --sync"},
-      {R"({"horizon": 100, "segment_length": 30})",
+      {R"({"training": {"horizon": 100, "segment_length": 30}})",
        "--segment_length must divide --horizon"},
+      {R"({"mode": "local", "distributed": {"actors": 2}})",
+       "--mode=local runs one strictly on-policy process: drop the "
+       "distributed settings"},
   };
   for (const auto& [json, message] : cases) {
     const absl::Status status = ResolveRunRequest(FromJson(json)).status();
     EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument) << json;
     EXPECT_THAT(std::string(status.message()), HasSubstr(message)) << json;
   }
+}
+
+// --algo switches a config file's algorithm; other settings of another
+// algorithm than the file's are refused instead of silently dropped.
+TEST(RunRequestTest, TheAlgorithmIsChosenOnce) {
+  RunRequest request;
+  request.config_file =
+      WriteTemp("a2c.json", R"({"a2c": {"n": 8}, "training": {"seed": 4}})");
+  absl::StatusOr<ResolvedRun> file = ResolveRunRequest(request);
+  ASSERT_TRUE(file.ok()) << file.status();
+  EXPECT_EQ(file->config.a2c().n(), 8);
+  EXPECT_EQ(file->config.training().horizon(), 40);
+  EXPECT_EQ(file->local.learner.algorithm.name, "a2c");
+
+  request.flags.mutable_ppo()->set_epochs(3);
+  EXPECT_THAT(
+      std::string(ResolveRunRequest(request).status().message()),
+      HasSubstr("the flags set ppo settings but " + request.config_file +
+                " holds a2c settings; add --algo=ppo to switch"));
+  request.algo = "ppo";
+  absl::StatusOr<ResolvedRun> switched = ResolveRunRequest(request);
+  ASSERT_TRUE(switched.ok()) << switched.status();
+  EXPECT_EQ(switched->config.ppo().epochs(), 3);
+  EXPECT_EQ(switched->config.training().seed(), 4);
+  EXPECT_EQ(switched->config.training().horizon(), 2048);
+  EXPECT_EQ(switched->local.learner.algorithm.ppo.epochs, 3);
 }
 
 TEST(RunRequestTest, BadFilesAreNamed) {
@@ -72,7 +104,8 @@ TEST(RunRequestTest, BadFilesAreNamed) {
 }
 
 TEST(RunRequestTest, ResumingRefusesChangesAndOtherDirectories) {
-  RunRequest request = FromJson(R"({"rho": 0.9})");
+  RunRequest request = FromJson(R"({"advantage": {"rho": 0.9}})");
+  request.given_flags = {"rho"};
   request.resume = "/some/run";
   EXPECT_THAT(std::string(ResolveRunRequest(request).status().message()),
               HasSubstr("drop --rho"));
@@ -85,7 +118,7 @@ TEST(RunRequestTest, ResumingRefusesChangesAndOtherDirectories) {
 
 TEST(RunRequestTest, ARunThatCannotStartIsRefusedBeforeItStarts) {
   absl::StatusOr<ResolvedRun> unknown =
-      ResolveRunRequest(FromJson(R"({"env": "Nope"})"));
+      ResolveRunRequest(FromJson(R"({"training": {"env": "Nope"}})"));
   ASSERT_TRUE(unknown.ok()) << unknown.status();
   EXPECT_THAT(std::string(CheckRunCanStart(*unknown).message()),
               HasSubstr("unknown environment 'Nope'"));

@@ -32,8 +32,9 @@ TEST(TrainCommandTest, ShortRunWritesARunDirectory) {
   const std::string progress = ReadFile(run + "/progress.csv");
   EXPECT_THAT(progress, HasSubstr("\n256,1,1,"));
   EXPECT_THAT(progress, HasSubstr("\n512,2,2,"));
-  // The resolved config has every field.
+  // The resolved config has every field of the run's sections.
   const std::string config = ReadFile(run + "/config.json");
+  EXPECT_THAT(config, HasSubstr("\"ppo\": {"));
   EXPECT_THAT(config, HasSubstr("\"minibatches\": 32"));
   EXPECT_THAT(config, HasSubstr("\"gae_lambda\": 0.95"));
   EXPECT_THAT(config, HasSubstr("\"horizon\": \"128\""));
@@ -64,10 +65,9 @@ TEST(TrainCommandTest, ShortRunWritesARunDirectory) {
 
 TEST(TrainCommandTest, ResumeContinuesTheRun) {
   const std::string run = FreshDirectory("cli_resume");
-  const std::string config =
-      WriteTemp("resume.json",
-                R"({"mode": "local", "steps": 768, "horizon": 128, "envs": 2,
-                    "algo": "trpo"})");
+  const std::string config = WriteTemp("resume.json",
+                                       R"({"mode": "local", "trpo": {},
+                    "training": {"steps": 768, "horizon": 128, "envs": 2}})");
   ASSERT_EQ(RunVantage("train --checkpoint_every=1 --config=" + config +
                        " --run_dir=" + run)
                 .exit_code,

@@ -60,10 +60,10 @@ pb::RegisterRequest Request(const EnvSpec& spec) {
 
 pb::RunConfig RunConfig() {
   pb::RunConfig config;
-  config.set_env("InvertedPendulum");
-  config.set_algo("ppo");
-  config.set_horizon(16);
-  config.set_segment_length(8);
+  config.mutable_training()->set_env("InvertedPendulum");
+  config.mutable_ppo();
+  config.mutable_training()->set_horizon(16);
+  config.mutable_training()->set_segment_length(8);
   return config;
 }
 

@@ -103,9 +103,10 @@ class SecurityTest : public ::testing::Test {
   absl::Status Start(const SecurityOptions& security) {
     queue_ = std::make_unique<SegmentQueue>(16);
     GatewayConfig config;
-    config.run_config.set_env("InvertedPendulum");
-    config.run_config.set_horizon(16);
-    config.run_config.set_segment_length(8);
+    pb::TrainingSettings& training = *config.run_config.mutable_training();
+    training.set_env("InvertedPendulum");
+    training.set_horizon(16);
+    training.set_segment_length(8);
     gateway_ = std::make_unique<ActorGateway>(config, *queue_);
     gateway_->Publish(MakeWeights(3));
     service_ = std::make_unique<LearnerService>(*gateway_);

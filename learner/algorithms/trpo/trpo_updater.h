@@ -1,5 +1,5 @@
-#ifndef VANTAGE_LEARNER_ALGORITHMS_TRPO_H_
-#define VANTAGE_LEARNER_ALGORITHMS_TRPO_H_
+#ifndef VANTAGE_LEARNER_ALGORITHMS_TRPO_TRPO_UPDATER_H_
+#define VANTAGE_LEARNER_ALGORITHMS_TRPO_TRPO_UPDATER_H_
 
 #include <memory>
 #include <vector>
@@ -7,28 +7,13 @@
 #include "absl/status/status.h"
 #include "common/nn/networks.h"
 #include "learner/algorithms/policy_updater.h"
+#include "learner/algorithms/trpo/trpo_config.h"
 
 namespace torch::optim {
 class Adam;
 }  // namespace torch::optim
 
 namespace vantage {
-
-// Defaults of the baselines' TRPO for MuJoCo.
-struct TrpoConfig {
-  double max_kl = 0.01;
-  int cg_iterations = 10;
-  double cg_damping = 0.1;
-  int line_search_steps = 10;  // step fractions 1, 1/2, 1/4, ...
-  double entropy_coef = 0.0;
-  bool normalize_advantages = true;  // over the batch, after rho mixing
-  // The value function is fitted by Adam on the targets V + GAE.
-  double value_learning_rate = 1e-3;
-  int value_epochs = 5;
-  int value_minibatch_size = 64;
-
-  absl::Status Validate() const;
-};
 
 // TRPO: the natural-gradient direction by conjugate gradient on
 // Fisher-vector products (Hessian of the mean KL, damped), scaled to the
@@ -62,4 +47,4 @@ class TrpoUpdater : public PolicyUpdater {
 
 }  // namespace vantage
 
-#endif  // VANTAGE_LEARNER_ALGORITHMS_TRPO_H_
+#endif  // VANTAGE_LEARNER_ALGORITHMS_TRPO_TRPO_UPDATER_H_

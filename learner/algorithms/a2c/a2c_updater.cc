@@ -1,4 +1,4 @@
-#include "learner/algorithms/a2c.h"
+#include "learner/algorithms/a2c/a2c_updater.h"
 
 #include <ATen/ATen.h>
 #include <torch/optim/rmsprop.h>
@@ -9,26 +9,6 @@
 #include "learner/algorithms/gradient_step.h"
 
 namespace vantage {
-
-absl::Status A2cConfig::Validate() const {
-  if (steps_per_minibatch < 1 || minibatches < 1) {
-    return absl::InvalidArgumentError(
-        "a2c steps_per_minibatch and minibatches must be >= 1");
-  }
-  if (!(learning_rate > 0) || !(max_grad_norm > 0)) {
-    return absl::InvalidArgumentError(
-        "a2c learning rate and max_grad_norm must be > 0");
-  }
-  if (!(rmsprop_alpha > 0 && rmsprop_alpha < 1) || !(rmsprop_eps > 0)) {
-    return absl::InvalidArgumentError(
-        "a2c rmsprop alpha must be in (0, 1) and eps > 0");
-  }
-  if (!(value_coef >= 0) || !(entropy_coef >= 0)) {
-    return absl::InvalidArgumentError(
-        "a2c value and entropy coefficients must be >= 0");
-  }
-  return absl::OkStatus();
-}
 
 A2cUpdater::A2cUpdater(PolicyNetwork policy, ValueNetwork value,
                        const A2cConfig& config)

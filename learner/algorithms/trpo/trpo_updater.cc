@@ -1,4 +1,4 @@
-#include "learner/algorithms/trpo.h"
+#include "learner/algorithms/trpo/trpo_updater.h"
 
 #include <ATen/ATen.h>
 #include <torch/csrc/autograd/autograd.h>
@@ -10,8 +10,8 @@
 #include <limits>
 #include <numeric>
 
-#include "learner/algorithms/conjugate_gradient.h"
 #include "learner/algorithms/gradient_step.h"
+#include "learner/algorithms/trpo/conjugate_gradient.h"
 
 namespace vantage {
 namespace {
@@ -47,27 +47,6 @@ void AssignParameters(const at::Tensor& flat,
 }
 
 }  // namespace
-
-absl::Status TrpoConfig::Validate() const {
-  if (!(max_kl > 0) || !(cg_damping >= 0)) {
-    return absl::InvalidArgumentError(
-        "trpo max_kl must be > 0 and cg_damping >= 0");
-  }
-  if (cg_iterations < 1 || line_search_steps < 1) {
-    return absl::InvalidArgumentError(
-        "trpo cg_iterations and line_search_steps must be >= 1");
-  }
-  if (!(value_learning_rate > 0) || value_epochs < 1 ||
-      value_minibatch_size < 1) {
-    return absl::InvalidArgumentError(
-        "trpo value learning rate must be > 0, value epochs and minibatch "
-        "size >= 1");
-  }
-  if (!(entropy_coef >= 0)) {
-    return absl::InvalidArgumentError("trpo entropy_coef must be >= 0");
-  }
-  return absl::OkStatus();
-}
 
 TrpoUpdater::TrpoUpdater(PolicyNetwork policy, ValueNetwork value,
                          const TrpoConfig& config)

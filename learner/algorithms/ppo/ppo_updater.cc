@@ -1,4 +1,4 @@
-#include "learner/algorithms/ppo.h"
+#include "learner/algorithms/ppo/ppo_updater.h"
 
 #include <ATen/ATen.h>
 #include <torch/optim/adam.h>
@@ -8,30 +8,9 @@
 #include <vector>
 
 #include "learner/algorithms/gradient_step.h"
-#include "learner/algorithms/ppo_objective.h"
+#include "learner/algorithms/ppo/ppo_objective.h"
 
 namespace vantage {
-
-absl::Status PpoConfig::Validate() const {
-  if (epochs < 1) return absl::InvalidArgumentError("ppo epochs must be >= 1");
-  if (minibatches < 1) {
-    return absl::InvalidArgumentError("ppo minibatches must be >= 1");
-  }
-  if (!(clip > 0 && clip < 1)) {
-    return absl::InvalidArgumentError("ppo clip must be in (0, 1)");
-  }
-  if (!(learning_rate > 0)) {
-    return absl::InvalidArgumentError("ppo learning rate must be > 0");
-  }
-  if (!(max_grad_norm > 0)) {
-    return absl::InvalidArgumentError("ppo max_grad_norm must be > 0");
-  }
-  if (!(value_coef >= 0) || !(entropy_coef >= 0)) {
-    return absl::InvalidArgumentError(
-        "ppo value and entropy coefficients must be >= 0");
-  }
-  return absl::OkStatus();
-}
 
 PpoUpdater::PpoUpdater(PolicyNetwork policy, ValueNetwork value,
                        const PpoConfig& config)

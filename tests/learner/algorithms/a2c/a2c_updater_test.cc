@@ -1,4 +1,4 @@
-#include "learner/algorithms/a2c.h"
+#include "learner/algorithms/a2c/a2c_updater.h"
 
 #include <ATen/ATen.h>
 #include <torch/nn/utils/clip_grad.h>
@@ -46,7 +46,7 @@ TEST(A2cTest, UpdatesConsecutiveFiveStepMinibatchesInOrder) {
   batch.returns = at::randn({kSamples});
 
   A2cConfig config;
-  config.minibatches = 3;
+  config.n = 3;
   const at::Tensor initial = policy->parameters()[0].clone();
   A2cUpdater a2c(policy, value, config);
   std::mt19937_64 rng(1);
@@ -93,11 +93,13 @@ TEST(A2cTest, UpdatesConsecutiveFiveStepMinibatchesInOrder) {
 TEST(A2cConfigTest, ValidatesItsSettings) {
   A2cConfig config;
   EXPECT_TRUE(config.Validate().ok());
+  EXPECT_EQ(config.horizon(), 20);
+  config.n = 1;  // the original A2C
   EXPECT_EQ(config.horizon(), 5);
-  config.minibatches = 20;
+  config.n = 20;
   EXPECT_EQ(config.horizon(), 100);
-  config.minibatches = 0;
-  EXPECT_FALSE(config.Validate().ok());
+  config.n = 0;
+  EXPECT_EQ(config.Validate().message(), "a2c.n must be >= 1");
   config = A2cConfig();
   config.rmsprop_alpha = 1.0;
   EXPECT_FALSE(config.Validate().ok());

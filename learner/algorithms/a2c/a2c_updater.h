@@ -1,11 +1,12 @@
-#ifndef VANTAGE_LEARNER_ALGORITHMS_A2C_H_
-#define VANTAGE_LEARNER_ALGORITHMS_A2C_H_
+#ifndef VANTAGE_LEARNER_ALGORITHMS_A2C_A2C_UPDATER_H_
+#define VANTAGE_LEARNER_ALGORITHMS_A2C_A2C_UPDATER_H_
 
 #include <memory>
 #include <vector>
 
 #include "absl/status/status.h"
 #include "common/nn/networks.h"
+#include "learner/algorithms/a2c/a2c_config.h"
 #include "learner/algorithms/policy_updater.h"
 
 namespace torch::optim {
@@ -13,27 +14,6 @@ class RMSprop;
 }  // namespace torch::optim
 
 namespace vantage {
-
-// Defaults of the baselines' A2C the paper builds on.
-struct A2cConfig {
-  int steps_per_minibatch = 5;  // A2C's rollout length
-  // The paper's path-ensemble trick: rollouts of steps_per_minibatch * n
-  // steps (longer paths for the k-step estimates), updated as n
-  // consecutive minibatches of steps_per_minibatch steps each. n = 1 is the
-  // original A2C.
-  int minibatches = 1;
-  double learning_rate = 7e-4;  // decays linearly to 0 over the run
-  double rmsprop_alpha = 0.99;
-  double rmsprop_eps = 1e-5;
-  double max_grad_norm = 0.5;
-  double value_coef = 0.5;
-  double entropy_coef = 0.01;
-
-  int64_t horizon() const {
-    return static_cast<int64_t>(steps_per_minibatch) * minibatches;
-  }
-  absl::Status Validate() const;
-};
 
 // A2C: per minibatch one RMSProp step on
 // -mean(log pi(a|s) A) + value_coef * value loss - entropy_coef * entropy.
@@ -59,4 +39,4 @@ class A2cUpdater : public PolicyUpdater {
 
 }  // namespace vantage
 
-#endif  // VANTAGE_LEARNER_ALGORITHMS_A2C_H_
+#endif  // VANTAGE_LEARNER_ALGORITHMS_A2C_A2C_UPDATER_H_

@@ -1,4 +1,4 @@
-#include "learner/algorithms/trpo.h"
+#include "learner/algorithms/trpo/trpo_updater.h"
 
 #include <ATen/ATen.h>
 #include <ATen/core/grad_mode.h>

@@ -1,4 +1,4 @@
-#include "learner/algorithms/ppo_objective.h"
+#include "learner/algorithms/ppo/ppo_objective.h"
 
 #include <ATen/ATen.h>
 

@@ -1,5 +1,5 @@
-#ifndef VANTAGE_LEARNER_ALGORITHMS_PPO_H_
-#define VANTAGE_LEARNER_ALGORITHMS_PPO_H_
+#ifndef VANTAGE_LEARNER_ALGORITHMS_PPO_PPO_UPDATER_H_
+#define VANTAGE_LEARNER_ALGORITHMS_PPO_PPO_UPDATER_H_
 
 #include <memory>
 #include <vector>
@@ -7,26 +7,13 @@
 #include "absl/status/status.h"
 #include "common/nn/networks.h"
 #include "learner/algorithms/policy_updater.h"
+#include "learner/algorithms/ppo/ppo_config.h"
 
 namespace torch::optim {
 class Adam;
 }  // namespace torch::optim
 
 namespace vantage {
-
-// Defaults of the paper's baselines setup for MuJoCo.
-struct PpoConfig {
-  int epochs = 10;
-  int minibatches = 32;
-  double clip = 0.2;
-  double learning_rate = 3e-4;  // decays linearly to 0 over the run
-  double max_grad_norm = 0.5;
-  double value_coef = 0.5;
-  double entropy_coef = 0.0;
-  bool normalize_advantages = true;  // per minibatch, after rho mixing
-
-  absl::Status Validate() const;
-};
 
 // PPO: `epochs` passes of shuffled minibatches, one Adam (eps 1e-5) over
 // the policy and value parameters, the gradient norm clipped. The ratio's
@@ -51,4 +38,4 @@ class PpoUpdater : public PolicyUpdater {
 
 }  // namespace vantage
 
-#endif  // VANTAGE_LEARNER_ALGORITHMS_PPO_H_
+#endif  // VANTAGE_LEARNER_ALGORITHMS_PPO_PPO_UPDATER_H_

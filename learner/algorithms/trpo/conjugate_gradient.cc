@@ -1,4 +1,4 @@
-#include "learner/algorithms/conjugate_gradient.h"
+#include "learner/algorithms/trpo/conjugate_gradient.h"
 
 #include <ATen/ATen.h>
 

@@ -1,0 +1,100 @@
+#include "learner/algorithms/algorithm.h"
+
+#include <google/protobuf/descriptor.h>
+
+#include <set>
+#include <string>
+
+#include "gmock/gmock.h"
+#include "gtest/gtest.h"
+#include "proto/run_config.pb.h"
+
+namespace vantage {
+namespace {
+
+using ::testing::HasSubstr;
+
+// Adding an algorithm is one folder, one registry line and its section in
+// the run config's oneof; the two lists must name the same algorithms.
+TEST(AlgorithmTest, EveryAlgorithmHasItsRunConfigSection) {
+  const auto* oneof = pb::RunConfig::descriptor()->FindOneofByName("algorithm");
+  ASSERT_NE(oneof, nullptr);
+  std::set<std::string> sections;
+  for (int i = 0; i < oneof->field_count(); ++i) {
+    sections.insert(oneof->field(i)->name());
+  }
+  const std::vector<std::string> names = AlgorithmNames();
+  EXPECT_EQ(sections, std::set<std::string>(names.begin(), names.end()));
+  for (const std::string& name : names) {
+    pb::RunConfig run;
+    ASSERT_TRUE(SelectAlgorithm(name, run).ok()) << name;
+    EXPECT_EQ(AlgorithmNameOf(run), name);
+  }
+}
+
+TEST(AlgorithmTest, UnknownNamesListTheValidOnes) {
+  pb::RunConfig run;
+  const absl::Status status = SelectAlgorithm("sac", run);
+  EXPECT_THAT(std::string(status.message()),
+              HasSubstr("unknown algorithm 'sac'; available: a2c, ppo, trpo"));
+  // Names of the run config's other message fields are no algorithms.
+  EXPECT_FALSE(SelectAlgorithm("training", run).ok());
+  EXPECT_EQ(AlgorithmNameOf(run), "ppo");
+}
+
+// An empty section means the struct defaults, and writing a config back
+// gives every field, which reads back as the same config.
+TEST(AlgorithmTest, AbsentSettingsAreTheStructDefaults) {
+  pb::RunConfig run;
+  AlgorithmConfig ppo = AlgorithmConfigOf(run);
+  EXPECT_EQ(ppo.name, "ppo");
+  EXPECT_EQ(ppo.ppo.minibatches, PpoConfig().minibatches);
+  ASSERT_TRUE(SelectAlgorithm("a2c", run).ok());
+  run.mutable_a2c()->set_learning_rate(1e-3);
+  AlgorithmConfig a2c = AlgorithmConfigOf(run);
+  EXPECT_EQ(a2c.name, "a2c");
+  EXPECT_EQ(a2c.a2c.n, A2cConfig().n);
+  EXPECT_EQ(a2c.a2c.learning_rate, 1e-3);
+  pb::RunConfig written;
+  SetAlgorithmSettings(a2c, written);
+  EXPECT_TRUE(written.a2c().has_n());
+  EXPECT_TRUE(written.a2c().has_entropy_coef());
+  const AlgorithmConfig again = AlgorithmConfigOf(written);
+  EXPECT_EQ(again.a2c.n, a2c.a2c.n);
+  EXPECT_EQ(again.a2c.learning_rate, 1e-3);
+
+  run.Clear();
+  ASSERT_TRUE(SelectAlgorithm("trpo", run).ok());
+  run.mutable_trpo()->set_max_kl(0.05);
+  const AlgorithmConfig trpo = AlgorithmConfigOf(run);
+  EXPECT_EQ(trpo.trpo.max_kl, 0.05);
+  EXPECT_EQ(trpo.trpo.value_learning_rate, TrpoConfig().value_learning_rate);
+}
+
+TEST(AlgorithmTest, RunDefaultsAreTheBaselines) {
+  AlgorithmConfig config;
+  EXPECT_EQ(RunDefaultsOf(config).horizon, 2048);
+  EXPECT_EQ(RunDefaultsOf(config).gae_lambda, 0.95);
+  EXPECT_FALSE(RunDefaultsOf(config).fixes_horizon);
+  config.name = "a2c";
+  config.a2c.n = 7;
+  EXPECT_EQ(RunDefaultsOf(config).horizon, 35);
+  EXPECT_EQ(RunDefaultsOf(config).gae_lambda, 1.0);
+  EXPECT_TRUE(RunDefaultsOf(config).fixes_horizon);
+  config.name = "trpo";
+  EXPECT_EQ(RunDefaultsOf(config).horizon, 1024);
+  EXPECT_EQ(RunDefaultsOf(config).gae_lambda, 0.98);
+}
+
+TEST(AlgorithmTest, ValidationNamesTheField) {
+  AlgorithmConfig config;
+  config.ppo.epochs = 0;
+  EXPECT_EQ(config.Validate().message(), "ppo.epochs must be >= 1");
+  config.name = "trpo";  // the ppo settings are not its business
+  EXPECT_TRUE(config.Validate().ok());
+  config.trpo.max_kl = -1;
+  EXPECT_EQ(config.Validate().message(), "trpo.max_kl must be > 0");
+}
+
+}  // namespace
+}  // namespace vantage
