@@ -8,6 +8,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_join.h"
+#include "absl/strings/str_replace.h"
 #include "common/advantage/advantage_config.h"
 #include "learner/algorithms/algorithm.h"
 #include "proto/flat_run_config.pb.h"
@@ -17,6 +18,17 @@ namespace {
 
 absl::Status Invalid(absl::string_view flag, absl::string_view rule) {
   return absl::InvalidArgumentError(absl::StrCat("--", flag, " ", rule));
+}
+
+// An algorithm's rule names its field ("ppo.epochs must be >= 1"); the
+// message adds the field's flag (--ppo_epochs).
+absl::Status AlgorithmSettingError(absl::string_view rule) {
+  const absl::string_view field = rule.substr(0, rule.find(' '));
+  if (field.find('.') == absl::string_view::npos) {
+    return absl::InvalidArgumentError(rule);
+  }
+  return absl::InvalidArgumentError(absl::StrCat(
+      rule, " (--", absl::StrReplaceAll(field, {{".", "_"}}), ")"));
 }
 
 // An actor sends segments of at most this many steps (or one horizon).
@@ -156,7 +168,7 @@ absl::StatusOr<pb::RunConfig> ResolveRunConfig(const pb::RunConfig& given) {
   }
   AlgorithmConfig algorithm = AlgorithmConfigOf(c);
   if (absl::Status status = algorithm.Validate(); !status.ok()) {
-    return Invalid("algo:", status.message());
+    return AlgorithmSettingError(status.message());
   }
   SetAlgorithmSettings(algorithm, c);
   const AlgorithmRunDefaults run_defaults = RunDefaultsOf(algorithm);
