@@ -174,6 +174,16 @@ std::string FieldText(const Message& message, const FieldDescriptor& field) {
   }
 }
 
+// Parses `text` as an integer of type T for `set`; `bad` words the error.
+template <typename T, typename Bad, typename Set>
+absl::Status SetInteger(const std::string& text, const Bad& bad,
+                        const Set& set) {
+  T value = 0;
+  if (!absl::SimpleAtoi(text, &value)) return bad("is not an integer");
+  set(value);
+  return absl::OkStatus();
+}
+
 // Sets the flag's field from the flag's value as absl prints it.
 absl::Status SetField(const RunFlag& flag, const std::string& text,
                       pb::RunConfig& config) {
@@ -216,24 +226,18 @@ absl::Status SetField(const RunFlag& flag, const std::string& text,
       reflection->SetDouble(message, field, value);
       return absl::OkStatus();
     }
-    case FieldDescriptor::CPPTYPE_INT32: {
-      int32_t value = 0;
-      if (!absl::SimpleAtoi(text, &value)) return bad("is not an integer");
-      reflection->SetInt32(message, field, value);
-      return absl::OkStatus();
-    }
-    case FieldDescriptor::CPPTYPE_INT64: {
-      int64_t value = 0;
-      if (!absl::SimpleAtoi(text, &value)) return bad("is not an integer");
-      reflection->SetInt64(message, field, value);
-      return absl::OkStatus();
-    }
-    case FieldDescriptor::CPPTYPE_UINT64: {
-      uint64_t value = 0;
-      if (!absl::SimpleAtoi(text, &value)) return bad("is not an integer");
-      reflection->SetUInt64(message, field, value);
-      return absl::OkStatus();
-    }
+    case FieldDescriptor::CPPTYPE_INT32:
+      return SetInteger<int32_t>(text, bad, [&](int32_t value) {
+        reflection->SetInt32(message, field, value);
+      });
+    case FieldDescriptor::CPPTYPE_INT64:
+      return SetInteger<int64_t>(text, bad, [&](int64_t value) {
+        reflection->SetInt64(message, field, value);
+      });
+    case FieldDescriptor::CPPTYPE_UINT64:
+      return SetInteger<uint64_t>(text, bad, [&](uint64_t value) {
+        reflection->SetUInt64(message, field, value);
+      });
     default:
       return bad("has a type no flag reads");
   }
@@ -279,27 +283,30 @@ std::vector<std::string> RunFlagNames(bool with_mode) {
 std::map<std::string, std::string> RunFlagDefaults(bool with_mode) {
   const pb::RunConfig standard = Resolved("", "");
   const pb::RunConfig local = Resolved("", "local");
+  std::map<std::string, pb::RunConfig> by_algorithm;
+  for (const std::string& algo : AlgorithmNames()) {
+    by_algorithm[algo] = Resolved(algo, "");
+  }
   std::map<std::string, std::string> defaults;
   defaults["algo"] = AlgorithmNameOf(standard);
   for (const RunFlag& flag : RunFlags()) {
     if (flag.algorithm()) {
       // Only its own algorithm reads it.
       defaults[flag.name] =
-          RunConfigFieldText(Resolved(flag.section->name(), ""), flag.name);
+          RunConfigFieldText(by_algorithm[flag.section->name()], flag.name);
       continue;
     }
     std::string text = RunConfigFieldText(standard, flag.name);
     // Varying a flag shows nothing about its own default.
     if (flag.name != "mode") {
-      std::vector<std::string> by_algorithm;
+      std::vector<std::string> values;
       bool differs = false;
-      for (const std::string& algo : AlgorithmNames()) {
-        const std::string value =
-            RunConfigFieldText(Resolved(algo, ""), flag.name);
+      for (const auto& [algo, config] : by_algorithm) {
+        const std::string value = RunConfigFieldText(config, flag.name);
         differs = differs || value != text;
-        by_algorithm.push_back(absl::StrCat(algo, ": ", value));
+        values.push_back(absl::StrCat(algo, ": ", value));
       }
-      if (differs) text = absl::StrJoin(by_algorithm, "; ");
+      if (differs) text = absl::StrJoin(values, "; ");
       const std::string in_local = RunConfigFieldText(local, flag.name);
       if (with_mode && in_local != RunConfigFieldText(standard, flag.name)) {
         absl::StrAppend(&text, " (--mode=local: ",

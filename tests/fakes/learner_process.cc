@@ -15,12 +15,6 @@
 
 namespace vantage {
 
-std::string FreshDirectory(const std::string& name) {
-  const std::string path = TempPath(name);
-  std::filesystem::remove_all(path);
-  return path;
-}
-
 // Starts `vantage learner <args>` and waits for its port file.
 Learner StartLearner(const std::string& args) {
   Learner learner;

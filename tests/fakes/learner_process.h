@@ -10,9 +10,6 @@
 
 namespace vantage {
 
-// TempPath(name), emptied.
-std::string FreshDirectory(const std::string& name);
-
 struct Learner {
   int pid = 0;
   std::string port;

@@ -29,12 +29,6 @@ using ::testing::HasSubstr;
 using ::testing::Not;
 using ::testing::StartsWith;
 
-std::string FreshRun(const std::string& name) {
-  const std::string path = TempPath(name);
-  std::filesystem::remove_all(path);
-  return path;
-}
-
 int Lines(const std::string& text) {
   return static_cast<int>(std::count(text.begin(), text.end(), '\n'));
 }
@@ -129,13 +123,13 @@ TEST(CommandLineTest, AFlagfileIsTheCommandLine) {
       "--mode=local --steps=512 --horizon=128 --envs=2 --seed=5 "
       "--estimator=max --rho=0.7 --ensemble=1,8,32 --ppo_epochs=3 "
       "--ppo_minibatches=4";
-  const std::string direct = FreshRun("direct");
+  const std::string direct = FreshDirectory("direct");
   ASSERT_EQ(RunVantage("train " + flags + " --run_dir=" + direct).exit_code, 0);
   std::string lines;
   for (absl::string_view flag : absl::StrSplit(flags, ' ')) {
     absl::StrAppend(&lines, flag, "\n");
   }
-  const std::string from_file = FreshRun("from_file");
+  const std::string from_file = FreshDirectory("from_file");
   const Outcome outcome =
       RunVantage("train --flagfile=" + WriteTemp("train.flags", lines) +
                  " --run_dir=" + from_file);
@@ -158,7 +152,7 @@ TEST(CommandLineTest, AFlagfileIsTheCommandLine) {
 TEST(CommandLineTest, HelpDefaultsAreTheRunsConfigAndBehaviour) {
   const std::map<std::string, std::string> help = HelpDefaults("train");
   for (const std::string algo : {"ppo", "a2c", "trpo"}) {
-    const std::string run = FreshRun("defaults_" + algo);
+    const std::string run = FreshDirectory("defaults_" + algo);
     const Outcome outcome = RunVantage(
         "train --mode=local --steps=1 --algo=" + algo + " --run_dir=" + run);
     ASSERT_EQ(outcome.exit_code, 0) << outcome.err;

@@ -6,6 +6,7 @@
 
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 
@@ -29,6 +30,12 @@ std::string TempPath(const std::string& name) {
       ::testing::TempDir(), "/vantage_",
       ::testing::UnitTest::GetInstance()->current_test_info()->name(), "_",
       getpid(), "_", counter++, "_", name);
+}
+
+std::string FreshDirectory(const std::string& name) {
+  const std::string path = TempPath(name);
+  std::filesystem::remove_all(path);
+  return path;
 }
 
 std::string WriteTemp(const std::string& name, const std::string& text) {

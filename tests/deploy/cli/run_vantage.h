@@ -31,6 +31,8 @@ std::string ReadFile(const std::string& path);
 // ctest runs tests as parallel processes: every path gets the running
 // test's name, the process id and a counter so that none share one.
 std::string TempPath(const std::string& name);
+// TempPath(name), emptied.
+std::string FreshDirectory(const std::string& name);
 std::string WriteTemp(const std::string& name, const std::string& text);
 
 }  // namespace vantage

@@ -11,12 +11,6 @@ namespace {
 using ::testing::HasSubstr;
 using ::testing::Not;
 
-std::string FreshDirectory(const std::string& name) {
-  const std::string path = TempPath(name);
-  std::filesystem::remove_all(path);
-  return path;
-}
-
 TEST(TrainCommandTest, ShortRunWritesARunDirectory) {
   const std::string run = FreshDirectory("cli_run");
   const Outcome outcome = RunVantage(
