@@ -3,18 +3,24 @@
 #include <ATen/ATen.h>
 #include <ATen/Parallel.h>
 #include <benchmark/benchmark.h>
-#include <torch/nn/modules/activation.h>
-#include <torch/nn/modules/container/sequential.h>
-#include <torch/nn/modules/linear.h>
-#include <torch/optim/adam.h>
+#include <sys/wait.h>
 
+#include <array>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <limits>
 #include <random>
+#include <thread>
 
+#include "absl/strings/str_cat.h"
+#include "bench/bare_ppo.h"
+#include "bench/blas_library.h"
 #include "bench/fastest.h"
+#include "common/net/loopback_port.h"
+#include "common/util/self_process.h"
 #include "learner/algorithms/ppo/ppo_updater.h"
+#include "learner/parallel/gloo_replica_group.h"
 #include "learner/update_guard.h"
 
 namespace vantage {
@@ -38,77 +44,122 @@ EnvSpec HalfCheetahSpec() {
   return spec;
 }
 
-torch::nn::Sequential BareMlp(int64_t outputs) {
-  return torch::nn::Sequential(torch::nn::Linear(kObservations, 64),
-                               torch::nn::Tanh(), torch::nn::Linear(64, 64),
-                               torch::nn::Tanh(),
-                               torch::nn::Linear(64, outputs));
+BarePpoShape BenchShape() {
+  BarePpoShape shape;
+  shape.observations = kObservations;
+  shape.actions = kActions;
+  shape.minibatches = kMinibatches;
+  shape.epochs = kEpochs;
+  return shape;
 }
 
-// The least a PPO update must do: shuffled minibatches, both networks
-// forward, the Gaussian log-probability, the clipped surrogate and the
-// value loss, backward, one Adam step.
-class BarePpo {
- public:
-  BarePpo()
-      : policy_(BareMlp(kActions)),
-        value_(BareMlp(1)),
-        log_std_(at::zeros({kActions}).set_requires_grad(true)) {
-    std::vector<at::Tensor> parameters = policy_->parameters();
-    for (const at::Tensor& p : value_->parameters()) parameters.push_back(p);
-    parameters.push_back(log_std_);
-    optimizer_ = std::make_unique<torch::optim::Adam>(
-        parameters, torch::optim::AdamOptions(3e-4).eps(1e-5));
-  }
+UpdateBatch SyntheticBatch() { return SyntheticBatch(BenchShape(), kBatch); }
 
-  void Update(const UpdateBatch& batch) {
-    const int64_t minibatch = kBatch / kMinibatches;
-    for (int epoch = 0; epoch < kEpochs; ++epoch) {
-      const at::Tensor permutation = at::randperm(kBatch, at::kLong);
-      for (int64_t begin = 0; begin < kBatch; begin += minibatch) {
-        const at::Tensor index = permutation.slice(0, begin, begin + minibatch);
-        const at::Tensor obs = batch.observations.index_select(0, index);
-        const at::Tensor actions = batch.actions.index_select(0, index);
-        const at::Tensor mean = policy_->forward(obs);
-        const at::Tensor z = (actions - mean) * at::exp(-log_std_);
-        const at::Tensor log_prob = (-0.5 * z * z - log_std_).sum(-1) -
-                                    0.5 * kActions * std::log(2 * M_PI);
-        const at::Tensor ratio = at::exp(
-            log_prob - batch.behaviour_log_probs.index_select(0, index));
-        const at::Tensor adv = batch.advantages.index_select(0, index);
-        const at::Tensor policy_loss =
-            -at::min(ratio * adv, ratio.clamp(0.8, 1.2) * adv).mean();
-        const at::Tensor error = value_->forward(obs).squeeze(-1) -
-                                 batch.returns.index_select(0, index);
-        const at::Tensor loss =
-            policy_loss + 0.5 * 0.5 * (error * error).mean();
-        optimizer_->zero_grad();
-        loss.backward();
-        optimizer_->step();
-      }
-    }
-  }
+double SecondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
+      .count();
+}
 
- private:
-  torch::nn::Sequential policy_;
-  torch::nn::Sequential value_;
-  at::Tensor log_std_;
-  std::unique_ptr<torch::optim::Adam> optimizer_;
+struct DataParallelFigures {
+  int64_t gradient_floats = 0;
+  double allreduce_seconds = 0.0;  // one gradient all-reduce, mean
+  double update_seconds = 0.0;     // the whole update, fastest
 };
 
-UpdateBatch SyntheticBatch() {
-  UpdateBatch batch;
-  batch.horizon = kBatch;
-  batch.streams = 1;
-  batch.observations = at::randn({kBatch, kObservations});
-  batch.actions = at::randn({kBatch, kActions}).clamp(-1, 1);
-  batch.behaviour_log_probs = at::randn({kBatch}) - 6;
-  batch.advantages = at::randn({kBatch});
-  batch.returns = at::randn({kBatch});
-  return batch;
+PpoConfig BenchPpoConfig() {
+  PpoConfig config;
+  config.minibatches = kMinibatches;
+  config.epochs = kEpochs;
+  return config;
+}
+
+// Replica `rank` of two learner processes joined over loopback Gloo as in
+// `vantage train --learners=2`, each updating on its half of `batch` with
+// the gradients averaged every minibatch (so the global minibatch is the
+// single learner's).
+DataParallelFigures RunReplica(int rank, const std::string& rendezvous,
+                               const UpdateBatch& batch) {
+  ReplicaGroupConfig group_config;
+  group_config.rank = rank;
+  group_config.world_size = 2;
+  group_config.rendezvous = rendezvous;
+  group_config.timeout = absl::Seconds(120);
+  std::shared_ptr<ReplicaGroup> group = JoinReplicaGroup(group_config).value();
+  NetworkConfig network;
+  PolicyNetwork policy(HalfCheetahSpec(), network);
+  ValueNetwork value(kObservations, network);
+  std::vector<at::Tensor> parameters = policy->parameters();
+  for (const at::Tensor& p : value->parameters()) parameters.push_back(p);
+  {
+    at::NoGradGuard no_grad;
+    group->Broadcast(parameters, /*root=*/0);
+  }
+  DataParallelFigures figures;
+  for (const at::Tensor& p : parameters) figures.gradient_floats += p.numel();
+  std::vector<at::Tensor> gradient = {at::zeros({figures.gradient_floats})};
+  constexpr int kWarmup = 50;
+  constexpr int kAllReduces = 2000;
+  for (int i = 0; i < kWarmup; ++i) group->AllReduceSum(gradient);
+  const auto start = std::chrono::steady_clock::now();
+  for (int i = 0; i < kAllReduces; ++i) group->AllReduceSum(gradient);
+  figures.allreduce_seconds = SecondsSince(start) / kAllReduces;
+
+  const int64_t half = batch.observations.size(0) / 2;
+  UpdateBatch own;
+  own.horizon = half;
+  own.streams = 1;
+  auto rows = [&](const at::Tensor& t) {
+    return t.slice(0, rank * half, (rank + 1) * half).contiguous();
+  };
+  own.observations = rows(batch.observations);
+  own.actions = rows(batch.actions);
+  own.behaviour_log_probs = rows(batch.behaviour_log_probs);
+  own.advantages = rows(batch.advantages);
+  own.returns = rows(batch.returns);
+  PpoUpdater ppo(policy, value, BenchPpoConfig(), group);
+  std::mt19937_64 rng(rank);
+  figures.update_seconds = std::numeric_limits<double>::infinity();
+  // The first is a warm-up; both replicas run in lockstep.
+  for (int i = 0; i <= kRepetitions; ++i) {
+    const auto update_start = std::chrono::steady_clock::now();
+    benchmark::DoNotOptimize(ppo.Update(own, 0.999, rng));
+    if (i > 0) {
+      figures.update_seconds =
+          std::min(figures.update_seconds, SecondsSince(update_start));
+    }
+  }
+  return figures;
+}
+
+// The second replica in a child process: the replicas of a real run are
+// processes, and two threads of one process measured several times
+// slower collectives than two processes.
+absl::StatusOr<DataParallelFigures> MeasureTwoReplicas(
+    const UpdateBatch& batch) {
+  absl::StatusOr<int> port = FreeLoopbackPort();
+  if (!port.ok()) return port.status();
+  const std::string rendezvous = absl::StrCat("127.0.0.1:", *port);
+  absl::StatusOr<pid_t> child =
+      SpawnSelf({"bench", "learner", "--bench_replica_of=" + rendezvous});
+  if (!child.ok()) return child.status();
+  const DataParallelFigures figures = RunReplica(0, rendezvous, batch);
+  int status = 0;
+  waitpid(*child, &status, 0);
+  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
+    return absl::InternalError("the second learner replica failed");
+  }
+  return figures;
 }
 
 }  // namespace
+
+int RunLearnerBenchmarkReplica(const std::string& rendezvous) {
+  at::set_num_threads(1);
+  at::manual_seed(0);
+  const UpdateBatch batch = SyntheticBatch();
+  RunReplica(1, rendezvous, batch);
+  return 0;
+}
 
 int RunLearnerBenchmark() {
   at::set_num_threads(1);
@@ -118,10 +169,7 @@ int RunLearnerBenchmark() {
   NetworkConfig network;  // 64x64
   PolicyNetwork policy(HalfCheetahSpec(), network);
   ValueNetwork value(kObservations, network);
-  PpoConfig config;
-  config.minibatches = kMinibatches;
-  config.epochs = kEpochs;
-  PpoUpdater ppo(policy, value, config);
+  PpoUpdater ppo(policy, value, BenchPpoConfig());
   std::mt19937_64 rng(0);
   // A learning rate that keeps the synthetic problem's updates tiny, so
   // every repetition does the same work on similar parameters.
@@ -144,7 +192,7 @@ int RunLearnerBenchmark() {
     }
   })->Apply([](auto* b) { UseFastestOfSingleRuns(b, kRepetitions); });
 
-  BarePpo bare;
+  BarePpo bare(BenchShape());
   benchmark::RegisterBenchmark("bare_update", [&](benchmark::State& state) {
     for (auto _ : state) bare.Update(batch);
   })->Apply([](auto* b) { UseFastestOfSingleRuns(b, kRepetitions); });
@@ -160,11 +208,35 @@ int RunLearnerBenchmark() {
   const double ppo_rate = samples / collector.Seconds("ppo_update");
   const double bare_rate = samples / collector.Seconds("bare_update");
   const double guarded_rate = samples / collector.Seconds("guarded_ppo_update");
+  absl::StatusOr<DataParallelFigures> measured = MeasureTwoReplicas(batch);
+  if (!measured.ok()) {
+    std::fprintf(stderr, "bench learner: %s\n",
+                 std::string(measured.status().message()).c_str());
+    return 1;
+  }
+  const DataParallelFigures& two = *measured;
+  const double steps = static_cast<double>(kMinibatches) * kEpochs;
+  const double dp_rate = samples / two.update_seconds;
+  const double allreduce_share =
+      two.allreduce_seconds * steps / two.update_seconds;
+  std::printf(
+      "learner: two replicas (processes joined over loopback Gloo, half the "
+      "batch each): %.0f samples/s, %.2fx one learner; each all-reduce of "
+      "%ld gradient floats %.1f us, %.0f%% of their update\n",
+      dp_rate, dp_rate / ppo_rate, static_cast<long>(two.gradient_floats),
+      two.allreduce_seconds * 1e6, 100 * allreduce_share);
+  const BlasLibrary blas = LoadedBlasLibrary();
+  std::printf("learner: BLAS %s (%s%s%s)\n",
+              blas.path.empty() ? "?" : blas.path.c_str(), blas.kind.c_str(),
+              blas.details.empty() ? "" : ": ", blas.details.c_str());
   std::printf(
       "RESULT learner ppo_samples_per_s=%.0f bare_samples_per_s=%.0f "
-      "ratio=%.3f guarded_samples_per_s=%.0f guard_ratio=%.3f\n",
+      "ratio=%.3f guarded_samples_per_s=%.0f guard_ratio=%.3f "
+      "two_replicas_samples_per_s=%.0f two_replicas_speedup=%.2f "
+      "allreduce_us=%.1f allreduce_share=%.3f blas=%s\n",
       ppo_rate, bare_rate, ppo_rate / bare_rate, guarded_rate,
-      guarded_rate / ppo_rate);
+      guarded_rate / ppo_rate, dp_rate, dp_rate / ppo_rate,
+      two.allreduce_seconds * 1e6, allreduce_share, blas.kind.c_str());
   return 0;
 }
 

@@ -3,11 +3,15 @@
 #include <ATen/Parallel.h>
 #include <benchmark/benchmark.h>
 #include <grpcpp/grpcpp.h>
+#include <signal.h>
+#include <sys/wait.h>
 
 #include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
 #include <thread>
 #include <vector>
 
@@ -19,6 +23,7 @@
 #include "bench/fastest.h"
 #include "bench/raw_physics.h"
 #include "common/nn/networks.h"
+#include "common/util/self_process.h"
 #include "proto/vantage.grpc.pb.h"
 #include "proto/wire_format.h"
 
@@ -139,10 +144,12 @@ double FastestIngestRate(const ConsumingLearner& learner, double seconds) {
 }
 
 // One client: registers, then streams copies of `segments` (renumbered as
-// its own consecutive streams) until `stop`.
+// its own consecutive streams) until `stop`, or only `rounds` of them
+// (rounds >= 0) and then holds its stream open, idle, until `stop`.
 absl::Status StreamCopies(int port, int client, const EnvSpec& spec,
                           const std::vector<pb::Segment>& segments,
-                          const std::atomic<bool>& stop) {
+                          const std::atomic<bool>& stop, int rounds = -1,
+                          std::atomic<int>* streaming = nullptr) {
   grpc::ChannelArguments arguments;
   // A connection of its own, as separate actor processes would have.
   arguments.SetInt("vantage.bench_client", client);
@@ -169,12 +176,15 @@ absl::Status StreamCopies(int port, int client, const EnvSpec& spec,
   pb::SegmentAck ack;
   std::unique_ptr<grpc::ClientWriter<pb::Segment>> writer =
       stub->StreamSegments(&stream_context, &ack);
-  for (int64_t sequence = 0; !stop; ++sequence) {
+  for (int64_t sequence = 0; !stop && (rounds < 0 || sequence < rounds);
+       ++sequence) {
     for (pb::Segment& copy : copies) {
       copy.set_sequence(sequence);
       if (!writer->Write(copy)) break;
     }
   }
+  if (streaming != nullptr) ++*streaming;
+  while (!stop) std::this_thread::sleep_for(std::chrono::milliseconds(50));
   writer->WritesDone();
   const grpc::Status finished = writer->Finish();
   if (!finished.ok() && !stop) {
@@ -230,6 +240,144 @@ int RunIngestBenchmark(int clients, double seconds) {
       "actors_fed=%.1f\n",
       clients, ingested, actor->steps_per_second,
       ingested / actor->steps_per_second);
+  return 0;
+}
+
+namespace {
+
+// A process's resident set and thread count, from /proc.
+struct ProcessFootprint {
+  double rss_mb = 0.0;
+  int threads = 0;
+};
+
+ProcessFootprint FootprintOf(pid_t pid) {
+  ProcessFootprint footprint;
+  std::ifstream status(absl::StrCat("/proc/", pid, "/status"));
+  std::string key;
+  while (status >> key) {
+    if (key == "VmRSS:") {
+      double kb = 0;
+      status >> kb;
+      footprint.rss_mb = kb / 1024;
+    } else if (key == "Threads:") {
+      status >> footprint.threads;
+    }
+  }
+  return footprint;
+}
+
+// Waits for `path` to hold a port; 0 if `pid` ends first or 60 s pass.
+int WaitForPortFile(pid_t pid, const std::string& path) {
+  for (int i = 0; i < 3000; ++i) {
+    std::ifstream file(path);
+    int port = 0;
+    if (file >> port && port > 0) return port;
+    if (waitpid(pid, nullptr, WNOHANG) == pid) return 0;
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  return 0;
+}
+
+}  // namespace
+
+int RunConnectionsBenchmark(int max_actors) {
+  constexpr char kTinyEnv[] = "InvertedPendulum";
+  absl::StatusOr<std::unique_ptr<Environment>> probe =
+      MakeEnvironment(kTinyEnv);
+  if (!probe.ok()) return Fail("connections", probe.status());
+  const EnvSpec spec = (*probe)->spec();
+  // One real 128-step segment of one env, which every client sends once.
+  ActorConfig actor_config;
+  actor_config.env = kTinyEnv;
+  actor_config.num_envs = 1;
+  actor_config.segment_length = kSegmentLength;
+  actor_config.network.hidden = {64, 64};
+  absl::StatusOr<std::unique_ptr<ActorCore>> actor =
+      ActorCore::Create(actor_config);
+  if (!actor.ok()) return Fail("connections", actor.status());
+  CountingSink sink;
+  if (absl::Status status = (*actor)->SetWeights(FreshWeights(spec));
+      !status.ok()) {
+    return Fail("connections", status);
+  }
+  if (absl::Status status = (*actor)->CollectSegments(sink); !status.ok()) {
+    return Fail("connections", status);
+  }
+  std::vector<pb::Segment> segment(1);
+  SegmentToProto(sink.kept().at(0), &segment[0]);
+
+  // A real learner process whose batch (one rollout per actor) never
+  // completes, so that what it holds is the actors' state alone.
+  const std::string port_file =
+      absl::StrCat(std::filesystem::temp_directory_path().string(),
+                   "/vantage-bench-connections-", ::getpid(), ".port");
+  std::error_code error;
+  std::filesystem::remove(port_file, error);
+  absl::StatusOr<pid_t> learner =
+      SpawnSelf({"learner", absl::StrCat("--env=", kTinyEnv),
+                 absl::StrCat("--actors=", max_actors), "--envs_per_actor=1",
+                 "--nosync", absl::StrCat("--segment_length=", kSegmentLength),
+                 "--listen=127.0.0.1:0", "--port_file=" + port_file,
+                 absl::StrCat("--max_live_actors=", max_actors),
+                 absl::StrCat("--max_server_threads=", 2 * max_actors + 64)},
+                port_file + ".log");
+  if (!learner.ok()) return Fail("connections", learner.status());
+  const int port = WaitForPortFile(*learner, port_file);
+  if (port == 0) {
+    kill(*learner, SIGKILL);
+    waitpid(*learner, nullptr, 0);
+    return Fail("connections",
+                absl::InternalError(absl::StrCat("the learner did not start (",
+                                                 port_file, ".log)")));
+  }
+  std::this_thread::sleep_for(std::chrono::seconds(1));
+  const ProcessFootprint idle = FootprintOf(*learner);
+  std::printf("connections: learner idle: %.1f MB, %d threads\n", idle.rss_mb,
+              idle.threads);
+  std::atomic<bool> stop{false};
+  std::atomic<int> streaming{0};
+  std::vector<absl::Status> results(max_actors);
+  std::vector<std::thread> clients;
+  ProcessFootprint last = idle;
+  for (int level :
+       {max_actors / 4, max_actors / 2, 3 * max_actors / 4, max_actors}) {
+    while (static_cast<int>(clients.size()) < level) {
+      const int i = static_cast<int>(clients.size());
+      clients.emplace_back([&, i] {
+        results[i] = StreamCopies(port, i, spec, segment, stop, /*rounds=*/1,
+                                  &streaming);
+      });
+    }
+    for (int i = 0; i < 500 && streaming < level; ++i) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    std::this_thread::sleep_for(std::chrono::seconds(1));
+    last = FootprintOf(*learner);
+    std::printf(
+        "connections: %d actors registered, one segment each, streams open: "
+        "%.1f MB, %d threads\n",
+        level, last.rss_mb, last.threads);
+  }
+  stop = true;
+  for (std::thread& client : clients) client.join();
+  kill(*learner, SIGTERM);
+  waitpid(*learner, nullptr, 0);
+  std::filesystem::remove(port_file, error);
+  for (const absl::Status& result : results) {
+    if (!result.ok()) return Fail("connections", result);
+  }
+  if (streaming < max_actors) {
+    return Fail("connections",
+                absl::InternalError("not every client got its stream"));
+  }
+  std::filesystem::remove(port_file + ".log", error);
+  std::printf(
+      "RESULT connections actors=%d idle_rss_mb=%.1f rss_mb=%.1f "
+      "per_actor_kb=%.1f threads=%d idle_threads=%d\n",
+      max_actors, idle.rss_mb, last.rss_mb,
+      (last.rss_mb - idle.rss_mb) * 1024 / max_actors, last.threads,
+      idle.threads);
   return 0;
 }
 

@@ -28,6 +28,16 @@ int RunIngestBenchmark(int clients, double seconds);
 // actor_steps_per_s=<y> ratio=<y/x>`. Returns the exit code.
 int RunActorBenchmark(const std::string& env_name, int envs, double seconds);
 
+// `vantage bench connections`: what connected actors cost a learner. A
+// `vantage learner` process (InvertedPendulum, a batch that never
+// completes) against its own idle footprint measured in the same run:
+// `max_actors` loopback clients register, each sends one real 128-step
+// segment and holds its stream open; the learner's RSS and threads at a
+// quarter, half, three quarters and all of them. Ends with `RESULT
+// connections actors=N idle_rss_mb=.. rss_mb=.. per_actor_kb=..
+// threads=.. idle_threads=..`.
+int RunConnectionsBenchmark(int max_actors);
+
 }  // namespace vantage
 
 #endif  // VANTAGE_BENCH_TRANSPORT_BENCH_H_

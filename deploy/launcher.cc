@@ -4,6 +4,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -13,34 +14,16 @@
 
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_join.h"
 #include "absl/strings/strip.h"
+#include "common/net/loopback_port.h"
+#include "common/util/self_process.h"
 #include "deploy/run_config.h"
 #include "deploy/run_directory.h"
 #include "learner/checkpoint.h"
 
 namespace vantage {
 namespace {
-
-// Runs this binary with `args` as a child process.
-absl::StatusOr<pid_t> Spawn(const std::vector<std::string>& args) {
-  std::error_code error;
-  const std::string self =
-      std::filesystem::read_symlink("/proc/self/exe", error).string();
-  if (error) return absl::InternalError("cannot find this binary");
-  std::vector<char*> argv;
-  argv.push_back(const_cast<char*>(self.c_str()));
-  for (const std::string& arg : args) {
-    argv.push_back(const_cast<char*>(arg.c_str()));
-  }
-  argv.push_back(nullptr);
-  const pid_t pid = fork();
-  if (pid < 0) return absl::InternalError("fork failed");
-  if (pid == 0) {
-    execv(self.c_str(), argv.data());
-    _exit(127);
-  }
-  return pid;
-}
 
 std::string Describe(int status) {
   if (WIFEXITED(status)) return absl::StrCat("exit code ", WEXITSTATUS(status));
@@ -108,10 +91,10 @@ bool CanResume(const LaunchConfig& config, int status) {
 absl::Status RunDistributedTraining(const LaunchConfig& config,
                                     const std::atomic<bool>& stop) {
   const pb::RunConfig& run = config.run_config;
+  const int learner_count = std::max(1, run.distributed().learners());
   std::error_code error;
   std::filesystem::create_directories(config.work_dir, error);
   const std::string config_path = config.work_dir + "/launch_config.json";
-  const std::string port_file = config.work_dir + "/learner.port";
   {
     std::ofstream file(config_path, std::ios::trunc);
     file << RunConfigToJson(run);
@@ -119,56 +102,95 @@ absl::Status RunDistributedTraining(const LaunchConfig& config,
       return absl::InternalError(absl::StrCat("cannot write ", config_path));
     }
   }
-  const std::vector<std::string> security_args = SecurityArgs(config);
-  // A resumed learner continues the run directory as its config.json says,
-  // on the port the actors already know.
-  auto start_learner = [&](bool resume,
-                           const std::string& port) -> absl::StatusOr<pid_t> {
-    std::filesystem::remove(port_file, error);
-    std::vector<std::string> args = {"learner", "--listen=127.0.0.1:" + port,
-                                     "--port_file=" + port_file};
-    if (resume) {
-      args.push_back("--resume=" + config.run_dir);
-    } else {
-      args.push_back("--config=" + config_path);
-      if (!config.run_dir.empty())
-        args.push_back("--run_dir=" + config.run_dir);
-    }
-    args.insert(args.end(), security_args.begin(), security_args.end());
-    return Spawn(args);
+  const auto port_file = [&](int rank) {
+    return rank == 0
+               ? config.work_dir + "/learner.port"
+               : absl::StrCat(config.work_dir, "/learner-", rank, ".port");
   };
-  absl::StatusOr<pid_t> learner = start_learner(config.resume, "0");
-  if (!learner.ok()) return learner.status();
-  int learner_status = 0;
-  const std::string port =
-      WaitForPort(*learner, port_file, stop, learner_status);
-  if (port.empty()) {
-    if (stop) {
-      Terminate({*learner}, std::chrono::seconds(10));
-      return absl::OkStatus();
+  const std::vector<std::string> security_args = SecurityArgs(config);
+  // Learner ranks' gRPC ports ("0" until first bound: the actors keep
+  // them across restarts) and processes.
+  std::vector<std::string> ports(learner_count, "0");
+  std::vector<pid_t> learners(learner_count, -1);
+  // A resumed learner continues the run directory as its config.json says,
+  // on the port its actors already know. Replicas meet at a rendezvous on
+  // a port fresh for every start, so a restart never meets the old group.
+  auto start_learners = [&](bool resume) -> absl::Status {
+    std::string rendezvous;
+    if (learner_count > 1) {
+      absl::StatusOr<int> port = FreeLoopbackPort();
+      if (!port.ok()) return port.status();
+      rendezvous = absl::StrCat("127.0.0.1:", *port);
     }
-    return absl::InternalError(absl::StrCat(
-        "the learner ended before serving (", Describe(learner_status), ")"));
+    for (int rank = 0; rank < learner_count; ++rank) {
+      std::filesystem::remove(port_file(rank), error);
+      std::vector<std::string> args = {"learner",
+                                       "--listen=127.0.0.1:" + ports[rank],
+                                       "--port_file=" + port_file(rank)};
+      if (learner_count > 1) {
+        args.push_back(absl::StrCat("--rank=", rank));
+        args.push_back("--rendezvous=" + rendezvous);
+      }
+      if (resume) {
+        args.push_back("--resume=" + config.run_dir);
+      } else {
+        args.push_back("--config=" + config_path);
+        if (!config.run_dir.empty())
+          args.push_back("--run_dir=" + config.run_dir);
+      }
+      args.insert(args.end(), security_args.begin(), security_args.end());
+      absl::StatusOr<pid_t> pid = SpawnSelf(args);
+      if (!pid.ok()) return pid.status();
+      learners[rank] = *pid;
+    }
+    for (int rank = 0; rank < learner_count; ++rank) {
+      int status = 0;
+      const std::string port =
+          WaitForPort(learners[rank], port_file(rank), stop, status);
+      if (port.empty()) {
+        if (stop) return absl::OkStatus();
+        learners[rank] = -1;
+        return absl::InternalError(
+            absl::StrCat(learner_count > 1 ? absl::StrCat("learner ", rank)
+                                           : std::string("the learner"),
+                         " ended before serving (", Describe(status), ")"));
+      }
+      ports[rank] = port;
+    }
+    return absl::OkStatus();
+  };
+  std::vector<pid_t> actors(run.distributed().actors(), -1);
+  auto everyone = [&] {
+    std::vector<pid_t> all = actors;
+    all.insert(all.end(), learners.begin(), learners.end());
+    return all;
+  };
+  if (absl::Status started = start_learners(config.resume); !started.ok()) {
+    Terminate(learners, std::chrono::seconds(10));
+    return started;
   }
-  std::fprintf(stderr, "launcher: learner on port %s, starting %d actors\n",
-               port.c_str(), run.distributed().actors());
+  if (stop) {
+    Terminate(learners, std::chrono::seconds(10));
+    return absl::OkStatus();
+  }
+  const std::string serving =
+      learner_count > 1 ? absl::StrCat(learner_count, " learners on ports ",
+                                       absl::StrJoin(ports, ", "))
+                        : absl::StrCat("learner on port ", ports[0]);
+  std::fprintf(stderr, "launcher: %s, starting %d actors\n", serving.c_str(),
+               run.distributed().actors());
 
+  // Actor i serves learner i mod K, so each learner gets an equal share.
   auto start_actor = [&](int i) {
     std::vector<std::string> args = {
         "actor",
-        "--learner=127.0.0.1:" + port,
+        "--learner=127.0.0.1:" + ports[i % learner_count],
         "--env=" + run.training().env(),
         absl::StrCat("--envs=", run.distributed().envs_per_actor()),
         absl::StrCat("--seed=", run.training().seed() + i),
         absl::StrCat("--name=actor-", i)};
     args.insert(args.end(), security_args.begin(), security_args.end());
-    return Spawn(args);
-  };
-  std::vector<pid_t> actors(run.distributed().actors(), -1);
-  auto everyone = [&] {
-    std::vector<pid_t> all = actors;
-    all.push_back(*learner);
-    return all;
+    return SpawnSelf(args);
   };
   for (int i = 0; i < run.distributed().actors(); ++i) {
     absl::StatusOr<pid_t> pid = start_actor(i);
@@ -181,41 +203,51 @@ absl::Status RunDistributedTraining(const LaunchConfig& config,
 
   int actor_restarts = 0;
   int learner_restarts = 0;
+  // Ranks whose learner finished the run (exit code 0).
+  std::vector<bool> finished(learner_count, false);
   absl::Status result;
   while (true) {
     if (stop) {
-      // Everyone gets the signal; the learner writes its last checkpoint.
+      // Everyone gets the signal; rank 0 writes the last checkpoint.
       Terminate(everyone(), std::chrono::seconds(30));
       return absl::OkStatus();
     }
     int status = 0;
     const pid_t done = waitpid(-1, &status, WNOHANG);
-    if (done == *learner) {
-      if (WIFEXITED(status) && WEXITSTATUS(status) == 0) break;
+    const auto learner = std::find(learners.begin(), learners.end(), done);
+    if (done > 0 && learner != learners.end()) {
+      const int rank = static_cast<int>(learner - learners.begin());
+      *learner = -1;
+      if (WIFEXITED(status) && WEXITSTATUS(status) == 0) {
+        finished[rank] = true;
+        if (std::all_of(finished.begin(), finished.end(),
+                        [](bool f) { return f; })) {
+          break;
+        }
+        continue;
+      }
+      const std::string who =
+          learner_count > 1 ? absl::StrCat("learner ", rank) : "the learner";
       if (learner_restarts >= config.max_learner_restarts ||
           !CanResume(config, status)) {
-        *learner = -1;
         result = absl::InternalError(
-            absl::StrCat("the learner failed (", Describe(status), ")"));
+            absl::StrCat(who, " failed (", Describe(status), ")"));
         break;
       }
-      // The actors keep their environments and reconnect by themselves.
+      // The actors keep their environments and reconnect by themselves;
+      // replicas only ever train together, so all restart.
       ++learner_restarts;
       std::fprintf(stderr,
-                   "launcher: the learner ended (%s); resuming it from the "
-                   "run's last checkpoint\n",
-                   Describe(status).c_str());
-      learner = start_learner(/*resume=*/true, port);
-      if (!learner.ok()) {
-        Terminate(actors, std::chrono::seconds(10));
-        return learner.status();
-      }
-      if (WaitForPort(*learner, port_file, stop, learner_status).empty() &&
-          !stop) {
-        *learner = -1;
-        result = absl::InternalError(
-            absl::StrCat("the resumed learner ended before serving (",
-                         Describe(learner_status), ")"));
+                   "launcher: %s ended (%s); resuming %s from the run's last "
+                   "checkpoint\n",
+                   who.c_str(), Describe(status).c_str(),
+                   learner_count > 1 ? "every learner" : "it");
+      Terminate(learners, std::chrono::seconds(30));
+      std::fill(finished.begin(), finished.end(), false);
+      if (absl::Status restarted = start_learners(/*resume=*/true);
+          !restarted.ok()) {
+        result = absl::InternalError(absl::StrCat(
+            "resuming from the last checkpoint failed: ", restarted.message()));
         break;
       }
       continue;
@@ -235,13 +267,10 @@ absl::Status RunDistributedTraining(const LaunchConfig& config,
       absl::StatusOr<pid_t> pid = start_actor(i);
       actors[i] = pid.ok() ? *pid : -1;
     }
-    if (!result.ok()) {
-      Terminate(everyone(), std::chrono::seconds(30));
-      return result;
-    }
+    if (!result.ok()) break;
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
-  Terminate(actors, std::chrono::seconds(10));
+  Terminate(everyone(), std::chrono::seconds(30));
   return result;
 }
 

@@ -1,8 +1,8 @@
 #ifndef VANTAGE_DEPLOY_LAUNCHER_H_
 #define VANTAGE_DEPLOY_LAUNCHER_H_
 
-// The main job on one machine: one learner process and N actor processes
-// of this same binary over loopback gRPC, supervised.
+// The main job on one machine: learner processes and N actor processes of
+// this same binary over loopback gRPC, supervised.
 
 #include <atomic>
 #include <string>
@@ -33,13 +33,16 @@ struct LaunchConfig {
   std::string tls_ca;
 };
 
-// Starts `vantage learner` on 127.0.0.1 with a free port, then the actors
-// (actor i gets seed + i, so one actor repeats a local run), restarts an
-// actor that dies (logged), restarts a learner that dies from the run's last
-// checkpoint on the same port (the actors reconnect to it keeping their
-// environments), forwards `stop` (SIGINT/SIGTERM) to every
-// process, and returns when the learner finishes the run (the actors are
-// then stopped). The learner's output (progress, the RESULT line) passes
+// Starts `vantage learner` on 127.0.0.1 with a free port (with
+// distributed.learners = K > 1, K data-parallel learners, rank 0 serving
+// their rendezvous on another free port), then the actors (actor i gets
+// seed + i, so one actor repeats a local run, and serves learner i mod K),
+// restarts an actor that dies (logged), restarts a learner that dies from
+// the run's last checkpoint on the same port (with K > 1 every learner, as
+// replicas only train together; the actors reconnect keeping their
+// environments), forwards `stop` (SIGINT/SIGTERM) to every process, and
+// returns when the learners finish the run (the actors are then stopped).
+// The learners' output (rank 0's progress, the RESULT line) passes
 // through.
 absl::Status RunDistributedTraining(const LaunchConfig& config,
                                     const std::atomic<bool>& stop);

@@ -82,9 +82,19 @@ absl::StatusOr<ServerCheckpointState> ReadServerState(
 absl::Status RunLearnerServer(
     const LearnerServerConfig& config, const std::atomic<bool>& stop,
     const std::function<void(const ProgressRow&)>& on_update) {
-  const LocalTrainingConfig& training = config.training;
+  const int world_size = config.replicas.world_size;
+  if (world_size < 1 || config.training.num_envs % world_size != 0) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "the batch of ", config.training.num_envs,
+        " env streams does not split over ", world_size, " learners"));
+  }
+  LocalTrainingConfig training = config.training;
+  training.record = config.replicas.rank == 0;
+  // This replica's share of the batch.
+  const int64_t own_streams = training.num_envs / world_size;
   auto learner_config_for = [&](const EnvSpec& spec) {
     LearnerConfig learner_config = MakeLearnerConfig(training, spec);
+    learner_config.rollouts_per_batch = own_streams;
     learner_config.max_segment_steps =
         config.run_config.training().segment_length();
     learner_config.value_limits = config.limits.values;
@@ -94,6 +104,14 @@ absl::Status RunLearnerServer(
     return status;
   }
   const EnvSpec& spec = config.spec;
+  absl::StatusOr<std::shared_ptr<ReplicaGroup>> replicas =
+      JoinReplicaGroup(config.replicas);
+  if (!replicas.ok()) return replicas.status();
+  if (world_size > 1) {
+    std::fprintf(stderr, "learner: replica %d of %d joined at %s\n",
+                 config.replicas.rank, world_size,
+                 config.replicas.rendezvous.c_str());
+  }
   // A resumed run knows its learner and the actor ids it handed out before
   // any actor registers; a new run's directory is made before serving, so a
   // taken one fails fast.
@@ -111,7 +129,8 @@ absl::Status RunLearnerServer(
         }
         first_actor_id = state->next_actor_id;
         return absl::OkStatus();
-      });
+      },
+      *replicas);
   if (!run.ok()) return run.status();
   LearnerCore& learner = (*run)->learner();
   if (training.resume) {
@@ -128,7 +147,7 @@ absl::Status RunLearnerServer(
   // learning), and actors that outpace the learner beyond that block on
   // their streams instead of growing memory.
   const int64_t batch_segments =
-      training.num_envs *
+      own_streams *
       (training.learner.horizon /
        std::max<int64_t>(1, config.run_config.training().segment_length()));
   SegmentQueue queue(
@@ -225,6 +244,14 @@ absl::Status RunLearnerServer(
   while (!(*run)->done() && !stop) {
     absl::StatusOr<ProgressRow> row = (*run)->Update(queue, server_state);
     if (!row.ok() && stop) break;
+    if (!row.ok() && absl::IsUnavailable(row.status())) {
+      // A replica is gone and the update was undone: what the learner
+      // holds is the last update's state, worth keeping for the restart.
+      if (absl::Status kept = (*run)->CheckpointNow(server_state); !kept.ok()) {
+        std::fprintf(stderr, "learner: no checkpoint after the failure: %s\n",
+                     std::string(kept.message()).c_str());
+      }
+    }
     if (!row.ok()) return finish(row.status());
     gateway.Publish(learner.CurrentWeights());
     {

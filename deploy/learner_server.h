@@ -9,6 +9,7 @@
 #include "common/env/environment.h"
 #include "common/net/security_options.h"
 #include "deploy/local_training.h"
+#include "learner/parallel/gloo_replica_group.h"
 #include "learner/service/actor_gateway.h"
 #include "proto/run_config.pb.h"
 
@@ -34,11 +35,17 @@ struct LearnerServerConfig {
   SecurityOptions security;  // TLS and the token every actor must send
   // Prometheus endpoint HOST:PORT (port 0: a free one); empty: none.
   std::string metrics_address;
+  // This learner's place among the run's data-parallel learners (the
+  // run config's distributed.learners); each trains on its own actors'
+  // share of the batch. Only rank 0 writes the run directory.
+  ReplicaGroupConfig replicas;
 };
 
 // `vantage learner`: serves actors over gRPC, trains on their segments and
 // publishes every new version until the run's steps are done or `stop` is
-// set.
+// set. A replica of a data-parallel run joins the others before serving;
+// if one is lost, the update fails here too (Unavailable) and the run is
+// continued by restarting every replica from the last checkpoint.
 absl::Status RunLearnerServer(
     const LearnerServerConfig& config, const std::atomic<bool>& stop,
     const std::function<void(const ProgressRow&)>& on_update);

@@ -33,6 +33,9 @@ struct LocalTrainingConfig {
   // unreadable one is reported and the one before it used); the continued
   // run's progress equals an uninterrupted run's.
   bool resume = false;
+  // False for the replicas of a data-parallel run other than rank 0: they
+  // read run_dir's checkpoints to resume but write nothing there.
+  bool record = true;
 };
 
 // The learner's config for `config` and the environment's spec.

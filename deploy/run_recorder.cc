@@ -22,7 +22,7 @@ absl::StatusOr<ProgressRow> RunRecorder::Record(
     absl::FunctionRef<absl::StatusOr<CheckpointExtras>()> extras) {
   ProgressRow row;
   row.stats = stats;
-  row.mean_return = learner.MeanRecentReturn();
+  row.mean_return = stats.mean_return;
   const double seconds = Seconds();
   row.elapsed_seconds = config_.elapsed_before + seconds;
   row.steps_per_second =

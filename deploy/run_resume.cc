@@ -10,6 +10,7 @@
 namespace vantage {
 
 absl::StatusOr<ResumePoint> ResumeFromNewestCheckpoint(RunDirectory& run,
+                                                       bool truncate_progress,
                                                        CheckpointLoader load) {
   const std::vector<std::string> paths =
       ListCheckpoints(run.checkpoint_directory());
@@ -33,7 +34,9 @@ absl::StatusOr<ResumePoint> ResumeFromNewestCheckpoint(RunDirectory& run,
         (void)absl::SimpleAtod(elapsed->second, &resumed.elapsed_seconds);
       }
       if (absl::Status status =
-              run.TruncateProgress(resumed.learner->policy_version());
+              truncate_progress
+                  ? run.TruncateProgress(resumed.learner->policy_version())
+                  : absl::OkStatus();
           !status.ok()) {
         return status;
       }

@@ -29,10 +29,11 @@ using CheckpointLoader =
 
 // Tries the run's checkpoints newest first; one that does not load is
 // reported on stderr and the one before it tried. NotFound without any
-// checkpoint, DataLoss (listing every reason) when none loads. The run's
-// progress rows after the checkpoint are dropped, so the continued run
-// appends where the checkpoint left off.
+// checkpoint, DataLoss (listing every reason) when none loads. With
+// `truncate_progress` the run's progress rows after the checkpoint are
+// dropped, so the continued run appends where the checkpoint left off.
 absl::StatusOr<ResumePoint> ResumeFromNewestCheckpoint(RunDirectory& run,
+                                                       bool truncate_progress,
                                                        CheckpointLoader load);
 
 }  // namespace vantage

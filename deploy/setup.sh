@@ -17,10 +17,15 @@ while [[ $# -gt 0 ]]; do
 done
 
 # The mujoco CMake config calls find_dependency(OpenGL) and needs Qhull's
-# config, hence libgl-dev, libopengl-dev and libqhull-dev.
+# config, hence libgl-dev, libopengl-dev and libqhull-dev. libgloo-dev holds
+# the headers of the Gloo engine that LibTorch's c10d runs data-parallel
+# learners on. libopenblas0-serial takes libblas.so.3 (Debian's
+# alternatives) over from the reference BLAS that LibTorch's GEMMs would
+# otherwise run on; serial, because every vantage process computes on one
+# thread of its own and several share the machine (docs/benchmarks.md).
 packages=(
   build-essential cmake ninja-build pkgconf clang-format openssl
-  libtorch-dev
+  libtorch-dev libgloo-dev libopenblas0-serial
   libmujoco-dev libqhull-dev libgl-dev libopengl-dev
   libbullet-dev
   libgrpc++-dev protobuf-compiler-grpc libprotobuf-dev protobuf-compiler

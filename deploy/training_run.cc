@@ -17,7 +17,7 @@ TrainingRun::TrainingRun(std::unique_ptr<LearnerCore> learner,
 
 absl::StatusOr<std::unique_ptr<TrainingRun>> TrainingRun::Open(
     const LocalTrainingConfig& config, const LearnerConfig& learner_config,
-    const RestoreExtras& restore) {
+    const RestoreExtras& restore, std::shared_ptr<ReplicaGroup> replicas) {
   std::optional<RunDirectory> run;
   std::unique_ptr<LearnerCore> learner;
   double elapsed_before = 0.0;
@@ -26,11 +26,11 @@ absl::StatusOr<std::unique_ptr<TrainingRun>> TrainingRun::Open(
     if (!opened.ok()) return opened.status();
     run = *std::move(opened);
     absl::StatusOr<ResumePoint> resumed = ResumeFromNewestCheckpoint(
-        *run,
+        *run, /*truncate_progress=*/config.record,
         [&](const std::string& path, const CheckpointExtras& extras)
             -> absl::StatusOr<std::unique_ptr<LearnerCore>> {
           absl::StatusOr<std::unique_ptr<LearnerCore>> loaded =
-              ReadCheckpoint(path, learner_config);
+              ReadCheckpoint(path, learner_config, replicas);
           if (!loaded.ok() || !restore) return loaded;
           if (absl::Status status = restore(path, extras); !status.ok()) {
             return status;
@@ -40,15 +40,16 @@ absl::StatusOr<std::unique_ptr<TrainingRun>> TrainingRun::Open(
     if (!resumed.ok()) return resumed.status();
     learner = std::move(resumed->learner);
     elapsed_before = resumed->elapsed_seconds;
+    if (!config.record) run.reset();
   } else {
-    if (!config.run_dir.empty()) {
+    if (!config.run_dir.empty() && config.record) {
       absl::StatusOr<RunDirectory> created =
           RunDirectory::Create(config.run_dir, config.config_json);
       if (!created.ok()) return created.status();
       run = *std::move(created);
     }
     absl::StatusOr<std::unique_ptr<LearnerCore>> created =
-        LearnerCore::Create(learner_config);
+        LearnerCore::Create(learner_config, replicas);
     if (!created.ok()) return created.status();
     learner = *std::move(created);
   }

@@ -35,9 +35,11 @@ class TrainingRun {
   // A new run (its directory, if `config.run_dir` is set, must not hold
   // one) or, with `config.resume`, the run in `config.run_dir` continued
   // from its newest checkpoint that loads with `learner` and `restore`.
+  // The learner is one of `replicas`.
   static absl::StatusOr<std::unique_ptr<TrainingRun>> Open(
       const LocalTrainingConfig& config, const LearnerConfig& learner,
-      const RestoreExtras& restore);
+      const RestoreExtras& restore,
+      std::shared_ptr<ReplicaGroup> replicas = SoloReplicaGroup());
 
   LearnerCore& learner() { return *learner_; }
   // The run's environment steps are done.

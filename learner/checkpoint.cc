@@ -137,11 +137,12 @@ absl::StatusOr<CheckpointExtras> ReadCheckpointExtras(const std::string& path) {
 }
 
 absl::StatusOr<std::unique_ptr<LearnerCore>> ReadCheckpoint(
-    const std::string& path, const LearnerConfig& config) {
+    const std::string& path, const LearnerConfig& config,
+    std::shared_ptr<ReplicaGroup> replicas) {
   absl::StatusOr<torch::serialize::InputArchive> archive = OpenArchive(path);
   if (!archive.ok()) return archive.status();
   absl::StatusOr<std::unique_ptr<LearnerCore>> learner =
-      LearnerCore::Load(config, *archive);
+      LearnerCore::Load(config, *archive, std::move(replicas));
   if (!learner.ok()) return InFile(path, learner.status());
   return learner;
 }

@@ -31,9 +31,11 @@ absl::Status WriteCheckpoint(const std::string& path,
 // The extras alone (e.g. to learn the config a learner needs).
 absl::StatusOr<CheckpointExtras> ReadCheckpointExtras(const std::string& path);
 
-// A learner for `config` with the checkpoint's state.
+// A learner for `config` with the checkpoint's state (one of `replicas`,
+// which all read the same checkpoint).
 absl::StatusOr<std::unique_ptr<LearnerCore>> ReadCheckpoint(
-    const std::string& path, const LearnerConfig& config);
+    const std::string& path, const LearnerConfig& config,
+    std::shared_ptr<ReplicaGroup> replicas = SoloReplicaGroup());
 
 // The checkpoint files in `directory`, oldest (lowest version) first.
 std::vector<std::string> ListCheckpoints(const std::string& directory);

@@ -17,6 +17,7 @@
 #include "common/advantage/advantage.h"
 #include "learner/archive_io.h"
 #include "learner/ingest/training_batch.h"
+#include "learner/parallel/replica_reductions.h"
 #include "learner/update_guard.h"
 
 namespace vantage {
@@ -58,23 +59,77 @@ absl::Status LearnerConfig::Validate() const {
 }
 
 absl::StatusOr<std::unique_ptr<LearnerCore>> LearnerCore::Create(
-    const LearnerConfig& config) {
+    const LearnerConfig& config, std::shared_ptr<ReplicaGroup> replicas) {
   if (absl::Status status = config.Validate(); !status.ok()) return status;
+  if (replicas == nullptr) replicas = SoloReplicaGroup();
   // Network initialisation draws from LibTorch's global generator.
   at::manual_seed(config.seed);
-  return std::unique_ptr<LearnerCore>(new LearnerCore(config));
+  std::unique_ptr<LearnerCore> core(
+      new LearnerCore(config, std::move(replicas)));
+  if (absl::Status status = core->SynchroniseReplicas(); !status.ok()) {
+    return status;
+  }
+  return core;
 }
 
-LearnerCore::LearnerCore(const LearnerConfig& config)
+LearnerCore::LearnerCore(const LearnerConfig& config,
+                         std::shared_ptr<ReplicaGroup> replicas)
     : config_(config),
+      replicas_(std::move(replicas)),
       policy_(config.spec, config.network),
       value_(config.spec.observation_size, config.network),
       normalizer_(config.spec.observation_size),
       reward_scaler_(config.advantage.gamma, config.reward_clip),
       // Validated by Create, so the algorithm exists.
-      updater_(MakePolicyUpdater(config.algorithm, policy_, value_).value()),
+      updater_(MakePolicyUpdater(config.algorithm, policy_, value_, replicas_)
+                   .value()),
       stitcher_(config.horizon),
-      rng_(config.seed) {}
+      rng_(ReplicaSeed(config.seed, replicas_->rank())) {}
+
+absl::Status LearnerCore::SynchroniseReplicas() {
+  if (replicas_->world_size() == 1) return absl::OkStatus();
+  at::NoGradGuard no_grad;
+  std::vector<at::Tensor> parameters = policy_->parameters();
+  for (const at::Tensor& p : value_->parameters()) parameters.push_back(p);
+  const int64_t local_version = version_;
+  std::vector<at::Tensor> state = {
+      at::cat({at::tensor({normalizer_.count(), static_cast<double>(version_),
+                           static_cast<double>(env_steps_),
+                           static_cast<double>(episodes_),
+                           static_cast<double>(rejected_),
+                           static_cast<double>(stale_segments_),
+                           static_cast<double>(stale_steps_),
+                           static_cast<double>(rolled_back_updates_)},
+                          at::kDouble),
+               normalizer_.mean(), normalizer_.var()})};
+  try {
+    replicas_->Broadcast(parameters, /*root=*/0);
+    replicas_->Broadcast(state, /*root=*/0);
+  } catch (const std::exception& error) {
+    return absl::UnavailableError(
+        absl::StrCat("learner replica ", replicas_->rank(),
+                     " could not receive rank 0's state: ", error.what()));
+  }
+  const at::Tensor& s = state[0];
+  const int64_t size = normalizer_.size();
+  const auto count = [&](int i) {
+    return static_cast<int64_t>(s[i].item<double>());
+  };
+  if (count(1) != local_version) {
+    return absl::FailedPreconditionError(absl::StrCat(
+        "learner replica ", replicas_->rank(), " is at policy version ",
+        local_version, " but rank 0 at ", count(1),
+        " (the replicas must resume from the same checkpoint)"));
+  }
+  env_steps_ = count(2);
+  episodes_ = count(3);
+  rejected_ = count(4);
+  stale_segments_ = count(5);
+  stale_steps_ = count(6);
+  rolled_back_updates_ = count(7);
+  return normalizer_.Restore(s[0].item<double>(), s.slice(0, 8, 8 + size),
+                             s.slice(0, 8 + size, 8 + 2 * size));
+}
 
 PolicyWeights LearnerCore::CurrentWeights() {
   return ExportPolicyWeights(*policy_, normalizer_, version_);
@@ -98,13 +153,13 @@ absl::StatusOr<UpdateStats> LearnerCore::RunUpdate(SegmentSource& source) {
   const int64_t min_version = config_.max_policy_lag < 0
                                   ? std::numeric_limits<int64_t>::min()
                                   : version_ - config_.max_policy_lag;
-  stale_steps_ += stitcher_.DropStepsOlderThan(min_version);
+  unreported_.stale_steps += stitcher_.DropStepsOlderThan(min_version);
   std::vector<Rollout> fresh;
   for (Rollout& rollout : pending_) {
     if (rollout.policy_versions.min().item<int64_t>() >= min_version) {
       fresh.push_back(std::move(rollout));
     } else {
-      stale_steps_ += rollout.policy_versions.size(0);
+      unreported_.stale_steps += rollout.policy_versions.size(0);
     }
   }
   pending_ = std::move(fresh);
@@ -120,14 +175,14 @@ absl::StatusOr<UpdateStats> LearnerCore::RunUpdate(SegmentSource& source) {
                        " is not published yet (newest ", version_, ")"));
     }
     if (!valid.ok()) {
-      ++rejected_;
+      ++unreported_.rejected;
       NoteRejection(*segment, valid);
       continue;
     }
     if (segment->policy_version < min_version) {
-      ++rejected_;
-      ++stale_segments_;
-      stale_steps_ += segment->steps();
+      ++unreported_.rejected;
+      ++unreported_.stale_segments;
+      unreported_.stale_steps += segment->steps();
       continue;
     }
     // Returns count only for segments the stitcher accepts (a duplicate
@@ -144,7 +199,7 @@ absl::StatusOr<UpdateStats> LearnerCore::RunUpdate(SegmentSource& source) {
     const int64_t actor_id = segment->actor_id;
     const int64_t env_slot = segment->env_slot;
     if (absl::Status added = stitcher_.Add(std::move(*segment)); !added.ok()) {
-      ++rejected_;
+      ++unreported_.rejected;
       if (first_rejection_.empty()) {
         first_rejection_ = absl::StrCat("actor ", actor_id, " slot ", env_slot,
                                         ": ", added.message());
@@ -155,17 +210,21 @@ absl::StatusOr<UpdateStats> LearnerCore::RunUpdate(SegmentSource& source) {
       recent_returns_.push_back(r);
       if (recent_returns_.size() > 100) recent_returns_.pop_front();
     }
-    episodes_ += static_cast<int64_t>(returns.size());
+    unreported_.episodes += static_cast<int64_t>(returns.size());
     for (Rollout& rollout : stitcher_.TakeReady()) {
       pending_.push_back(std::move(rollout));
     }
   }
-  const auto update_start = std::chrono::steady_clock::now();
-  std::vector<Rollout> rollouts(pending_.begin(),
-                                pending_.begin() + config_.rollouts_per_batch);
+  std::vector<Rollout> rollouts(
+      std::make_move_iterator(pending_.begin()),
+      std::make_move_iterator(pending_.begin() + config_.rollouts_per_batch));
   pending_.erase(pending_.begin(),
                  pending_.begin() + config_.rollouts_per_batch);
+  return Update(std::move(rollouts));
+}
 
+absl::StatusOr<UpdateStats> LearnerCore::Update(std::vector<Rollout> rollouts) {
+  const auto update_start = std::chrono::steady_clock::now();
   // The batch is normalised with the statistics the acting policy used
   // (shipped with its weights), so that in sync mode the first epoch's
   // ratios start at 1; the statistics absorb the batch after the update.
@@ -178,73 +237,139 @@ absl::StatusOr<UpdateStats> LearnerCore::RunUpdate(SegmentSource& source) {
   if (!batch.ok()) return batch.status();
   UpdateGuard guard(*policy_, *value_, *updater_,
                     config_.scale_rewards ? &reward_scaler_ : nullptr);
-  if (config_.scale_rewards) {
-    if (absl::Status status = reward_scaler_.Observe(rollouts); !status.ok()) {
-      return status;
+  ReplicaGroup& replicas = *replicas_;
+  const double world = replicas.world_size();
+  // A collective that fails (a replica gone) throws from inside the
+  // algorithm; nothing of the update may stay.
+  try {
+    if (config_.scale_rewards) {
+      if (absl::Status status = reward_scaler_.Observe(rollouts, replicas);
+          !status.ok()) {
+        return status;
+      }
+      batch->advantage_inputs.rewards =
+          reward_scaler_.Scale(batch->advantage_inputs.rewards);
     }
-    batch->advantage_inputs.rewards =
-        reward_scaler_.Scale(batch->advantage_inputs.rewards);
-  }
-  absl::StatusOr<Advantages> advantages =
-      ComputeAdvantages(batch->advantage_inputs, config_.advantage, rng_);
-  if (!advantages.ok()) return advantages.status();
+    absl::StatusOr<Advantages> advantages =
+        ComputeAdvantages(batch->advantage_inputs, config_.advantage, rng_);
+    if (!advantages.ok()) return advantages.status();
 
-  const UpdateBatch update = MakeUpdateBatch(
-      *batch, *advantages,
-      [&](const at::Tensor& raw) { return normalizer_.Normalize(raw, clip); });
-  const int64_t samples = update.horizon * update.streams;
-  const double progress =
-      static_cast<double>(env_steps_) / config_.total_env_steps;
-  UpdateStats stats;
-  stats.algorithm = updater_->Update(update, progress, rng_);
-  stats.rollback_reason =
-      guard.Fault(stats.algorithm, config_.rollback_gradient_norm);
-  if (!stats.rollback_reason.empty()) {
-    guard.Restore();
-    stats.rolled_back = true;
-    ++rolled_back_updates_;
-    std::fprintf(stderr,
-                 "learner: warning: update to version %ld rolled back (%s); "
-                 "its batch of %ld steps is dropped\n",
-                 static_cast<long>(version_ + 1), stats.rollback_reason.c_str(),
-                 static_cast<long>(samples));
-  } else {
-    // A dropped batch must not move the statistics either.
-    for (const Rollout& rollout : rollouts) {
-      if (absl::Status status = normalizer_.Update(
-              rollout.observations.slice(0, 0, config_.horizon));
+    const UpdateBatch update =
+        MakeUpdateBatch(*batch, *advantages, [&](const at::Tensor& raw) {
+          return normalizer_.Normalize(raw, clip);
+        });
+    const int64_t samples = update.horizon * update.streams;
+    const double progress =
+        static_cast<double>(env_steps_) / config_.total_env_steps;
+    UpdateStats stats;
+    stats.algorithm = updater_->Update(update, progress, rng_);
+
+    // Everything the statistics need, summed over the replicas in one
+    // collective (every replica holds `samples` samples).
+    const at::Tensor targets = advantages->returns.to(at::kDouble);
+    const at::Tensor residual =
+        targets - batch->advantage_inputs.values.to(at::kDouble);
+    AlgorithmStats& algorithm = stats.algorithm;
+    const std::vector<double> sums = SumAcrossReplicas(
+        replicas,
+        {static_cast<double>(samples),
+         static_cast<double>(unreported_.episodes),
+         static_cast<double>(unreported_.rejected),
+         static_cast<double>(unreported_.stale_segments),
+         static_cast<double>(unreported_.stale_steps),
+         static_cast<double>(stitcher_.stats().evicted_steps),
+         std::accumulate(recent_returns_.begin(), recent_returns_.end(), 0.0),
+         static_cast<double>(recent_returns_.size()),
+         advantages->mask.to(at::kDouble).sum().item<double>(),
+         (advantages->biased - advantages->gae)
+             .abs()
+             .to(at::kDouble)
+             .sum()
+             .item<double>(),
+         targets.sum().item<double>(), targets.pow(2).sum().item<double>(),
+         residual.sum().item<double>(), residual.pow(2).sum().item<double>(),
+         algorithm.policy_loss, algorithm.value_loss, algorithm.entropy,
+         algorithm.approx_kl, algorithm.clip_fraction});
+    for (auto [field, sum] : {std::pair{&algorithm.policy_loss, sums[14]},
+                              std::pair{&algorithm.value_loss, sums[15]},
+                              std::pair{&algorithm.entropy, sums[16]},
+                              std::pair{&algorithm.approx_kl, sums[17]},
+                              std::pair{&algorithm.clip_fraction, sums[18]}}) {
+      *field = sum / world;
+    }
+    // The same decision on every replica: the statistics are global and
+    // the parameters identical.
+    stats.rollback_reason =
+        guard.Fault(stats.algorithm, config_.rollback_gradient_norm);
+    const double global_samples = sums[0];
+    if (!stats.rollback_reason.empty()) {
+      guard.Restore();
+      stats.rolled_back = true;
+      ++rolled_back_updates_;
+      std::fprintf(stderr,
+                   "learner: warning: update to version %ld rolled back (%s); "
+                   "its batch of %ld steps is dropped\n",
+                   static_cast<long>(version_ + 1),
+                   stats.rollback_reason.c_str(),
+                   static_cast<long>(global_samples));
+    } else {
+      // A dropped batch must not move the statistics either.
+      std::vector<at::Tensor> observations;
+      for (const Rollout& rollout : rollouts) {
+        observations.push_back(
+            rollout.observations.slice(0, 0, config_.horizon));
+      }
+      if (absl::Status status = UpdateAcrossReplicas(replicas, normalizer_,
+                                                     at::cat(observations));
           !status.ok()) {
         return status;
       }
     }
+    env_steps_ += static_cast<int64_t>(global_samples);
+    episodes_ += static_cast<int64_t>(sums[1]);
+    rejected_ += static_cast<int64_t>(sums[2]);
+    stale_segments_ += static_cast<int64_t>(sums[3]);
+    stale_steps_ += static_cast<int64_t>(sums[4]);
+    unreported_ = LocalCounts();
+    stats.rolled_back_updates = rolled_back_updates_;
+    for (const Rollout& rollout : rollouts) {
+      stats.rollout_policy_lags.push_back(
+          version_ - rollout.policy_versions.min().item<int64_t>());
+    }
+    ++version_;
+    stats.policy_version = version_;
+    stats.env_steps = env_steps_;
+    stats.episodes = episodes_;
+    stats.mean_return = sums[7] > 0 ? sums[6] / sums[7]
+                                    : std::numeric_limits<double>::quiet_NaN();
+    stats.biased_fraction = sums[8] / global_samples;
+    stats.mean_abs_bias = sums[9] / global_samples;
+    const auto variance = [&](double sum, double squares) {
+      return (squares - sum * sum / global_samples) /
+             std::max(global_samples - 1.0, 1.0);
+    };
+    stats.explained_variance = 1.0 - variance(sums[12], sums[13]) /
+                                         (variance(sums[10], sums[11]) + 1e-8);
+    stats.rejected_segments = rejected_;
+    stats.first_rejection = std::move(first_rejection_);
+    first_rejection_.clear();
+    stats.stale_segments = stale_segments_;
+    stats.stale_steps = stale_steps_;
+    stats.evicted_steps = static_cast<int64_t>(sums[5]);
+    stats.update_seconds = std::chrono::duration<double>(
+                               std::chrono::steady_clock::now() - update_start)
+                               .count();
+    return stats;
+  } catch (const std::exception& error) {
+    guard.Restore();
+    return absl::UnavailableError(absl::StrCat(
+        "the update to version ", version_ + 1, " failed",
+        world > 1 ? absl::StrCat(" on learner replica ", replicas.rank(),
+                                 " of ", replicas.world_size(),
+                                 " (another replica is gone or timed out)")
+                  : "",
+        "; the learner is as before it: ", error.what()));
   }
-  stats.rolled_back_updates = rolled_back_updates_;
-  for (const Rollout& rollout : rollouts) {
-    stats.rollout_policy_lags.push_back(
-        version_ - rollout.policy_versions.min().item<int64_t>());
-  }
-  env_steps_ += samples;
-  ++version_;
-  stats.policy_version = version_;
-  stats.env_steps = env_steps_;
-  stats.episodes = episodes_;
-  stats.biased_fraction = advantages->mask.to(at::kFloat).mean().item<double>();
-  stats.mean_abs_bias =
-      (advantages->biased - advantages->gae).abs().mean().item<double>();
-  const at::Tensor targets = advantages->returns;
-  const at::Tensor residual = targets - batch->advantage_inputs.values;
-  stats.explained_variance =
-      1.0 - (residual.var() / (targets.var() + 1e-8)).item<double>();
-  stats.rejected_segments = rejected_;
-  stats.first_rejection = std::move(first_rejection_);
-  first_rejection_.clear();
-  stats.stale_segments = stale_segments_;
-  stats.stale_steps = stale_steps_;
-  stats.evicted_steps = stitcher_.stats().evicted_steps;
-  stats.update_seconds = std::chrono::duration<double>(
-                             std::chrono::steady_clock::now() - update_start)
-                             .count();
-  return stats;
 }
 
 namespace {
@@ -284,8 +409,14 @@ void LearnerCore::Save(torch::serialize::OutputArchive& archive) const {
 }
 
 absl::StatusOr<std::unique_ptr<LearnerCore>> LearnerCore::Load(
-    const LearnerConfig& config, torch::serialize::InputArchive& archive) {
-  absl::StatusOr<std::unique_ptr<LearnerCore>> created = Create(config);
+    const LearnerConfig& config, torch::serialize::InputArchive& archive,
+    std::shared_ptr<ReplicaGroup> replicas) {
+  if (absl::Status status = config.Validate(); !status.ok()) return status;
+  if (replicas == nullptr) replicas = SoloReplicaGroup();
+  // Synchronised after the state is read, not at creation.
+  at::manual_seed(config.seed);
+  absl::StatusOr<std::unique_ptr<LearnerCore>> created =
+      std::unique_ptr<LearnerCore>(new LearnerCore(config, replicas));
   if (!created.ok()) return created.status();
   LearnerCore& core = **created;
   absl::StatusOr<std::string> name = ReadBytes(archive, "spec.name");
@@ -358,6 +489,13 @@ absl::StatusOr<std::unique_ptr<LearnerCore>> LearnerCore::Load(
   }
   for (int64_t i = 0; i < returns.numel(); ++i) {
     core.recent_returns_.push_back(returns[i].item<double>());
+  }
+  if (core.replicas_->rank() != 0) {
+    core.rng_.seed(ReplicaSeed(config.seed, core.replicas_->rank()) +
+                   static_cast<uint64_t>(core.version_));
+  }
+  if (absl::Status status = core.SynchroniseReplicas(); !status.ok()) {
+    return status;
   }
   return created;
 }

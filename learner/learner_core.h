@@ -20,13 +20,16 @@
 #include "learner/algorithms/algorithm.h"
 #include "learner/ingest/reward_scaler.h"
 #include "learner/ingest/rollout_stitcher.h"
+#include "learner/parallel/replica_group.h"
 
 namespace vantage {
 
 struct LearnerConfig {
   EnvSpec spec;
-  int64_t horizon = 2048;          // steps per rollout and env stream
-  int64_t rollouts_per_batch = 1;  // env streams per update
+  int64_t horizon = 2048;  // steps per rollout and env stream
+  // Env streams per update of this learner (of each replica, in a
+  // data-parallel run: the global batch is world_size times as large).
+  int64_t rollouts_per_batch = 1;
   int64_t max_segment_steps = 4096;
   // Steps acted by a policy older than version - max_policy_lag are
   // dropped and counted (0: strictly on-policy, the sync mode); -1: any.
@@ -54,10 +57,13 @@ struct LearnerConfig {
   absl::Status Validate() const;
 };
 
+// Over the global batch (every replica's) in a data-parallel run.
 struct UpdateStats {
   int64_t policy_version = 0;  // published after this update
   int64_t env_steps = 0;       // consumed so far
   int64_t episodes = 0;        // finished, reported by consumed segments
+  // Of the last 100 episodes each replica saw; NaN before the first ends.
+  double mean_return = 0.0;
   AlgorithmStats algorithm;
   double biased_fraction = 0.0;  // share of samples using the bias
   double mean_abs_bias = 0.0;    // mean |biased - GAE|
@@ -92,12 +98,19 @@ struct UpdateStats {
 class LearnerCore {
  public:
   // Seeds LibTorch's global generator with config.seed, so the initial
-  // networks are reproducible.
+  // networks are reproducible. With `replicas` of more than one learner,
+  // every replica starts from rank 0's networks and statistics (Create
+  // returns once all have joined) and each update averages gradients and
+  // statistics over them; rank r draws its minibatches and rho masks from
+  // ReplicaSeed(seed, r).
   static absl::StatusOr<std::unique_ptr<LearnerCore>> Create(
-      const LearnerConfig& config);
+      const LearnerConfig& config,
+      std::shared_ptr<ReplicaGroup> replicas = SoloReplicaGroup());
 
   PolicyWeights CurrentWeights();
-  // Blocks on `source` until a batch is complete, then updates.
+  // Blocks on `source` until a batch is complete, then updates. A replica
+  // lost during the update leaves this learner as it was before it and
+  // returns Unavailable.
   absl::StatusOr<UpdateStats> RunUpdate(SegmentSource& source);
 
   // Frees the stitching state of an actor that is gone (its registration
@@ -128,15 +141,26 @@ class LearnerCore {
   void Save(torch::serialize::OutputArchive& archive) const;
   // Creates a learner from `config` and the state `archive` holds; any
   // missing or mismatching entry is an InvalidArgument error naming it.
+  // Replicas all load the same checkpoint (rank 0's); ranks other than 0
+  // then reseed their generator from ReplicaSeed(seed, rank) + version.
   static absl::StatusOr<std::unique_ptr<LearnerCore>> Load(
-      const LearnerConfig& config, torch::serialize::InputArchive& archive);
+      const LearnerConfig& config, torch::serialize::InputArchive& archive,
+      std::shared_ptr<ReplicaGroup> replicas = SoloReplicaGroup());
+  const ReplicaGroup& replicas() const { return *replicas_; }
 
  private:
-  explicit LearnerCore(const LearnerConfig& config);
+  LearnerCore(const LearnerConfig& config,
+              std::shared_ptr<ReplicaGroup> replicas);
   // Keeps the first refusal's reason of the update being gathered.
   void NoteRejection(const Segment& segment, const absl::Status& why);
+  // Rank 0's networks, normaliser and counters on every replica; an error
+  // if this replica's version differs from rank 0's.
+  absl::Status SynchroniseReplicas();
+  // The update once its batch is complete.
+  absl::StatusOr<UpdateStats> Update(std::vector<Rollout> rollouts);
 
   const LearnerConfig config_;
+  std::shared_ptr<ReplicaGroup> replicas_;
   PolicyNetwork policy_;
   ValueNetwork value_;
   RunningMeanStd normalizer_;
@@ -145,14 +169,23 @@ class LearnerCore {
   RolloutStitcher stitcher_;
   std::vector<Rollout> pending_;
   std::mt19937_64 rng_;
+  // Totals over the global batch, the same on every replica.
   int64_t version_ = 0;
   int64_t env_steps_ = 0;
   int64_t rejected_ = 0;
-  std::string first_rejection_;  // of the update being gathered
   int64_t stale_segments_ = 0;
   int64_t stale_steps_ = 0;
   int64_t episodes_ = 0;
   int64_t rolled_back_updates_ = 0;
+  // This replica's counts since the last update, added to the totals over
+  // all replicas when the next update sums its statistics.
+  struct LocalCounts {
+    int64_t rejected = 0;
+    int64_t stale_segments = 0;
+    int64_t stale_steps = 0;
+    int64_t episodes = 0;
+  } unreported_;
+  std::string first_rejection_;  // of the update being gathered
   std::deque<double> recent_returns_;
 };
 

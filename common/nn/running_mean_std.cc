@@ -24,13 +24,28 @@ absl::Status RunningMeanStd::Update(const at::Tensor& batch) {
     return absl::InvalidArgumentError(
         "normaliser update holds non-finite values; statistics unchanged");
   }
-  const double batch_count = static_cast<double>(values.size(0));
-  const at::Tensor batch_mean = values.mean(0);
-  const at::Tensor batch_var = values.var(0, /*unbiased=*/false);
+  return Merge(static_cast<double>(values.size(0)), values.mean(0),
+               values.var(0, /*unbiased=*/false));
+}
+
+absl::Status RunningMeanStd::Merge(double batch_count,
+                                   const at::Tensor& batch_mean,
+                                   const at::Tensor& batch_var) {
+  if (batch_mean.dim() != 1 || batch_mean.size(0) != size() ||
+      batch_var.dim() != 1 || batch_var.size(0) != size()) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("normaliser merge needs moments of size ", size()));
+  }
+  if (batch_count == 0) return absl::OkStatus();
+  if (!(batch_count > 0) || !at::isfinite(batch_mean).all().item<bool>() ||
+      !at::isfinite(batch_var).all().item<bool>()) {
+    return absl::InvalidArgumentError(
+        "normaliser merge holds non-finite moments; statistics unchanged");
+  }
   const double total = count_ + batch_count;
-  const at::Tensor delta = batch_mean - mean_;
+  const at::Tensor delta = batch_mean.to(at::kDouble) - mean_;
   mean_ = mean_ + delta * (batch_count / total);
-  var_ = (var_ * count_ + batch_var * batch_count +
+  var_ = (var_ * count_ + batch_var.to(at::kDouble) * batch_count +
           delta * delta * (count_ * batch_count / total)) /
          total;
   count_ = total;

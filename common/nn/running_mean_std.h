@@ -22,6 +22,12 @@ class RunningMeanStd {
   // batch: [B, size] (or [size]); rejects wrong sizes and non-finite values
   // without touching the statistics.
   absl::Status Update(const at::Tensor& batch);
+  // Folds in a batch given by its moments: `count` rows with per-element
+  // `mean` and (population) `var`, double [size]. Update() is this on the
+  // batch's own moments; data-parallel learners merge moments summed
+  // across replicas.
+  absl::Status Merge(double count, const at::Tensor& mean,
+                     const at::Tensor& var);
 
   // (x - mean) / sqrt(var + 1e-8), clipped to [-clip, clip], in x's dtype.
   at::Tensor Normalize(const at::Tensor& x, double clip) const;

@@ -2,7 +2,10 @@
 
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
 #include <functional>
 #include <map>
 #include <string>
@@ -11,19 +14,28 @@
 #include "absl/flags/flag.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_join.h"
+#include "actor/envs/env_registry.h"
 #include "bench/advantage_bench.h"
 #include "bench/env_bench.h"
 #include "bench/learner_bench.h"
+#include "bench/train_bench.h"
 #include "bench/transport_bench.h"
 #include "deploy/cli/command_line.h"
+#include "deploy/cli/run_flags.h"
 #include "deploy/cli/shared_flags.h"
+#include "deploy/run_config.h"
+#include "learner/algorithms/algorithm.h"
 
 ABSL_FLAG(int64_t, bench_steps, 2048, "advantages: rollout length T");
 ABSL_FLAG(int64_t, bench_streams, 16, "advantages: number of env streams");
 ABSL_FLAG(int32_t, bench_clients, 4,
-          "ingest: loopback clients streaming segments");
+          "ingest: loopback clients streaming segments; connections: actors "
+          "connected (default 200)");
 ABSL_FLAG(double, bench_seconds, 5.0,
           "ingest, actor: length of each timed window");
+ABSL_FLAG(std::string, bench_replica_of, "",
+          "learner: run as the second data-parallel replica of the `bench "
+          "learner` whose rendezvous is this HOST:PORT (started by it)");
 
 namespace vantage {
 namespace {
@@ -31,10 +43,68 @@ namespace {
 // `bench actor`'s setting unless told otherwise.
 constexpr char kActorBenchEnv[] = "HalfCheetah";
 constexpr int kActorBenchEnvs = 16;
+// `bench train`'s run unless told otherwise: HalfCheetah with the
+// baselines' PPO, about 30 updates of the default two actors.
+constexpr char kTrainBenchEnv[] = "HalfCheetah";
+constexpr int64_t kTrainBenchSteps = 122880;
+constexpr int kConnectionsBenchActors = 200;
 
 int Usage(const char* message) {
   std::fprintf(stderr, "vantage bench %s\n", message);
   return kUsageError;
+}
+
+// The run `vantage train` would make of the run flags given (with the
+// bench's env and steps unless given), timed against the machine's limit.
+int RunTrainBench() {
+  absl::StatusOr<RunRequest> request = RunRequestFromFlags();
+  if (!request.ok())
+    return Usage(std::string(request.status().message()).c_str());
+  if (!request->resume.empty() || !request->run_dir.empty()) {
+    return Usage("train: --run_dir and --resume are not for a benchmark");
+  }
+  pb::TrainingSettings& training = *request->flags.mutable_training();
+  if (!training.has_env()) training.set_env(kTrainBenchEnv);
+  if (!training.has_steps()) training.set_steps(kTrainBenchSteps);
+  if (request->flags.has_mode() && request->flags.mode() != "distributed") {
+    return Usage("train: times the distributed main job (no --mode=local)");
+  }
+  request->flags.set_mode("distributed");
+  absl::StatusOr<ResolvedRun> run = ResolveRunRequest(*request);
+  if (!run.ok()) return Usage(std::string(run.status().message()).c_str());
+  const pb::RunConfig& config = run->config;
+  if (AlgorithmNameOf(config) != "ppo") {
+    return Usage("train: the limit counts PPO's epochs; use --algo=ppo");
+  }
+  absl::StatusOr<std::unique_ptr<Environment>> env =
+      MakeEnvironment(config.training().env());
+  if (!env.ok()) return Usage(std::string(env.status().message()).c_str());
+  TrainBenchConfig bench;
+  bench.config_path =
+      absl::StrCat(std::filesystem::temp_directory_path().string(),
+                   "/vantage-bench-train-", ::getpid(), ".json");
+  {
+    std::ofstream file(bench.config_path, std::ios::trunc);
+    file << RunConfigToJson(config);
+    if (!file.flush()) return Usage("train: cannot write its run config");
+  }
+  const pb::DistributedSettings& d = config.distributed();
+  bench.env = config.training().env();
+  bench.learners = d.learners();
+  bench.actors = d.actors();
+  bench.envs_per_actor = d.envs_per_actor();
+  bench.sync = d.sync();
+  bench.batch = config.training().horizon() * config.training().envs();
+  bench.shape.observations = (*env)->spec().observation_size;
+  bench.shape.actions = (*env)->spec().action_size;
+  bench.shape.hidden.assign(config.training().hidden().begin(),
+                            config.training().hidden().end());
+  bench.shape.epochs = config.ppo().epochs();
+  bench.shape.minibatches = config.ppo().minibatches();
+  const int code = RunTrainBenchmark(bench);
+  std::error_code error;
+  std::filesystem::remove(bench.config_path, error);
+  return code;
 }
 
 const std::map<std::string, std::function<int()>>& Benchmarks() {
@@ -74,7 +144,23 @@ const std::map<std::string, std::function<int()>>& Benchmarks() {
          }
          return RunIngestBenchmark(clients, seconds);
        }},
-      {"learner", [] { return RunLearnerBenchmark(); }},
+      {"train", RunTrainBench},
+      {"connections",
+       [] {
+         const int actors = FlagGiven("bench_clients")
+                                ? absl::GetFlag(FLAGS_bench_clients)
+                                : kConnectionsBenchActors;
+         if (actors < 4 || actors > 1000) {
+           return Usage("connections: --bench_clients must be in [4, 1000]");
+         }
+         return RunConnectionsBenchmark(actors);
+       }},
+      {"learner",
+       [] {
+         const std::string replica_of = absl::GetFlag(FLAGS_bench_replica_of);
+         return replica_of.empty() ? RunLearnerBenchmark()
+                                   : RunLearnerBenchmarkReplica(replica_of);
+       }},
   };
   return *benchmarks;
 }
@@ -114,19 +200,33 @@ Command BenchCommand() {
   command.name = "bench";
   command.summary = "benchmarks: ratios against a baseline of the same run";
   command.usage =
-      "vantage bench (advantages | actor | env | ingest | learner) [flags] "
-      "[--benchmark_*]";
+      "vantage bench (advantages | actor | connections | env | ingest | "
+      "learner | train) [flags] [--benchmark_*]";
   command.description =
       "advantages: the path-ensemble estimators against GAE; env: the\n"
       "environment layer against raw physics; learner: a PPO update against\n"
       "a bare LibTorch loop; ingest: the learner's segment ingest in actors;\n"
-      "actor: a streaming actor against raw physics. Each ends with a line\n"
-      "`RESULT <name> ... ratio=...` measured in the same run. Google\n"
+      "actor: a streaming actor against raw physics; connections: a\n"
+      "learner's memory and threads per connected actor against its idle\n"
+      "footprint; train: the distributed\n"
+      "main job (`vantage train` with the run flags given) against the\n"
+      "machine's limit from raw physics and a bare update. Each ends with a\n"
+      "line `RESULT <name> ... ratio=...` measured in the same run. Google\n"
       "Benchmark's --benchmark_* flags apply.";
-  command.flags = {"bench_steps",   "bench_streams", "bench_clients",
-                   "bench_seconds", "env",           "envs"};
+  command.flags = {"bench_steps",   "bench_streams",    "bench_clients",
+                   "bench_seconds", "bench_replica_of", "env",
+                   "envs"};
+  // train: the run flags, as `vantage train` takes them.
+  for (const std::string& name : RunFlagNames(/*with_mode=*/false)) {
+    if (std::find(command.flags.begin(), command.flags.end(), name) ==
+        command.flags.end()) {
+      command.flags.push_back(name);
+    }
+  }
   command.defaults = {
-      {"env", absl::StrCat("actor: ", kActorBenchEnv, "; env: required")},
+      {"env", absl::StrCat("actor: ", kActorBenchEnv,
+                           "; env: required; train: ", kTrainBenchEnv)},
+      {"steps", absl::StrCat("train: ", kTrainBenchSteps)},
       {"envs", absl::StrCat("actor: ", kActorBenchEnvs)}};
   command.example = "vantage bench env --env=Hopper";
   command.take_own_arguments = InitializeGoogleBenchmark;

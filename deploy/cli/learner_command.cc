@@ -2,8 +2,10 @@
 
 #include <ATen/Parallel.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <thread>
 
 #include "absl/flags/flag.h"
 #include "absl/strings/str_cat.h"
@@ -19,6 +21,19 @@
 ABSL_FLAG(std::string, listen, "127.0.0.1:0",
           "HOST:PORT to serve actors on (port 0: a free one)");
 ABSL_FLAG(std::string, port_file, "", "write the bound port here once serving");
+ABSL_FLAG(int, rank, 0,
+          "this learner's rank among the run's --learners (rank 0 serves the "
+          "rendezvous and writes the run directory)");
+ABSL_FLAG(int, world_size, 0,
+          "the number of data-parallel learners (the same as --learners; "
+          "0: --learners)");
+ABSL_FLAG(std::string, rendezvous, "",
+          "HOST:PORT of rank 0's rendezvous store, the same for every "
+          "learner (needed with more than one)");
+ABSL_FLAG(double, replica_timeout_s,
+          absl::ToDoubleSeconds(vantage::ReplicaGroupConfig().timeout),
+          "how long a learner waits for the others (to join, or in an "
+          "update) before it fails");
 // What clients can make a learner hold; defaults from the structs that use
 // them (docs/security.md explains each).
 ABSL_FLAG(int64_t, max_live_actors, vantage::GatewayLimits().max_live_actors,
@@ -86,11 +101,28 @@ absl::Status ReadLimits(LearnerServerConfig& server) {
   return absl::OkStatus();
 }
 
+// --learner_threads, or the machine's cores over the run's learners.
+int LearnerThreads(const pb::DistributedSettings& distributed) {
+  if (distributed.learner_threads() > 0) return distributed.learner_threads();
+  const int cores =
+      std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+  return std::max(1, cores / std::max(1, distributed.learners()));
+}
+
 int RunLearner(const std::vector<std::string>&) {
   absl::StatusOr<RunRequest> request = RunRequestFromFlags();
   if (!request.ok()) return Fail(kUsageError, request.status().message());
   // A learner is the distributed run's, whatever a config file says.
   if (request->resume.empty()) request->flags.set_mode("distributed");
+  if (const int world_size = absl::GetFlag(FLAGS_world_size); world_size != 0) {
+    pb::DistributedSettings& d = *request->flags.mutable_distributed();
+    if (d.has_learners() && d.learners() != world_size) {
+      return Fail(kUsageError,
+                  absl::StrCat("--world_size=", world_size,
+                               " contradicts --learners=", d.learners()));
+    }
+    if (request->resume.empty()) d.set_learners(world_size);
+  }
   absl::StatusOr<ResolvedRun> resolved = ResolveRunRequest(*request);
   if (!resolved.ok()) return Fail(kUsageError, resolved.status().message());
   if (resolved->config.mode() != "distributed") {
@@ -109,7 +141,8 @@ int RunLearner(const std::vector<std::string>&) {
   }
   absl::StatusOr<SecurityOptions> security = SecurityFromFlags(/*server=*/true);
   if (!security.ok()) return Fail(kUsageError, security.status().message());
-  at::set_num_threads(1);
+  const int learner_threads = LearnerThreads(resolved->config.distributed());
+  at::set_num_threads(learner_threads);
   // The learner's own configuration pins the environment; no actor's
   // registration decides it.
   absl::StatusOr<std::unique_ptr<Environment>> env =
@@ -122,11 +155,24 @@ int RunLearner(const std::vector<std::string>&) {
   server.port_file = absl::GetFlag(FLAGS_port_file);
   server.security = *std::move(security);
   server.metrics_address = absl::GetFlag(FLAGS_metrics);
+  server.replicas.rank = absl::GetFlag(FLAGS_rank);
+  server.replicas.world_size = resolved->config.distributed().learners();
+  server.replicas.rendezvous = absl::GetFlag(FLAGS_rendezvous);
+  server.replicas.timeout =
+      absl::Seconds(absl::GetFlag(FLAGS_replica_timeout_s));
+  if (absl::Status status = server.replicas.Validate(); !status.ok()) {
+    return Fail(kUsageError, absl::StrCat(status.message(),
+                                          " (--rank, --learners, --rendezvous, "
+                                          "--replica_timeout_s)"));
+  }
+  // The other replicas train silently: rank 0 speaks for the run.
+  const bool primary = server.replicas.rank == 0;
   ProgressRow last;
   last.mean_return = std::nan("");
   const absl::Status status =
       RunLearnerServer(server, StopRequested(), [&](const ProgressRow& row) {
         last = row;
+        if (!primary) return;
         std::fprintf(stderr,
                      "learner: update %ld steps %ld return(last100) %.1f "
                      "%.0f steps/s\n",
@@ -135,7 +181,7 @@ int RunLearner(const std::vector<std::string>&) {
                      row.steps_per_second);
       });
   if (!status.ok()) return Fail(kRuntimeError, status.message());
-  PrintTrainResult(resolved->config, last);
+  if (primary) PrintTrainResult(resolved->config, last);
   return 0;
 }
 
@@ -156,11 +202,11 @@ Command LearnerCommand() {
       "what clients can make it hold (docs/security.md).";
   command.flags = RunFlagNames(/*with_mode=*/false);
   for (const char* name :
-       {"listen", "port_file", "metrics", "max_live_actors",
-        "max_envs_per_actor", "max_live_env_slots", "actor_expiry_s",
-        "idle_stream_timeout_s", "max_abs_observation", "max_abs_action",
-        "max_abs_reward", "max_abs_log_prob", "max_server_threads",
-        "max_grpc_memory_mb"}) {
+       {"listen", "port_file", "metrics", "rank", "world_size", "rendezvous",
+        "replica_timeout_s", "max_live_actors", "max_envs_per_actor",
+        "max_live_env_slots", "actor_expiry_s", "idle_stream_timeout_s",
+        "max_abs_observation", "max_abs_action", "max_abs_reward",
+        "max_abs_log_prob", "max_server_threads", "max_grpc_memory_mb"}) {
     command.flags.push_back(name);
   }
   for (const std::string& name : SecurityFlagNames()) {

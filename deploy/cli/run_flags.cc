@@ -44,6 +44,13 @@ ABSL_FLAG(bool, sync, true,
           "distributed: each batch only from the current policy version "
           "(actors wait for it); --nosync: asynchronous within "
           "--max_policy_lag");
+ABSL_FLAG(int, learners, 0,
+          "distributed: data-parallel learner processes, each serving an "
+          "equal share of the actors and averaging gradients with the "
+          "others");
+ABSL_FLAG(int, learner_threads, 0,
+          "distributed: LibTorch intra-op threads of each learner (0: the "
+          "machine's cores shared out over the learners)");
 ABSL_FLAG(int64_t, max_policy_lag, 0,
           "distributed, asynchronous: segments older than this many versions "
           "are dropped and counted");

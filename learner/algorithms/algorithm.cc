@@ -19,7 +19,8 @@ struct Algorithm {
   std::function<AlgorithmRunDefaults(const AlgorithmConfig&)> run_defaults;
   std::function<absl::Status(const AlgorithmConfig&)> validate;
   std::function<std::unique_ptr<PolicyUpdater>(const AlgorithmConfig&,
-                                               PolicyNetwork, ValueNetwork)>
+                                               PolicyNetwork, ValueNetwork,
+                                               std::shared_ptr<ReplicaGroup>)>
       make;
 };
 
@@ -44,9 +45,11 @@ Algorithm Entry(Config AlgorithmConfig::*member,
     return (config.*member).Validate();
   };
   algorithm.make = [=](const AlgorithmConfig& config, PolicyNetwork policy,
-                       ValueNetwork value) -> std::unique_ptr<PolicyUpdater> {
+                       ValueNetwork value,
+                       std::shared_ptr<ReplicaGroup> replicas)
+      -> std::unique_ptr<PolicyUpdater> {
     return std::make_unique<Updater>(std::move(policy), std::move(value),
-                                     config.*member);
+                                     config.*member, std::move(replicas));
   };
   return algorithm;
 }
@@ -85,11 +88,12 @@ absl::Status AlgorithmConfig::Validate() const {
 }
 
 absl::StatusOr<std::unique_ptr<PolicyUpdater>> MakePolicyUpdater(
-    const AlgorithmConfig& config, PolicyNetwork policy, ValueNetwork value) {
+    const AlgorithmConfig& config, PolicyNetwork policy, ValueNetwork value,
+    std::shared_ptr<ReplicaGroup> replicas) {
   if (absl::Status status = config.Validate(); !status.ok()) return status;
   return Algorithms()
       .at(config.name)
-      .make(config, std::move(policy), std::move(value));
+      .make(config, std::move(policy), std::move(value), std::move(replicas));
 }
 
 AlgorithmRunDefaults RunDefaultsOf(const AlgorithmConfig& config) {

@@ -12,6 +12,7 @@
 #include "learner/algorithms/ppo/ppo_config.h"
 #include "learner/algorithms/run_defaults.h"
 #include "learner/algorithms/trpo/trpo_config.h"
+#include "learner/parallel/replica_group.h"
 
 namespace vantage {
 namespace pb {
@@ -32,8 +33,11 @@ struct AlgorithmConfig {
 
 std::vector<std::string> AlgorithmNames();
 
+// `replicas`: the data-parallel learners the updater averages gradients
+// (and the global batch's statistics) over.
 absl::StatusOr<std::unique_ptr<PolicyUpdater>> MakePolicyUpdater(
-    const AlgorithmConfig& config, PolicyNetwork policy, ValueNetwork value);
+    const AlgorithmConfig& config, PolicyNetwork policy, ValueNetwork value,
+    std::shared_ptr<ReplicaGroup> replicas = SoloReplicaGroup());
 
 // What the named algorithm's defaults choose outside its own section.
 AlgorithmRunDefaults RunDefaultsOf(const AlgorithmConfig& config);

@@ -8,6 +8,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "learner/archive_io.h"
+#include "learner/parallel/replica_reductions.h"
 
 namespace vantage {
 
@@ -19,9 +20,11 @@ at::Tensor ValueLoss(ValueNetworkImpl& value, const at::Tensor& observations,
 
 double GradientStep(torch::optim::Optimizer& optimizer,
                     const std::vector<at::Tensor>& parameters,
-                    const at::Tensor& loss, double max_grad_norm) {
+                    const at::Tensor& loss, double max_grad_norm,
+                    ReplicaGroup& replicas) {
   optimizer.zero_grad();
   loss.backward();
+  AverageGradients(replicas, parameters);
   const double norm =
       torch::nn::utils::clip_grad_norm_(parameters, max_grad_norm);
   optimizer.step();

@@ -11,6 +11,7 @@
 #include "absl/status/status.h"
 #include "common/nn/networks.h"
 #include "learner/algorithms/policy_updater.h"
+#include "learner/parallel/replica_group.h"
 
 namespace torch::optim {
 class Optimizer;
@@ -26,12 +27,14 @@ namespace vantage {
 at::Tensor ValueLoss(ValueNetworkImpl& value, const at::Tensor& observations,
                      const at::Tensor& targets);
 
-// Zeroes the gradients, backpropagates `loss`, clips the global gradient
-// norm of `parameters` to `max_grad_norm` and steps. Returns the norm before
-// clipping.
+// Zeroes the gradients, backpropagates `loss`, averages the gradients over
+// `replicas`, clips the global gradient norm of `parameters` to
+// `max_grad_norm` and steps. Returns the norm before clipping (the same on
+// every replica).
 double GradientStep(torch::optim::Optimizer& optimizer,
                     const std::vector<at::Tensor>& parameters,
-                    const at::Tensor& loss, double max_grad_norm);
+                    const at::Tensor& loss, double max_grad_norm,
+                    ReplicaGroup& replicas);
 
 // Sets every parameter group's learning rate.
 void SetLearningRate(torch::optim::Optimizer& optimizer, double learning_rate);

@@ -6,13 +6,15 @@
 #include <cmath>
 
 #include "learner/archive_io.h"
+#include "learner/parallel/replica_reductions.h"
 
 namespace vantage {
 
 RewardScaler::RewardScaler(double gamma, double clip)
     : gamma_(gamma), clip_(clip), returns_(1) {}
 
-absl::Status RewardScaler::Observe(const std::vector<Rollout>& rollouts) {
+absl::Status RewardScaler::Observe(const std::vector<Rollout>& rollouts,
+                                   ReplicaGroup& replicas) {
   std::map<std::pair<int64_t, int64_t>, double> running = running_return_;
   std::vector<double> samples;
   for (const Rollout& rollout : rollouts) {
@@ -28,9 +30,9 @@ absl::Status RewardScaler::Observe(const std::vector<Rollout>& rollouts) {
       if (done[t]) value = 0.0;
     }
   }
-  if (samples.empty()) return absl::OkStatus();
   const at::Tensor batch = at::tensor(samples, at::kDouble).reshape({-1, 1});
-  if (absl::Status status = returns_.Update(batch); !status.ok()) {
+  if (absl::Status status = UpdateAcrossReplicas(replicas, returns_, batch);
+      !status.ok()) {
     return status;
   }
   running_return_ = std::move(running);

@@ -11,6 +11,7 @@
 #include "absl/status/status.h"
 #include "common/nn/running_mean_std.h"
 #include "learner/ingest/rollout_stitcher.h"
+#include "learner/parallel/replica_group.h"
 
 namespace torch::serialize {
 class InputArchive;
@@ -28,8 +29,10 @@ class RewardScaler {
   RewardScaler(double gamma, double clip);
 
   // Folds the rollouts' discounted returns into the statistics (in rollout
-  // order, continuing each (actor, slot) stream where it stopped).
-  absl::Status Observe(const std::vector<Rollout>& rollouts);
+  // order, continuing each (actor, slot) stream where it stopped), together
+  // with every other replica's: all replicas scale by the same statistics.
+  absl::Status Observe(const std::vector<Rollout>& rollouts,
+                       ReplicaGroup& replicas);
   // rewards / sqrt(var + 1e-8), clipped to [-clip, clip].
   at::Tensor Scale(const at::Tensor& rewards) const;
 

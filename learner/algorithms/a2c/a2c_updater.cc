@@ -11,10 +11,12 @@
 namespace vantage {
 
 A2cUpdater::A2cUpdater(PolicyNetwork policy, ValueNetwork value,
-                       const A2cConfig& config)
+                       const A2cConfig& config,
+                       std::shared_ptr<ReplicaGroup> replicas)
     : policy_(std::move(policy)),
       value_(std::move(value)),
       config_(config),
+      replicas_(std::move(replicas)),
       parameters_(JointParameters(*policy_, *value_)),
       optimizer_(std::make_unique<torch::optim::RMSprop>(
           parameters_, torch::optim::RMSpropOptions(config.learning_rate)
@@ -46,7 +48,7 @@ AlgorithmStats A2cUpdater::Update(const UpdateBatch& batch, double progress,
         GradientStep(*optimizer_, parameters_,
                      policy_loss + config_.value_coef * value_loss -
                          config_.entropy_coef * entropy,
-                     config_.max_grad_norm);
+                     config_.max_grad_norm, *replicas_);
     AlgorithmStats step;
     step.max_gradient_norm = gradient_norm;
     step.policy_loss = policy_loss.item<double>();

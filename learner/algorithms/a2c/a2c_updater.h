@@ -8,6 +8,7 @@
 #include "common/nn/networks.h"
 #include "learner/algorithms/a2c/a2c_config.h"
 #include "learner/algorithms/policy_updater.h"
+#include "learner/parallel/replica_group.h"
 
 namespace torch::optim {
 class RMSprop;
@@ -19,7 +20,9 @@ namespace vantage {
 // -mean(log pi(a|s) A) + value_coef * value loss - entropy_coef * entropy.
 class A2cUpdater : public PolicyUpdater {
  public:
-  A2cUpdater(PolicyNetwork policy, ValueNetwork value, const A2cConfig& config);
+  // `replicas`: the data-parallel learners whose gradients are averaged.
+  A2cUpdater(PolicyNetwork policy, ValueNetwork value, const A2cConfig& config,
+             std::shared_ptr<ReplicaGroup> replicas = SoloReplicaGroup());
   ~A2cUpdater() override;
 
   // The batch's horizon must be a multiple of steps_per_minibatch; the
@@ -33,6 +36,7 @@ class A2cUpdater : public PolicyUpdater {
   PolicyNetwork policy_;
   ValueNetwork value_;
   A2cConfig config_;
+  std::shared_ptr<ReplicaGroup> replicas_;
   std::vector<at::Tensor> parameters_;
   std::unique_ptr<torch::optim::RMSprop> optimizer_;
 };

@@ -5,18 +5,22 @@
 
 #include <algorithm>
 #include <numeric>
+#include <optional>
 #include <vector>
 
 #include "learner/algorithms/gradient_step.h"
 #include "learner/algorithms/ppo/ppo_objective.h"
+#include "learner/parallel/replica_reductions.h"
 
 namespace vantage {
 
 PpoUpdater::PpoUpdater(PolicyNetwork policy, ValueNetwork value,
-                       const PpoConfig& config)
+                       const PpoConfig& config,
+                       std::shared_ptr<ReplicaGroup> replicas)
     : policy_(std::move(policy)),
       value_(std::move(value)),
       config_(config),
+      replicas_(std::move(replicas)),
       parameters_(JointParameters(*policy_, *value_)),
       optimizer_(std::make_unique<torch::optim::Adam>(
           parameters_,
@@ -36,13 +40,21 @@ AlgorithmStats PpoUpdater::Update(const UpdateBatch& batch, double progress,
     std::iota(order.begin(), order.end(), 0);
     std::shuffle(order.begin(), order.end(), rng);
     const at::Tensor permutation = at::tensor(order, at::kLong);
+    std::vector<at::Tensor> indices;
     for (int64_t begin = 0; begin + minibatch <= size; begin += minibatch) {
-      const at::Tensor index = permutation.slice(0, begin, begin + minibatch);
+      indices.push_back(permutation.slice(0, begin, begin + minibatch));
+    }
+    // Each minibatch's advantage statistics over every replica's part of
+    // it, all of the epoch's in one collective.
+    std::optional<PartsNormalizer> normalizer;
+    if (config_.normalize_advantages) {
+      normalizer.emplace(*replicas_, batch.advantages, indices);
+    }
+    for (size_t part = 0; part < indices.size(); ++part) {
+      const at::Tensor& index = indices[part];
       const at::Tensor obs = batch.observations.index_select(0, index);
       at::Tensor adv = batch.advantages.index_select(0, index);
-      if (config_.normalize_advantages) {
-        adv = (adv - adv.mean()) / (adv.std() + 1e-8);
-      }
+      if (normalizer.has_value()) adv = normalizer->Normalize(part, adv);
       const at::Tensor output = policy_->forward(obs);
       const at::Tensor log_prob =
           policy_->LogProb(output, batch.actions.index_select(0, index));
@@ -56,7 +68,7 @@ AlgorithmStats PpoUpdater::Update(const UpdateBatch& batch, double progress,
           GradientStep(*optimizer_, parameters_,
                        policy_loss.loss + config_.value_coef * value_loss -
                            config_.entropy_coef * entropy,
-                       config_.max_grad_norm);
+                       config_.max_grad_norm, *replicas_);
       AlgorithmStats step;
       step.max_gradient_norm = gradient_norm;
       step.policy_loss = policy_loss.loss.item<double>();

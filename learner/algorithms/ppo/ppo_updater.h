@@ -8,6 +8,7 @@
 #include "common/nn/networks.h"
 #include "learner/algorithms/policy_updater.h"
 #include "learner/algorithms/ppo/ppo_config.h"
+#include "learner/parallel/replica_group.h"
 
 namespace torch::optim {
 class Adam;
@@ -20,7 +21,9 @@ namespace vantage {
 // denominator is the behaviour log-probability carried with the segment.
 class PpoUpdater : public PolicyUpdater {
  public:
-  PpoUpdater(PolicyNetwork policy, ValueNetwork value, const PpoConfig& config);
+  // `replicas`: the data-parallel learners whose gradients are averaged.
+  PpoUpdater(PolicyNetwork policy, ValueNetwork value, const PpoConfig& config,
+             std::shared_ptr<ReplicaGroup> replicas = SoloReplicaGroup());
   ~PpoUpdater() override;
 
   AlgorithmStats Update(const UpdateBatch& batch, double progress,
@@ -32,6 +35,7 @@ class PpoUpdater : public PolicyUpdater {
   PolicyNetwork policy_;
   ValueNetwork value_;
   PpoConfig config_;
+  std::shared_ptr<ReplicaGroup> replicas_;
   std::vector<at::Tensor> parameters_;
   std::unique_ptr<torch::optim::Adam> optimizer_;
 };

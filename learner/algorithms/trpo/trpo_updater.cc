@@ -12,6 +12,7 @@
 
 #include "learner/algorithms/gradient_step.h"
 #include "learner/algorithms/trpo/conjugate_gradient.h"
+#include "learner/parallel/replica_reductions.h"
 
 namespace vantage {
 namespace {
@@ -49,10 +50,12 @@ void AssignParameters(const at::Tensor& flat,
 }  // namespace
 
 TrpoUpdater::TrpoUpdater(PolicyNetwork policy, ValueNetwork value,
-                         const TrpoConfig& config)
+                         const TrpoConfig& config,
+                         std::shared_ptr<ReplicaGroup> replicas)
     : policy_(std::move(policy)),
       value_(std::move(value)),
       config_(config),
+      replicas_(std::move(replicas)),
       policy_parameters_(policy_->parameters()),
       value_parameters_(value_->parameters()),
       value_optimizer_(std::make_unique<torch::optim::Adam>(
@@ -65,7 +68,7 @@ AlgorithmStats TrpoUpdater::Update(const UpdateBatch& batch,
                                    double /*progress*/, std::mt19937_64& rng) {
   at::Tensor advantages = batch.advantages;
   if (config_.normalize_advantages) {
-    advantages = (advantages - advantages.mean()) / (advantages.std() + 1e-8);
+    advantages = NormalizeAcrossReplicas(*replicas_, advantages);
   }
   AlgorithmStats stats;
   stats.clip_fraction = std::numeric_limits<double>::quiet_NaN();
@@ -109,11 +112,20 @@ double TrpoUpdater::PolicyStep(const UpdateBatch& batch,
         .mean();
   };
 
+  // Every replica's batch is the same size, so means over the global batch
+  // are means of the replicas' means.
+  ReplicaGroup& replicas = *replicas_;
+  auto global_means = [&](std::vector<double> local) {
+    std::vector<double> sums = SumAcrossReplicas(replicas, std::move(local));
+    for (double& sum : sums) sum /= replicas.world_size();
+    return sums;
+  };
   const at::Tensor objective = surrogate();
-  const double objective_before = objective.item<double>();
+  const double objective_before = global_means({objective.item<double>()})[0];
   surrogate_after = objective_before;
-  const at::Tensor gradient =
-      FlatGradient(objective, policy_parameters_, /*create_graph=*/false);
+  const at::Tensor gradient = AverageAcrossReplicas(
+      replicas,
+      FlatGradient(objective, policy_parameters_, /*create_graph=*/false));
   auto fisher_product = [&](const at::Tensor& v) {
     const at::Tensor kl = mean_kl();
     const at::Tensor kl_gradient =
@@ -121,7 +133,8 @@ double TrpoUpdater::PolicyStep(const UpdateBatch& batch,
     const at::Tensor product =
         FlatGradient((kl_gradient * v.detach()).sum(), policy_parameters_,
                      /*create_graph=*/false);
-    return product.detach() + config_.cg_damping * v;
+    return AverageAcrossReplicas(replicas, product.detach()) +
+           config_.cg_damping * v;
   };
   const at::Tensor direction = ConjugateGradient(
       fisher_product, gradient.detach(), config_.cg_iterations);
@@ -139,8 +152,10 @@ double TrpoUpdater::PolicyStep(const UpdateBatch& batch,
   double fraction = 1.0;
   for (int i = 0; i < config_.line_search_steps; ++i, fraction *= 0.5) {
     AssignParameters(start + fraction * full_step, policy_parameters_);
-    const double value = surrogate().item<double>();
-    const double kl = mean_kl().item<double>();
+    const std::vector<double> means =
+        global_means({surrogate().item<double>(), mean_kl().item<double>()});
+    const double value = means[0];
+    const double kl = means[1];
     if (std::isfinite(value) && std::isfinite(kl) && kl <= config_.max_kl &&
         value > objective_before) {
       surrogate_after = value;
@@ -153,8 +168,11 @@ double TrpoUpdater::PolicyStep(const UpdateBatch& batch,
 
 double TrpoUpdater::FitValue(const UpdateBatch& batch, std::mt19937_64& rng) {
   const int64_t size = batch.observations.size(0);
+  // The global minibatch is value_minibatch_size samples, shared out.
   const int64_t minibatch =
-      std::min<int64_t>(config_.value_minibatch_size, size);
+      std::min<int64_t>(std::max<int64_t>(1, config_.value_minibatch_size /
+                                                 replicas_->world_size()),
+                        size);
   std::vector<int64_t> order(size);
   double total = 0.0;
   int64_t count = 0;
@@ -169,6 +187,7 @@ double TrpoUpdater::FitValue(const UpdateBatch& batch, std::mt19937_64& rng) {
                     batch.returns.index_select(0, index));
       value_optimizer_->zero_grad();
       loss.backward();
+      AverageGradients(*replicas_, value_parameters_);
       value_optimizer_->step();
       total += loss.item<double>();
       ++count;

@@ -8,6 +8,7 @@
 #include "common/nn/networks.h"
 #include "learner/algorithms/policy_updater.h"
 #include "learner/algorithms/trpo/trpo_config.h"
+#include "learner/parallel/replica_group.h"
 
 namespace torch::optim {
 class Adam;
@@ -22,8 +23,10 @@ namespace vantage {
 // of the surrogate; if none qualifies the policy stays as it was.
 class TrpoUpdater : public PolicyUpdater {
  public:
+  // `replicas`: the data-parallel learners whose gradients are averaged.
   TrpoUpdater(PolicyNetwork policy, ValueNetwork value,
-              const TrpoConfig& config);
+              const TrpoConfig& config,
+              std::shared_ptr<ReplicaGroup> replicas = SoloReplicaGroup());
   ~TrpoUpdater() override;
 
   AlgorithmStats Update(const UpdateBatch& batch, double progress,
@@ -40,6 +43,7 @@ class TrpoUpdater : public PolicyUpdater {
   PolicyNetwork policy_;
   ValueNetwork value_;
   TrpoConfig config_;
+  std::shared_ptr<ReplicaGroup> replicas_;
   std::vector<at::Tensor> policy_parameters_;
   std::vector<at::Tensor> value_parameters_;
   std::unique_ptr<torch::optim::Adam> value_optimizer_;

@@ -100,5 +100,55 @@ TEST(BenchCommandsTest, ResultLinesCarryNoColourCodes) {
   EXPECT_THAT(outcome.out, Not(HasSubstr("\033[")));
 }
 
+// The distributed main job against the machine's limit, with two learners:
+// the limit is computed as documented from the figures it prints.
+TEST(BenchCommandsTest, TrainTimesTheMainJobAgainstTheMachinesLimit) {
+  const Outcome outcome = RunVantage(
+      "bench train --env=InvertedPendulum --steps=10240 --horizon=512 "
+      "--learners=2");
+  ASSERT_EQ(outcome.exit_code, 0) << outcome.err;
+  const auto fields = ResultFields(outcome.out, "RESULT train ");
+  EXPECT_EQ(fields.at("env"), "InvertedPendulum");
+  EXPECT_EQ(fields.at("learners"), "2");
+  EXPECT_EQ(fields.at("actors"), "2");
+  const double raw = Number(fields, "raw_steps_per_s");
+  const double bare = Number(fields, "bare_samples_per_s");
+  const double cores = Number(fields, "cores");
+  ASSERT_GT(raw, 0);
+  ASSERT_GT(bare, 0);
+  ASSERT_GE(cores, 1);
+  const double limit = Number(fields, "limit_sps");
+  EXPECT_NEAR(limit, cores / (1 / raw + 10 / bare), 0.01 * limit + 1);
+  EXPECT_GT(Number(fields, "sps"), 0);
+  EXPECT_NEAR(Number(fields, "ratio"), Number(fields, "sps") / limit, 0.002);
+  // Only the benchmark's RESULT line: the run's own went to its log.
+  EXPECT_THAT(outcome.out, Not(HasSubstr("mean_return=")));
+}
+
+TEST(BenchCommandsTest, TrainRefusesWhatItCannotTime) {
+  const Outcome resume = RunVantage("bench train --run_dir=/tmp/x");
+  EXPECT_EQ(resume.exit_code, 2);
+  EXPECT_THAT(resume.err, HasSubstr("not for a benchmark"));
+  const Outcome trpo = RunVantage("bench train --algo=trpo");
+  EXPECT_EQ(trpo.exit_code, 2);
+  EXPECT_THAT(trpo.err, HasSubstr("--algo=ppo"));
+}
+
+// A real learner process with connected actors against its idle self: each
+// open stream holds a server thread, so the threads grow with the actors.
+TEST(BenchCommandsTest, ConnectionsMeasureALearnerPerConnectedActor) {
+  const Outcome outcome = RunVantage("bench connections --bench_clients=8");
+  ASSERT_EQ(outcome.exit_code, 0) << outcome.err;
+  const auto fields = ResultFields(outcome.out, "RESULT connections ");
+  EXPECT_EQ(fields.at("actors"), "8");
+  EXPECT_GT(Number(fields, "idle_rss_mb"), 0);
+  EXPECT_GT(Number(fields, "rss_mb"), 0);
+  EXPECT_GE(Number(fields, "threads"), Number(fields, "idle_threads") + 8);
+  EXPECT_NEAR(
+      Number(fields, "per_actor_kb"),
+      (Number(fields, "rss_mb") - Number(fields, "idle_rss_mb")) * 1024 / 8,
+      0.1 * 1024 / 8);  // the MB figures are printed to 0.1
+}
+
 }  // namespace
 }  // namespace vantage
