@@ -63,18 +63,33 @@ std::vector<std::string> SecurityArgs(const LaunchConfig& config) {
   return args;
 }
 
-// Waits for the learner `pid` to write its port to `port_file`; empty if
-// it ended first (`status` says how) or `stop` was set.
-std::string WaitForPort(pid_t pid, const std::string& port_file,
-                        const std::atomic<bool>& stop, int& status) {
-  while (!stop) {
-    if (waitpid(pid, &status, WNOHANG) == pid) return "";
-    std::ifstream file(port_file);
-    std::string line;
-    if (std::getline(file, line) && !line.empty()) return line;
+// Waits for every learner (`pids`, by rank) to write its port to its
+// `port_files` entry, into `ports`. Returns -1 once all have (or when
+// `stop` is set), else the rank of the first that ended before (`status`
+// says how): replicas wait for each other before serving, so one that
+// ends must not leave the launcher waiting for the others' timeout.
+int WaitForPorts(const std::vector<pid_t>& pids,
+                 const std::vector<std::string>& port_files,
+                 const std::atomic<bool>& stop, std::vector<std::string>& ports,
+                 int& status) {
+  std::vector<bool> serving(pids.size(), false);
+  size_t waiting = pids.size();
+  while (!stop && waiting > 0) {
+    for (size_t rank = 0; rank < pids.size(); ++rank) {
+      if (serving[rank]) continue;
+      std::ifstream file(port_files[rank]);
+      std::string line;
+      if (std::getline(file, line) && !line.empty()) {
+        ports[rank] = line;
+        serving[rank] = true;
+        --waiting;
+      } else if (waitpid(pids[rank], &status, WNOHANG) == pids[rank]) {
+        return static_cast<int>(rank);
+      }
+    }
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
-  return "";
+  return -1;
 }
 
 // A learner that died (not one that refused its flags, exit code 2) can be
@@ -143,21 +158,18 @@ absl::Status RunDistributedTraining(const LaunchConfig& config,
       if (!pid.ok()) return pid.status();
       learners[rank] = *pid;
     }
+    std::vector<std::string> port_files;
     for (int rank = 0; rank < learner_count; ++rank) {
-      int status = 0;
-      const std::string port =
-          WaitForPort(learners[rank], port_file(rank), stop, status);
-      if (port.empty()) {
-        if (stop) return absl::OkStatus();
-        learners[rank] = -1;
-        return absl::InternalError(
-            absl::StrCat(learner_count > 1 ? absl::StrCat("learner ", rank)
-                                           : std::string("the learner"),
-                         " ended before serving (", Describe(status), ")"));
-      }
-      ports[rank] = port;
+      port_files.push_back(port_file(rank));
     }
-    return absl::OkStatus();
+    int status = 0;
+    const int ended = WaitForPorts(learners, port_files, stop, ports, status);
+    if (ended < 0) return absl::OkStatus();
+    learners[ended] = -1;
+    return absl::InternalError(
+        absl::StrCat(learner_count > 1 ? absl::StrCat("learner ", ended)
+                                       : std::string("the learner"),
+                     " ended before serving (", Describe(status), ")"));
   };
   std::vector<pid_t> actors(run.distributed().actors(), -1);
   auto everyone = [&] {
