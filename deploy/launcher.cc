@@ -16,10 +16,14 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_join.h"
 #include "absl/strings/strip.h"
+#include "common/metrics/metrics_endpoint.h"
 #include "common/net/loopback_port.h"
+#include "common/net/port_file.h"
 #include "common/util/self_process.h"
 #include "deploy/run_config.h"
 #include "deploy/run_directory.h"
+#include "deploy/scrape_targets.h"
+#include "learner/algorithms/algorithm.h"
 #include "learner/checkpoint.h"
 
 namespace vantage {
@@ -101,6 +105,114 @@ bool CanResume(const LaunchConfig& config, int status) {
   return run.ok() && !ListCheckpoints(run->checkpoint_directory()).empty();
 }
 
+// Where each process of a run serves its metrics, and the scrape targets
+// file that tells Prometheus.
+class MetricsPlan {
+ public:
+  MetricsPlan(const LaunchConfig& config, int learners, int actors)
+      : enabled_(!config.metrics_address.empty()), learners_(learners) {
+    if (!enabled_) return;
+    const std::string address = ResolveMetricsAddress(config.metrics_address);
+    const size_t colon = address.rfind(':');
+    host_ = address.substr(0, colon);
+    if (colon == std::string::npos ||
+        !absl::SimpleAtoi(address.substr(colon + 1), &base_port_)) {
+      base_port_ = 0;
+    }
+    targets_path_ =
+        absl::StrCat(config.run_dir.empty() ? config.work_dir : config.run_dir,
+                     "/", kScrapeTargetsFile);
+    const pb::RunConfig& run = config.run_config;
+    common_labels_ = {{"run", config.run_dir.empty()
+                                  ? std::string("")
+                                  : std::filesystem::absolute(config.run_dir)
+                                        .lexically_normal()
+                                        .string()},
+                      {"env", run.training().env()},
+                      {"algo", AlgorithmNameOf(run)},
+                      {"estimator", run.advantage().estimator()}};
+    for (int rank = 0; rank < learners; ++rank) {
+      processes_.push_back(
+          {absl::StrCat(config.work_dir, "/learner-", rank, ".metrics.port"),
+           {{"role", "learner"}, {"rank", absl::StrCat(rank)}}});
+    }
+    for (int i = 0; i < actors; ++i) {
+      processes_.push_back(
+          {absl::StrCat(config.work_dir, "/actor-", i, ".metrics.port"),
+           {{"role", "actor"}, {"actor", absl::StrCat(i)}}});
+    }
+  }
+
+  // The flags that make learner `rank` (or actor `index`) serve metrics;
+  // its old port file goes first, so a restart is seen when it serves.
+  std::vector<std::string> LearnerArgs(int rank) { return Args(rank); }
+  std::vector<std::string> ActorArgs(int index) {
+    return Args(learners_ + index);
+  }
+
+  // Rewrites the targets file if a process serves on a port it does not
+  // list yet (called often: it only reads small files).
+  void Refresh() {
+    if (!enabled_) return;
+    std::vector<ScrapeTarget> targets;
+    bool changed = false;
+    for (Process& process : processes_) {
+      const std::optional<int> port = ReadPortFile(process.port_file);
+      if (port.has_value() && *port != process.port) {
+        process.port = *port;
+        changed = true;
+      }
+      if (process.port <= 0) continue;
+      ScrapeTarget target{ScrapeAddress(host_, process.port), common_labels_};
+      target.labels.insert(process.labels.begin(), process.labels.end());
+      targets.push_back(std::move(target));
+    }
+    if (changed) Write(targets);
+  }
+
+  // Nothing to scrape any more: the run ended or was stopped.
+  void Clear() {
+    if (enabled_) Write({});
+  }
+
+ private:
+  struct Process {
+    std::string port_file;
+    std::map<std::string, std::string> labels;
+    int port = 0;  // listed in the targets file (0: not yet)
+  };
+
+  std::vector<std::string> Args(int index) {
+    if (!enabled_) return {};
+    std::error_code error;
+    std::filesystem::remove(processes_[index].port_file, error);
+    const int port = base_port_ == 0 ? 0 : base_port_ + index;
+    return {absl::StrCat("--metrics=", host_, ":", port),
+            "--metrics_port_file=" + processes_[index].port_file};
+  }
+
+  void Write(const std::vector<ScrapeTarget>& targets) {
+    if (absl::Status status = WriteScrapeTargets(targets_path_, targets);
+        !status.ok()) {
+      std::fprintf(stderr, "launcher: %s\n",
+                   std::string(status.message()).c_str());
+    } else if (!announced_) {
+      announced_ = true;
+      std::fprintf(stderr, "launcher: Prometheus scrape targets in %s\n",
+                   targets_path_.c_str());
+    }
+  }
+
+  const bool enabled_;
+  const int learners_;
+  std::string host_;
+  int base_port_ = 0;
+  std::string targets_path_;
+  std::map<std::string, std::string> common_labels_;
+  std::vector<Process> processes_;
+  bool announced_ = false;
+};
+
 }  // namespace
 
 absl::Status RunDistributedTraining(const LaunchConfig& config,
@@ -123,6 +235,7 @@ absl::Status RunDistributedTraining(const LaunchConfig& config,
                : absl::StrCat(config.work_dir, "/learner-", rank, ".port");
   };
   const std::vector<std::string> security_args = SecurityArgs(config);
+  MetricsPlan metrics(config, learner_count, run.distributed().actors());
   // Learner ranks' gRPC ports ("0" until first bound: the actors keep
   // them across restarts) and processes.
   std::vector<std::string> ports(learner_count, "0");
@@ -154,6 +267,8 @@ absl::Status RunDistributedTraining(const LaunchConfig& config,
           args.push_back("--run_dir=" + config.run_dir);
       }
       args.insert(args.end(), security_args.begin(), security_args.end());
+      const std::vector<std::string> metrics_args = metrics.LearnerArgs(rank);
+      args.insert(args.end(), metrics_args.begin(), metrics_args.end());
       absl::StatusOr<pid_t> pid = SpawnSelf(args);
       if (!pid.ok()) return pid.status();
       learners[rank] = *pid;
@@ -202,6 +317,8 @@ absl::Status RunDistributedTraining(const LaunchConfig& config,
         absl::StrCat("--seed=", run.training().seed() + i),
         absl::StrCat("--name=actor-", i)};
     args.insert(args.end(), security_args.begin(), security_args.end());
+    const std::vector<std::string> metrics_args = metrics.ActorArgs(i);
+    args.insert(args.end(), metrics_args.begin(), metrics_args.end());
     return SpawnSelf(args);
   };
   for (int i = 0; i < run.distributed().actors(); ++i) {
@@ -218,11 +335,18 @@ absl::Status RunDistributedTraining(const LaunchConfig& config,
   // Ranks whose learner finished the run (exit code 0).
   std::vector<bool> finished(learner_count, false);
   absl::Status result;
+  auto last_refresh = std::chrono::steady_clock::now();
   while (true) {
     if (stop) {
       // Everyone gets the signal; rank 0 writes the last checkpoint.
       Terminate(everyone(), std::chrono::seconds(30));
+      metrics.Clear();
       return absl::OkStatus();
+    }
+    if (std::chrono::steady_clock::now() - last_refresh >
+        std::chrono::milliseconds(250)) {
+      metrics.Refresh();
+      last_refresh = std::chrono::steady_clock::now();
     }
     int status = 0;
     const pid_t done = waitpid(-1, &status, WNOHANG);
@@ -283,6 +407,7 @@ absl::Status RunDistributedTraining(const LaunchConfig& config,
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
   Terminate(everyone(), std::chrono::seconds(30));
+  if (result.ok()) metrics.Clear();
   return result;
 }
 

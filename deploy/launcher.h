@@ -31,6 +31,14 @@ struct LaunchConfig {
   std::string tls_cert;
   std::string tls_key;
   std::string tls_ca;
+  // If set ("HOST:PORT" or "PORT"), every process serves Prometheus
+  // metrics on HOST: learner rank r on PORT + r, actor i on PORT + K + i
+  // (PORT 0: each a free one), and the run's scrape targets are kept in
+  // <run_dir or work_dir>/prometheus_targets.json (scrape_targets.h),
+  // rewritten when a restarted process serves elsewhere and emptied when
+  // the run ends or is stopped (a failed run keeps them, so that
+  // Prometheus sees it down).
+  std::string metrics_address;
 };
 
 // Starts `vantage learner` on 127.0.0.1 with a free port (with

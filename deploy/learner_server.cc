@@ -10,6 +10,8 @@
 
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
+#include "common/net/port_file.h"
+#include "deploy/progress_columns.h"
 #include "deploy/training_run.h"
 #include "learner/service/actor_gateway.h"
 #include "learner/service/learner_metrics.h"
@@ -18,21 +20,6 @@
 
 namespace vantage {
 namespace {
-
-absl::Status WritePortFile(const std::string& path, int port) {
-  const std::string temporary = path + ".tmp";
-  {
-    std::ofstream file(temporary, std::ios::trunc);
-    file << port << "\n";
-    if (!file.flush()) {
-      return absl::InternalError(absl::StrCat("cannot write ", temporary));
-    }
-  }
-  if (std::rename(temporary.c_str(), path.c_str()) != 0) {
-    return absl::InternalError(absl::StrCat("cannot write ", path));
-  }
-  return absl::OkStatus();
-}
 
 constexpr char kEnvSpec[] = "env_spec";
 constexpr char kNextActorId[] = "next_actor_id";
@@ -194,7 +181,16 @@ absl::Status RunLearnerServer(
       return started.status();
     }
     metrics = *std::move(started);
+    metrics->SetMaxPolicyLag(config.run_config.distributed().max_policy_lag());
     std::fprintf(stderr, "learner: metrics on port %d\n", metrics->port());
+    if (!config.metrics_port_file.empty()) {
+      if (absl::Status status =
+              WritePortFile(config.metrics_port_file, metrics->port());
+          !status.ok()) {
+        server->server->Shutdown();
+        return status;
+      }
+    }
   }
   std::atomic<int64_t> buffered_steps{0};
   auto record_gateway = [&] {
@@ -206,6 +202,13 @@ absl::Status RunLearnerServer(
                            counters.registrations, counters.expirations});
     metrics->SetQueueDepth(static_cast<int64_t>(queue.size()),
                            buffered_steps.load());
+    std::vector<LearnerMetrics::ActorActivity> actors;
+    for (const ActorActivity& actor : gateway.activity()) {
+      actors.push_back(
+          {actor.actor_id, actor.accepted_steps,
+           absl::ToDoubleSeconds(actor.last_seen - absl::UnixEpoch())});
+    }
+    metrics->RecordActorActivity(actors);
   };
   // Registrations that expired, for the update loop to free (the stitcher
   // belongs to that thread).
@@ -253,7 +256,12 @@ absl::Status RunLearnerServer(
       }
     }
     if (!row.ok()) return finish(row.status());
+    const auto publish_start = std::chrono::steady_clock::now();
     gateway.Publish(learner.CurrentWeights());
+    const double publish_seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() -
+                                      publish_start)
+            .count();
     {
       std::lock_guard<std::mutex> lock(expired_mutex);
       for (int64_t actor_id : expired) learner.ForgetActor(actor_id);
@@ -262,6 +270,14 @@ absl::Status RunLearnerServer(
     buffered_steps = learner.buffered_steps();
     if (metrics != nullptr) {
       const UpdateStats& stats = row->stats;
+      // The statistics first: a scrape that sees this update's version
+      // finds its statistics' series.
+      std::vector<LearnerMetrics::Statistic> statistics;
+      for (const ProgressColumn& column : ProgressColumns()) {
+        statistics.push_back({column.metric, column.help, column.value(*row),
+                              column.kind == ProgressColumn::Metric::kCounter});
+      }
+      metrics->RecordStatistics(statistics);
       for (int64_t lag : stats.rollout_policy_lags) {
         metrics->RecordPolicyLag(lag);
       }
@@ -269,6 +285,8 @@ absl::Status RunLearnerServer(
                             stats.episodes, stats.update_seconds,
                             row->mean_return, row->steps_per_second);
       metrics->RecordRolledBackUpdates(stats.rolled_back_updates);
+      metrics->AddUpdatePhases(stats.advantage_seconds,
+                               stats.optimisation_seconds, publish_seconds);
       record_gateway();
     }
     on_update(*row);

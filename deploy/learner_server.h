@@ -35,6 +35,8 @@ struct LearnerServerConfig {
   SecurityOptions security;  // TLS and the token every actor must send
   // Prometheus endpoint HOST:PORT (port 0: a free one); empty: none.
   std::string metrics_address;
+  // If set, the metrics port goes there once serving (see port_file.h).
+  std::string metrics_port_file;
   // This learner's place among the run's data-parallel learners (the
   // run config's distributed.learners); each trains on its own actors'
   // share of the batch. Only rank 0 writes the run directory.

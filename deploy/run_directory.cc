@@ -16,10 +16,6 @@
 namespace vantage {
 namespace {
 
-std::string Number(double value) {
-  return std::isnan(value) ? "" : absl::StrFormat("%.9g", value);
-}
-
 absl::Status WriteFileAtomically(const std::string& path,
                                  const std::string& text) {
   const std::string temporary = path + ".tmp";
@@ -39,22 +35,6 @@ absl::Status WriteFileAtomically(const std::string& path,
 }
 
 }  // namespace
-
-std::string FormatProgressRow(const ProgressRow& row) {
-  const UpdateStats& s = row.stats;
-  return absl::StrJoin(
-      {absl::StrCat(s.env_steps), absl::StrCat(s.policy_version),
-       absl::StrCat(s.policy_version), absl::StrCat(s.episodes),
-       Number(row.mean_return), Number(s.algorithm.policy_loss),
-       Number(s.algorithm.value_loss), Number(s.algorithm.entropy),
-       Number(s.algorithm.approx_kl), Number(s.algorithm.clip_fraction),
-       Number(s.explained_variance), Number(s.biased_fraction),
-       Number(s.mean_abs_bias), absl::StrCat(s.rejected_segments),
-       absl::StrCat(s.rolled_back_updates),
-       absl::StrFormat("%.3f", row.elapsed_seconds),
-       absl::StrFormat("%.1f", row.steps_per_second)},
-      ",");
-}
 
 absl::Status RunDirectory::CheckFree(const std::string& path) {
   if (std::filesystem::exists(RunDirectory(path).config_path())) {
@@ -76,7 +56,7 @@ absl::StatusOr<RunDirectory> RunDirectory::Create(
         "cannot create run directory ", path, ": ", error.message()));
   }
   if (absl::Status status = WriteFileAtomically(
-          run.progress_path(), absl::StrCat(kProgressColumns, "\n"));
+          run.progress_path(), absl::StrCat(ProgressHeader(), "\n"));
       !status.ok()) {
     return status;
   }
@@ -106,7 +86,7 @@ std::string RunDirectory::checkpoint_directory() const {
 
 absl::Status RunDirectory::TruncateProgress(int64_t updates) const {
   std::ifstream file(progress_path());
-  std::string text = absl::StrCat(kProgressColumns, "\n");
+  std::string text = absl::StrCat(ProgressHeader(), "\n");
   std::string line;
   bool header = true;
   while (std::getline(file, line)) {

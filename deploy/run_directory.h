@@ -4,7 +4,7 @@
 // A training run's directory:
 //   config.json     the resolved run config (`vantage train --config` and
 //                   --resume read it back)
-//   progress.csv    one row per update (columns: kProgressColumns)
+//   progress.csv    one row per update (columns: ProgressColumns())
 //   checkpoints/    checkpoint-<version>.pt, the newest few kept
 
 #include <cstdint>
@@ -12,27 +12,9 @@
 
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
-#include "learner/learner_core.h"
+#include "deploy/progress_columns.h"
 
 namespace vantage {
-
-// Every column but the last two (wall-clock) repeats exactly for the same
-// seed and flags.
-inline constexpr char kProgressColumns[] =
-    "env_steps,updates,policy_version,episodes,mean_return,policy_loss,"
-    "value_loss,entropy,approx_kl,clip_fraction,explained_variance,"
-    "biased_fraction,mean_abs_bias,rejected_segments,rolled_back_updates,"
-    "elapsed_s,sps";
-
-struct ProgressRow {
-  UpdateStats stats;
-  double mean_return = 0.0;       // last 100 episodes; NaN: none finished yet
-  double elapsed_seconds = 0.0;   // of the whole run, across resumes
-  double steps_per_second = 0.0;  // since this process started
-};
-
-// The CSV line (no newline); NaN values are empty fields.
-std::string FormatProgressRow(const ProgressRow& row);
 
 class RunDirectory {
  public:

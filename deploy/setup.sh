@@ -23,6 +23,8 @@ done
 # alternatives) over from the reference BLAS that LibTorch's GEMMs would
 # otherwise run on; serial, because every vantage process computes on one
 # thread of its own and several share the machine (docs/benchmarks.md).
+# prometheus (with promtool) serves deploy/prometheus/ and its test;
+# python3-matplotlib draws `vantage plot`'s figures.
 packages=(
   build-essential cmake ninja-build pkgconf clang-format openssl
   libtorch-dev libgloo-dev libopenblas0-serial
@@ -33,6 +35,7 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   prometheus-cpp-dev
   libminizip-dev
+  prometheus python3-matplotlib
 )
 
 "${repo_root}/deploy/install_packages.sh" setup.sh "${packages[@]}"

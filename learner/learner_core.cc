@@ -262,7 +262,15 @@ absl::StatusOr<UpdateStats> LearnerCore::Update(std::vector<Rollout> rollouts) {
     const double progress =
         static_cast<double>(env_steps_) / config_.total_env_steps;
     UpdateStats stats;
+    const auto optimisation_start = std::chrono::steady_clock::now();
+    stats.advantage_seconds =
+        std::chrono::duration<double>(optimisation_start - update_start)
+            .count();
     stats.algorithm = updater_->Update(update, progress, rng_);
+    stats.optimisation_seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() -
+                                      optimisation_start)
+            .count();
 
     // Everything the statistics need, summed over the replicas in one
     // collective (every replica holds `samples` samples).

@@ -86,6 +86,10 @@ struct UpdateStats {
   // Wall-clock seconds of this update once its batch was complete (not
   // reproducible, so not in progress.csv).
   double update_seconds = 0.0;
+  // Of which: the critic's values and the advantages (batch assembly
+  // included), and the algorithm's optimisation.
+  double advantage_seconds = 0.0;
+  double optimisation_seconds = 0.0;
   // Per rollout of this batch: how many versions behind the updated policy
   // its oldest step was acted (0 throughout in sync mode).
   std::vector<int64_t> rollout_policy_lags;

@@ -13,6 +13,7 @@
 #include "actor/envs/env_registry.h"
 #include "actor/remote/actor_metrics.h"
 #include "common/net/grpc_security.h"
+#include "common/net/port_file.h"
 #include "proto/vantage.grpc.pb.h"
 #include "proto/wire_format.h"
 
@@ -247,6 +248,13 @@ absl::Status RunRemoteActor(const RemoteActorConfig& config,
     metrics = *std::move(started);
     std::fprintf(stderr, "%s: metrics on port %d\n", config.name.c_str(),
                  metrics->port());
+    if (!config.metrics_port_file.empty()) {
+      if (absl::Status status =
+              WritePortFile(config.metrics_port_file, metrics->port());
+          !status.ok()) {
+        return status;
+      }
+    }
   }
   std::unique_ptr<ActorCore> actor;  // kept across reconnects
   int failures = 0;

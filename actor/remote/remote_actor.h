@@ -28,6 +28,8 @@ struct RemoteActorConfig {
   SecurityOptions security;  // TLS and the auth token sent on every call
   // Prometheus endpoint HOST:PORT (port 0: a free one); empty: none.
   std::string metrics_address;
+  // If set, the metrics port goes there once serving (see port_file.h).
+  std::string metrics_port_file;
 };
 
 // Registers, acts with the newest weights (picked up between segments; in

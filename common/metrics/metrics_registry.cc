@@ -29,11 +29,15 @@ prometheus::Family<prometheus::Counter>& MetricsRegistry::AddCounterFamily(
 
 prometheus::Gauge& MetricsRegistry::AddGauge(const std::string& name,
                                              const std::string& help) {
+  return AddGaugeFamily(name, help).Add({});
+}
+
+prometheus::Family<prometheus::Gauge>& MetricsRegistry::AddGaugeFamily(
+    const std::string& name, const std::string& help) {
   return prometheus::BuildGauge()
       .Name(prefix_ + name)
       .Help(help)
-      .Register(*registry_)
-      .Add({});
+      .Register(*registry_);
 }
 
 prometheus::Histogram& MetricsRegistry::AddHistogram(

@@ -43,6 +43,8 @@ class MetricsRegistry {
   // A family whose series the caller adds by label.
   prometheus::Family<prometheus::Counter>& AddCounterFamily(
       const std::string& name, const std::string& help);
+  prometheus::Family<prometheus::Gauge>& AddGaugeFamily(
+      const std::string& name, const std::string& help);
 
   // Starts serving (see StartMetricsEndpoint); `who` names the process in
   // errors.

@@ -35,6 +35,7 @@ int RunActor(const std::vector<std::string>&) {
   config.name = absl::GetFlag(FLAGS_name);
   config.max_reconnects = absl::GetFlag(FLAGS_max_reconnects);
   config.metrics_address = absl::GetFlag(FLAGS_metrics);
+  config.metrics_port_file = absl::GetFlag(FLAGS_metrics_port_file);
   if (config.num_envs < 1 || config.learner.empty()) {
     return Fail(kUsageError,
                 "--learner=HOST:PORT and --envs >= 1 are required");
@@ -63,8 +64,9 @@ Command ActorCommand() {
       "backoff when the learner goes away (its environments kept). Ends at\n"
       "SIGINT/SIGTERM (exit 0) or when the learner refuses it or the\n"
       "reconnects run out (exit 1).";
-  command.flags = {"learner", "env",     "envs",          "seed",
-                   "name",    "metrics", "max_reconnects"};
+  command.flags = {
+      "learner",           "env",           "envs", "seed", "name", "metrics",
+      "metrics_port_file", "max_reconnects"};
   for (const std::string& name : SecurityFlagNames()) {
     command.flags.push_back(name);
   }

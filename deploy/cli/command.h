@@ -38,6 +38,9 @@ struct Command {
   // Whether it takes positional arguments after its name (`vantage bench
   // NAME`); if not, any is a usage error before it runs.
   bool takes_arguments = false;
+  // The whole `vantage help NAME` text, for a command whose flags another
+  // program owns (`vantage plot`); empty: made from the fields above.
+  std::function<std::string()> help;
   // Runs with the positional arguments after the command's name.
   std::function<int(const std::vector<std::string>& args)> run;
 };

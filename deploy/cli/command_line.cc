@@ -159,6 +159,7 @@ bool FlagGiven(absl::string_view name) {
 }
 
 std::string CommandHelp(const Command& command) {
+  if (command.help) return command.help();
   std::string text = absl::StrCat("usage: ", command.usage, "\n\n");
   for (absl::string_view line : absl::StrSplit(command.description, '\n')) {
     absl::StrAppend(&text, "  ", line, "\n");

@@ -6,6 +6,7 @@
 #include "deploy/cli/advantages_command.h"
 #include "deploy/cli/env_commands.h"
 #include "deploy/cli/learner_command.h"
+#include "deploy/cli/plot_command.h"
 #include "deploy/cli/train_command.h"
 #ifdef VANTAGE_WITH_BENCHMARKS
 #include "deploy/cli/bench_command.h"
@@ -16,8 +17,8 @@ namespace vantage {
 const std::vector<Command>& AllCommands() {
   static const auto* commands = [] {
     auto* all = new std::vector<Command>{
-        ActorCommand(),   AdvantagesCommand(), EnvsCommand(),
-        LearnerCommand(), RolloutCommand(),    TrainCommand(),
+        ActorCommand(), AdvantagesCommand(), EnvsCommand(),  LearnerCommand(),
+        PlotCommand(),  RolloutCommand(),    TrainCommand(),
     };
 #ifdef VANTAGE_WITH_BENCHMARKS
     all->push_back(BenchCommand());

@@ -155,6 +155,7 @@ int RunLearner(const std::vector<std::string>&) {
   server.port_file = absl::GetFlag(FLAGS_port_file);
   server.security = *std::move(security);
   server.metrics_address = absl::GetFlag(FLAGS_metrics);
+  server.metrics_port_file = absl::GetFlag(FLAGS_metrics_port_file);
   server.replicas.rank = absl::GetFlag(FLAGS_rank);
   server.replicas.world_size = resolved->config.distributed().learners();
   server.replicas.rendezvous = absl::GetFlag(FLAGS_rendezvous);
@@ -202,11 +203,12 @@ Command LearnerCommand() {
       "what clients can make it hold (docs/security.md).";
   command.flags = RunFlagNames(/*with_mode=*/false);
   for (const char* name :
-       {"listen", "port_file", "metrics", "rank", "world_size", "rendezvous",
-        "replica_timeout_s", "max_live_actors", "max_envs_per_actor",
-        "max_live_env_slots", "actor_expiry_s", "idle_stream_timeout_s",
-        "max_abs_observation", "max_abs_action", "max_abs_reward",
-        "max_abs_log_prob", "max_server_threads", "max_grpc_memory_mb"}) {
+       {"listen", "port_file", "metrics", "metrics_port_file", "rank",
+        "world_size", "rendezvous", "replica_timeout_s", "max_live_actors",
+        "max_envs_per_actor", "max_live_env_slots", "actor_expiry_s",
+        "idle_stream_timeout_s", "max_abs_observation", "max_abs_action",
+        "max_abs_reward", "max_abs_log_prob", "max_server_threads",
+        "max_grpc_memory_mb"}) {
     command.flags.push_back(name);
   }
   for (const std::string& name : SecurityFlagNames()) {

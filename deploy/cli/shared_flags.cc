@@ -9,3 +9,5 @@ ABSL_FLAG(uint64_t, seed, 0, "random seed");
 ABSL_FLAG(std::string, metrics, "",
           "serve Prometheus metrics on PORT (127.0.0.1) or HOST:PORT (port "
           "0: a free one, printed on stderr); empty: none");
+ABSL_FLAG(std::string, metrics_port_file, "",
+          "with --metrics, write the metrics port to this file once serving");

@@ -8,11 +8,13 @@
 #include <filesystem>
 #include <vector>
 
+#include "absl/flags/flag.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_join.h"
 #include "actor/envs/env_registry.h"
 #include "deploy/cli/run_flags.h"
 #include "deploy/cli/security_flags.h"
+#include "deploy/cli/shared_flags.h"
 #include "deploy/cli/stop_signal.h"
 #include "deploy/launcher.h"
 #include "deploy/local_training.h"
@@ -51,6 +53,7 @@ int RunDistributed(const ResolvedRun& run) {
   launch.tls_cert = security->tls_cert_file;
   launch.tls_key = security->tls_key_file;
   launch.tls_ca = security->tls_ca_file;
+  launch.metrics_address = absl::GetFlag(FLAGS_metrics);
   std::printf(
       "%s %s with %s, estimator %s (rho %g), %ld steps, seed %lu: "
       "1 learner + %d actors x %d envs over gRPC%s%s\n",
@@ -123,6 +126,12 @@ int RunTrain(const std::vector<std::string>&) {
   if (absl::Status status = CheckRunCanStart(*run); !status.ok()) {
     return Fail(kUsageError, status.message());
   }
+  if (!absl::GetFlag(FLAGS_metrics).empty() &&
+      run->config.mode() != "distributed") {
+    return Fail(kUsageError,
+                "--metrics serves the processes of --mode=distributed; a "
+                "--mode=local run has none");
+  }
   return run->config.mode() == "distributed" ? RunDistributed(*run)
                                              : RunLocal(*run);
 }
@@ -158,6 +167,7 @@ Command TrainCommand() {
   for (const std::string& name : SecurityFlagNames()) {
     command.flags.push_back(name);
   }
+  command.flags.push_back("metrics");
   command.defaults = RunFlagDefaults(/*with_mode=*/true);
   command.example =
       "vantage train --env=Hopper --algo=ppo --estimator=max --rho=0.3 "

@@ -265,6 +265,9 @@ absl::Status ActorGateway::Admit(int64_t actor_id, const pb::Segment& proto,
   std::lock_guard<std::mutex> lock(mutex_);
   ++counters_.accepted_segments;
   counters_.accepted_steps += steps;
+  if (auto it = actors_.find(actor_id); it != actors_.end()) {
+    it->second.accepted_steps += steps;
+  }
   return absl::OkStatus();
 }
 
@@ -312,6 +315,17 @@ GatewayCounters ActorGateway::counters() const {
   GatewayCounters counters = counters_;
   counters.live_actors = static_cast<int64_t>(actors_.size());
   return counters;
+}
+
+std::vector<ActorActivity> ActorGateway::activity() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  std::vector<ActorActivity> activity;
+  activity.reserve(actors_.size());
+  for (const auto& [actor_id, registration] : actors_) {
+    activity.push_back(
+        {actor_id, registration.accepted_steps, registration.last_seen});
+  }
+  return activity;
 }
 
 }  // namespace vantage

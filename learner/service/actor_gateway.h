@@ -85,6 +85,14 @@ struct GatewayCounters {
   std::map<std::string, int64_t> rejected;  // reason -> segments or calls
 };
 
+// What one live registration has done: the steps of its admitted segments
+// and when it was last heard from.
+struct ActorActivity {
+  int64_t actor_id = 0;
+  int64_t accepted_steps = 0;
+  absl::Time last_seen;
+};
+
 class ActorGateway {
  public:
   // Admitted segments go to `sink` (which blocks when full: backpressure
@@ -140,6 +148,8 @@ class ActorGateway {
   bool closed() const;
 
   GatewayCounters counters() const;
+  // One entry per live registration, by actor id.
+  std::vector<ActorActivity> activity() const;
 
  private:
   struct Registration {
@@ -148,6 +158,7 @@ class ActorGateway {
     // Per env slot: the lowest sequence number not yet admitted.
     std::vector<int64_t> next_sequence;
     int64_t open_calls = 0;
+    int64_t accepted_steps = 0;
     absl::Time last_seen;
   };
 

@@ -4,6 +4,7 @@
 #include <utility>
 
 #include "absl/memory/memory.h"
+#include "absl/strings/str_cat.h"
 
 namespace vantage {
 namespace {
@@ -65,6 +66,29 @@ LearnerMetrics::LearnerMetrics()
       rolled_back_updates_(metrics_.AddCounter(
           "rolled_back_updates_total",
           "Updates undone because they produced non-finite numbers.")),
+      phase_seconds_(metrics_.AddCounterFamily(
+          "update_phase_seconds_total",
+          "Wall time of updates by phase: advantages (critic values and "
+          "estimates), optimisation, publish (weights to the actors).")),
+      advantage_seconds_(phase_seconds_.Add({{"phase", "advantages"}})),
+      optimisation_seconds_(phase_seconds_.Add({{"phase", "optimisation"}})),
+      publish_seconds_(phase_seconds_.Add({{"phase", "publish"}})),
+      max_policy_lag_(metrics_.AddGauge(
+          "max_policy_lag",
+          "The run's limit on policy lag (older segments are dropped); "
+          "negative: none.")),
+      last_update_time_(metrics_.AddGauge(
+          "last_update_timestamp_seconds",
+          "When the last update was published (Unix time; the process's "
+          "start before the first).")),
+      actor_steps_(metrics_.AddCounterFamily(
+          "actor_env_steps_total",
+          "Environment steps in the admitted segments of each live actor "
+          "registration (label actor_id, the id the learner granted).")),
+      actor_last_seen_(metrics_.AddGaugeFamily(
+          "actor_last_seen_timestamp_seconds",
+          "When each live actor registration was last heard from (Unix "
+          "time).")),
       env_steps_total_(env_steps_),
       episodes_total_(episodes_),
       segments_accepted_total_(segments_accepted_),
@@ -72,6 +96,13 @@ LearnerMetrics::LearnerMetrics()
       expirations_total_(expirations_),
       rolled_back_total_(rolled_back_updates_) {
   for (const char* reason : kKnownRejectReasons) RejectedTotal(reason);
+  statistics_ = {{"policy_version", &policy_version_},
+                 {"mean_return", &mean_return_},
+                 {"steps_per_second", &steps_per_second_}};
+  last_update_time_.SetToCurrentTime();
+  statistic_totals_ = {{"env_steps_total", &env_steps_total_},
+                       {"episodes_total", &episodes_total_},
+                       {"rolled_back_updates_total", &rolled_back_total_}};
 }
 
 LearnerMetrics::~LearnerMetrics() = default;
@@ -97,6 +128,7 @@ void LearnerMetrics::RecordUpdate(int64_t policy_version,
   if (policy_version > last_update_version_) {
     last_update_version_ = policy_version;
     updates_.Increment();
+    last_update_time_.SetToCurrentTime();
     // A NaN would poison the histogram's sum for good.
     if (std::isfinite(update_seconds) && update_seconds >= 0) {
       update_seconds_.Observe(update_seconds);
@@ -143,6 +175,75 @@ void LearnerMetrics::RecordActors(const Actors& actors) {
 void LearnerMetrics::RecordRolledBackUpdates(int64_t total) {
   std::lock_guard<std::mutex> lock(mutex_);
   rolled_back_total_.Record(total);
+}
+
+void LearnerMetrics::RecordStatistics(
+    const std::vector<Statistic>& statistics) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  // Every series exists before any takes its value, so no scrape sees
+  // some of an update's statistics without the others' series.
+  for (const Statistic& statistic : statistics) {
+    if (statistic.total) {
+      if (statistic_totals_.count(statistic.name) > 0) continue;
+      auto& owned = own_totals_[statistic.name];
+      owned = std::make_unique<TotalCounter>(
+          metrics_.AddCounter(statistic.name, statistic.help));
+      statistic_totals_.emplace(statistic.name, owned.get());
+    } else if (statistics_.count(statistic.name) == 0) {
+      statistics_.emplace(statistic.name,
+                          &metrics_.AddGauge(statistic.name, statistic.help));
+    }
+  }
+  for (const Statistic& statistic : statistics) {
+    if (!std::isfinite(statistic.value)) continue;
+    if (statistic.total) {
+      statistic_totals_.at(statistic.name)
+          ->Record(static_cast<int64_t>(statistic.value));
+    } else {
+      statistics_.at(statistic.name)->Set(statistic.value);
+    }
+  }
+}
+
+void LearnerMetrics::AddUpdatePhases(double advantage_seconds,
+                                     double optimisation_seconds,
+                                     double publish_seconds) {
+  AddSeconds(advantage_seconds_, advantage_seconds);
+  AddSeconds(optimisation_seconds_, optimisation_seconds);
+  AddSeconds(publish_seconds_, publish_seconds);
+}
+
+void LearnerMetrics::SetMaxPolicyLag(int64_t max_policy_lag) {
+  max_policy_lag_.Set(static_cast<double>(max_policy_lag));
+}
+
+void LearnerMetrics::RecordActorActivity(
+    const std::vector<ActorActivity>& actors) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  std::map<int64_t, ActorSeries> live;
+  for (const ActorActivity& actor : actors) {
+    auto it = actor_series_.find(actor.actor_id);
+    ActorSeries series;
+    if (it != actor_series_.end()) {
+      series = std::move(it->second);
+      actor_series_.erase(it);
+    } else {
+      const std::map<std::string, std::string> labels = {
+          {"actor_id", absl::StrCat(actor.actor_id)}};
+      series.steps = &actor_steps_.Add(labels);
+      series.last_seen = &actor_last_seen_.Add(labels);
+      series.steps_total = std::make_unique<TotalCounter>(*series.steps);
+    }
+    series.steps_total->Record(actor.accepted_steps);
+    series.last_seen->Set(actor.last_seen_unix_seconds);
+    live.emplace(actor.actor_id, std::move(series));
+  }
+  // Whoever was not reported is gone.
+  for (auto& [actor_id, series] : actor_series_) {
+    actor_steps_.Remove(series.steps);
+    actor_last_seen_.Remove(series.last_seen);
+  }
+  actor_series_ = std::move(live);
 }
 
 TotalCounter& LearnerMetrics::RejectedTotal(const std::string& reason) {

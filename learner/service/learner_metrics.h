@@ -10,6 +10,7 @@
 #include <memory>
 #include <mutex>
 #include <string>
+#include <vector>
 
 #include "absl/status/statusor.h"
 #include "common/metrics/metrics_registry.h"
@@ -37,7 +38,8 @@ class LearnerMetrics {
   // learner's running totals (counters advance by the difference to the
   // highest total seen). The update is counted, and `update_seconds`
   // observed, only if `policy_version` is above the last one recorded, so
-  // the same update recorded twice counts once. A non-finite mean return
+  // the same update recorded twice counts once (and sets the time of the
+  // last update, which starts at the process's start). A non-finite mean return
   // (NaN before the first episode ends) or steps per second leaves its
   // gauge as it was.
   void RecordUpdate(int64_t policy_version, int64_t env_steps_total,
@@ -69,10 +71,45 @@ class LearnerMetrics {
   // Running total of updates undone for non-finite numbers.
   void RecordRolledBackUpdates(int64_t total);
 
+  // The update's statistics, each a gauge prefix + name (or, if `total`,
+  // a counter fed from that running total, as RecordUpdate feeds its
+  // own), created on first report; the same name must always come with
+  // the same help and kind. A non-finite value (a statistic the algorithm
+  // has not got) leaves its series as it was.
+  struct Statistic {
+    std::string name;
+    std::string help;
+    double value = 0.0;
+    bool total = false;
+  };
+  void RecordStatistics(const std::vector<Statistic>& statistics);
+  // Where an update's wall time went: the critic's values and the
+  // advantages, the algorithm's optimisation, publishing the weights.
+  void AddUpdatePhases(double advantage_seconds, double optimisation_seconds,
+                       double publish_seconds);
+  // The live registrations, replacing the last report: per actor id, the
+  // steps of its admitted segments (a running total) and when it was last
+  // heard from (Unix seconds). An actor no longer reported loses its
+  // series, so ids of actors long gone do not pile up.
+  struct ActorActivity {
+    int64_t actor_id = 0;
+    int64_t accepted_steps = 0;
+    double last_seen_unix_seconds = 0.0;
+  };
+  void RecordActorActivity(const std::vector<ActorActivity>& actors);
+  // The run's limit on policy lag (negative: none), for alerts to compare
+  // the lag histogram with.
+  void SetMaxPolicyLag(int64_t max_policy_lag);
+
  private:
   LearnerMetrics();
   // The series of one refusal reason, created on first use.
   TotalCounter& RejectedTotal(const std::string& reason);
+  struct ActorSeries {
+    prometheus::Counter* steps = nullptr;
+    prometheus::Gauge* last_seen = nullptr;
+    std::unique_ptr<TotalCounter> steps_total;
+  };
 
   MetricsRegistry metrics_;  // first: every series below lives in it
   prometheus::Counter& env_steps_;
@@ -92,6 +129,14 @@ class LearnerMetrics {
   prometheus::Counter& registrations_;
   prometheus::Counter& expirations_;
   prometheus::Counter& rolled_back_updates_;
+  prometheus::Family<prometheus::Counter>& phase_seconds_;
+  prometheus::Counter& advantage_seconds_;
+  prometheus::Counter& optimisation_seconds_;
+  prometheus::Counter& publish_seconds_;
+  prometheus::Gauge& max_policy_lag_;
+  prometheus::Gauge& last_update_time_;
+  prometheus::Family<prometheus::Counter>& actor_steps_;
+  prometheus::Family<prometheus::Gauge>& actor_last_seen_;
 
   // Guards the totals: the learner loop and the gRPC threads both report.
   std::mutex mutex_;
@@ -103,6 +148,11 @@ class LearnerMetrics {
   TotalCounter expirations_total_;
   TotalCounter rolled_back_total_;
   std::map<std::string, TotalCounter> rejected_totals_;
+  // The statistics' gauges by name (the ones above among them).
+  std::map<std::string, prometheus::Gauge*> statistics_;
+  std::map<std::string, TotalCounter*> statistic_totals_;
+  std::map<std::string, std::unique_ptr<TotalCounter>> own_totals_;
+  std::map<int64_t, ActorSeries> actor_series_;
 };
 
 }  // namespace vantage

@@ -3,8 +3,10 @@
 #include <signal.h>
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <string>
 #include <thread>
 #include <vector>
@@ -16,7 +18,10 @@
 #include "absl/strings/str_split.h"
 #include "absl/strings/strip.h"
 #include "gmock/gmock.h"
+#include "google/protobuf/struct.pb.h"
+#include "google/protobuf/util/json_util.h"
 #include "gtest/gtest.h"
+#include "deploy/progress_columns.h"
 #include "tests/deploy/cli/run_vantage.h"
 #include "tests/fakes/http_get.h"
 #include "tests/fakes/learner_process.h"
@@ -79,12 +84,40 @@ TEST(DistributedTest, TwoActorsFeedOneLearner) {
 // The main job: `vantage train --actors=2` supervises its processes; an
 // actor killed with SIGKILL mid-run is restarted (and logged), the learner
 // keeps training and the run completes.
+// The run's scrape targets (prometheus_targets.json): role and actor label
+// -> address, for every process listed.
+std::map<std::string, std::string> ScrapeTargets(const std::string& run) {
+  google::protobuf::ListValue list;
+  std::map<std::string, std::string> targets;
+  if (!google::protobuf::util::JsonStringToMessage(
+           ReadFile(run + "/prometheus_targets.json"), &list)
+           .ok()) {
+    return targets;
+  }
+  for (const google::protobuf::Value& group : list.values()) {
+    const auto& fields = group.struct_value().fields();
+    const auto& labels = fields.at("labels").struct_value().fields();
+    std::string who = labels.at("role").string_value();
+    if (labels.count("actor") > 0) {
+      absl::StrAppend(&who, "-", labels.at("actor").string_value());
+    }
+    EXPECT_EQ(labels.at("run").string_value(),
+              std::filesystem::absolute(run).lexically_normal().string());
+    EXPECT_EQ(labels.at("env").string_value(), "InvertedPendulum");
+    targets[who] =
+        fields.at("targets").list_value().values(0).string_value();
+  }
+  return targets;
+}
+
+// With --metrics the run's scrape targets follow its processes: an actor
+// restarted on a free port is listed there, and a finished run lists none.
 TEST(DistributedTest, TrainRestartsAKilledActor) {
   const std::string run = FreshDirectory("supervised");
   const std::string err = TempPath("train.err");
   const int train = StartVantage(
       "train --actors=2 --envs_per_actor=1 --steps=6144 --horizon=512 "
-      "--seed=3 --run_dir=" +
+      "--seed=3 --metrics=0 --run_dir=" +
           run,
       TempPath("train.out"), err);
   // Wait for the first update, then kill one actor.
@@ -92,10 +125,40 @@ TEST(DistributedTest, TrainRestartsAKilledActor) {
     std::this_thread::sleep_for(std::chrono::milliseconds(50));
   }
   ASSERT_GE(DeterministicProgress(run).size(), 2u) << ReadFile(err);
+  std::map<std::string, std::string> targets;
+  for (int i = 0; i < 100 && targets.size() < 3; ++i) {
+    targets = ScrapeTargets(run);
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+  ASSERT_EQ(targets.size(), 3u) << ReadFile(run + "/prometheus_targets.json");
+  for (const auto& [who, address] : targets) {
+    const std::string port = address.substr(address.rfind(':') + 1);
+    int number = 0;
+    ASSERT_TRUE(absl::SimpleAtoi(port, &number)) << address;
+    absl::StatusOr<std::string> text = HttpGet(number, "/metrics");
+    ASSERT_TRUE(text.ok()) << who << ": " << text.status();
+    EXPECT_THAT(*text, HasSubstr(who == "learner" ? "vantage_learner_"
+                                                  : "vantage_actor_"));
+  }
   const std::vector<int> actors = ChildrenRunning(train, " actor ");
   ASSERT_EQ(actors.size(), 2u);
+  const std::string killed =
+      ReadFile("/proc/" + std::to_string(actors[0]) + "/cmdline")
+                  .find("actor-1") != std::string::npos
+          ? "actor-1"
+          : "actor-0";
   kill(actors[0], SIGKILL);
+  std::map<std::string, std::string> after = targets;
+  for (int i = 0; i < 600 && after[killed] == targets[killed] &&
+                  kill(train, 0) == 0;
+       ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    after = ScrapeTargets(run);
+  }
+  EXPECT_NE(after[killed], targets[killed]) << killed;
   EXPECT_EQ(WaitVantage(train, 180), 0) << ReadFile(err);
+  EXPECT_THAT(ReadFile(run + "/prometheus_targets.json"),
+              ::testing::MatchesRegex("\\[\\s*\\]\\s*"));
   EXPECT_THAT(ReadFile(err), HasSubstr("ended (signal 9); restarting it"));
   // Under a new id: its streams are new ones, never stitched onto the
   // killed actor's.
@@ -192,8 +255,8 @@ TEST(DistributedTest, AStoppedRunKeepsEveryUpdateAndResumes) {
   }
 }
 
-// Scrapes the learner while it trains: every scrape's policy version,
-// env steps and episodes agree with that update's row of progress.csv.
+// Scrapes the learner while it trains: every column of progress.csv is a
+// series of the learner's, and scrapes agree with that update's row.
 TEST(DistributedTest, PrometheusCountersAgreeWithProgressCsv) {
   const std::string run = FreshDirectory("metrics");
   const Learner learner = StartLearner(
@@ -225,11 +288,23 @@ TEST(DistributedTest, PrometheusCountersAgreeWithProgressCsv) {
     const std::vector<std::string> rows = DeterministicProgress(run);
     if (version < 1 || version >= static_cast<int>(rows.size())) continue;
     const std::vector<std::string> row = absl::StrSplit(rows[version], ',');
-    // A scrape may fall between two updates' gauges; count only whole ones.
-    if (std::to_string(static_cast<int64_t>(
-            Sample(*text, "vantage_learner_env_steps_total"))) == row[0] &&
-        std::to_string(static_cast<int64_t>(
-            Sample(*text, "vantage_learner_episodes_total"))) == row[3]) {
+    // Every column of the row is a series of the learner's (one table
+    // feeds both). A scrape may fall between two updates' reports: count
+    // only those that agree on every column (the wall-clock ones aside).
+    bool whole = true;
+    for (size_t c = 0; c < ProgressColumns().size(); ++c) {
+      const ProgressColumn& column = ProgressColumns()[c];
+      const std::string name = absl::StrCat("vantage_learner_", column.metric);
+      EXPECT_THAT(*text, HasSubstr("\n" + name + " ")) << column.name;
+      double expected = 0;
+      if (c + 2 >= ProgressColumns().size() ||
+          !absl::SimpleAtod(row[c], &expected)) {
+        continue;  // wall clock, or NaN (an empty field)
+      }
+      whole = whole && std::abs(Sample(*text, name) - expected) <=
+                           1e-6 * std::max(1.0, std::abs(expected));
+    }
+    if (whole) {
       ++agreeing;
       EXPECT_EQ(Sample(*text, "vantage_learner_updates_total"), version);
       EXPECT_EQ(Sample(*text, "vantage_learner_live_actors"), 1);

@@ -8,7 +8,11 @@
 #include <thread>
 #include <vector>
 
+#include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
+#include "absl/strings/strip.h"
+#include "absl/time/clock.h"
+#include "absl/time/time.h"
 #include "absl/strings/str_split.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
@@ -222,6 +226,90 @@ TEST(LearnerMetricsTest, MalformedAddressIsAnError) {
         LearnerMetrics::Start(address);
     EXPECT_FALSE(metrics.ok()) << address;
   }
+}
+
+TEST(LearnerMetricsTest, StatisticsAreGaugesOrCountersByKind) {
+  std::unique_ptr<LearnerMetrics> metrics = StartOnAnyPort();
+  ASSERT_NE(metrics, nullptr);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  metrics->RecordStatistics({{"value_loss", "Critic loss.", 2.5},
+                             {"clip_fraction", "Clipped share.", 0.25},
+                             {"batch_rejected_segments_total", "Refused.", 4,
+                              /*total=*/true},
+                             // Fed by RecordUpdate too: one series.
+                             {"env_steps_total", "Steps.", 4096, true},
+                             {"mean_return", "Return.", 7.0}});
+  metrics->RecordUpdate(1, 4096, 3, 0.5, 7.0, 1000);
+  // A statistic the algorithm has not got keeps its gauge; totals only
+  // grow by their difference.
+  metrics->RecordStatistics({{"value_loss", "Critic loss.", nan},
+                             {"batch_rejected_segments_total", "Refused.", 6,
+                              true},
+                             {"env_steps_total", "Steps.", 4096, true}});
+  const std::vector<std::string> lines = Scrape(*metrics);
+  for (const char* line : {
+           "vantage_learner_value_loss 2.5",
+           "vantage_learner_clip_fraction 0.25",
+           "vantage_learner_batch_rejected_segments_total 6",
+           "vantage_learner_env_steps_total 4096",
+           "vantage_learner_mean_return 7",
+           "# TYPE vantage_learner_value_loss gauge",
+           "# TYPE vantage_learner_batch_rejected_segments_total counter",
+           "# HELP vantage_learner_value_loss Critic loss.",
+       }) {
+    EXPECT_THAT(lines, Contains(line));
+  }
+}
+
+TEST(LearnerMetricsTest, UpdatePhasesAndTheLastUpdateTime) {
+  std::unique_ptr<LearnerMetrics> metrics = StartOnAnyPort();
+  ASSERT_NE(metrics, nullptr);
+  metrics->AddUpdatePhases(0.25, 1.5, 0.125);
+  metrics->AddUpdatePhases(0.25, -1, std::nan(""));
+  metrics->SetMaxPolicyLag(3);
+  const double before = absl::ToDoubleSeconds(absl::Now() - absl::UnixEpoch());
+  metrics->RecordUpdate(1, 10, 0, 0.1, 0, 10);
+  const std::vector<std::string> lines = Scrape(*metrics);
+  for (const char* line : {
+           "vantage_learner_update_phase_seconds_total{phase=\"advantages\"} "
+           "0.5",
+           "vantage_learner_update_phase_seconds_total{phase=\"optimisation\"}"
+           " 1.5",
+           "vantage_learner_update_phase_seconds_total{phase=\"publish\"} "
+           "0.125",
+           "vantage_learner_max_policy_lag 3",
+       }) {
+    EXPECT_THAT(lines, Contains(line));
+  }
+  double last_update = 0;
+  for (absl::string_view line : lines) {
+    if (absl::ConsumePrefix(&line,
+                            "vantage_learner_last_update_timestamp_seconds ")) {
+      ASSERT_TRUE(absl::SimpleAtod(line, &last_update)) << line;
+    }
+  }
+  EXPECT_GE(last_update, std::floor(before));
+  EXPECT_LE(last_update, before + 60);
+}
+
+TEST(LearnerMetricsTest, ActorSeriesFollowTheLiveRegistrations) {
+  std::unique_ptr<LearnerMetrics> metrics = StartOnAnyPort();
+  ASSERT_NE(metrics, nullptr);
+  metrics->RecordActorActivity({{3, 100, 1000.5}, {4, 50, 1001}});
+  metrics->RecordActorActivity({{3, 300, 1002}, {4, 50, 1001}});
+  std::vector<std::string> lines = Scrape(*metrics);
+  EXPECT_THAT(lines, Contains("vantage_learner_actor_env_steps_total{actor_id="
+                              "\"3\"} 300"));
+  EXPECT_THAT(lines, Contains("vantage_learner_actor_env_steps_total{actor_id="
+                              "\"4\"} 50"));
+  EXPECT_THAT(lines, Contains("vantage_learner_actor_last_seen_timestamp_"
+                              "seconds{actor_id=\"3\"} 1002"));
+  // Actor 4 expired: its series go, so restarted actors' ids do not pile up.
+  metrics->RecordActorActivity({{3, 320, 1003}});
+  lines = Scrape(*metrics);
+  EXPECT_THAT(lines, Contains("vantage_learner_actor_env_steps_total{actor_id="
+                              "\"3\"} 320"));
+  EXPECT_THAT(lines, Not(Contains(HasSubstr("actor_id=\"4\""))));
 }
 
 }  // namespace

@@ -1,0 +1,110 @@
+#include "deploy/progress_columns.h"
+
+#include <cmath>
+#include <cstdint>
+
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
+#include "absl/strings/str_join.h"
+
+namespace vantage {
+namespace {
+
+using Format = ProgressColumn::Format;
+using Metric = ProgressColumn::Metric;
+
+std::string FormatValue(Format format, double value) {
+  switch (format) {
+    case Format::kInteger:
+      return absl::StrCat(static_cast<int64_t>(value));
+    case Format::kNumber:
+      return std::isnan(value) ? "" : absl::StrFormat("%.9g", value);
+    case Format::kMilliseconds:
+      return absl::StrFormat("%.3f", value);
+    case Format::kTenths:
+      return absl::StrFormat("%.1f", value);
+  }
+  return "";
+}
+
+}  // namespace
+
+const std::vector<ProgressColumn>& ProgressColumns() {
+  static const std::vector<ProgressColumn> columns = {
+      {"env_steps", "env_steps_total", Metric::kCounter, Format::kInteger,
+       "Environment steps consumed by updates.",
+       [](const ProgressRow& r) { return double(r.stats.env_steps); }},
+      {"updates", "policy_version", Metric::kGauge, Format::kInteger,
+       "Newest published policy version (= updates of the run).",
+       [](const ProgressRow& r) { return double(r.stats.policy_version); }},
+      {"policy_version", "policy_version", Metric::kGauge, Format::kInteger,
+       "Newest published policy version (= updates of the run).",
+       [](const ProgressRow& r) { return double(r.stats.policy_version); }},
+      {"episodes", "episodes_total", Metric::kCounter, Format::kInteger,
+       "Episodes finished in consumed segments.",
+       [](const ProgressRow& r) { return double(r.stats.episodes); }},
+      {"mean_return", "mean_return", Metric::kGauge, Format::kNumber,
+       "Mean return of the last 100 finished episodes.",
+       [](const ProgressRow& r) { return r.mean_return; }},
+      {"policy_loss", "policy_loss", Metric::kGauge, Format::kNumber,
+       "Policy (surrogate) loss of the last update.",
+       [](const ProgressRow& r) { return r.stats.algorithm.policy_loss; }},
+      {"value_loss", "value_loss", Metric::kGauge, Format::kNumber,
+       "Critic loss of the last update.",
+       [](const ProgressRow& r) { return r.stats.algorithm.value_loss; }},
+      {"entropy", "policy_entropy", Metric::kGauge, Format::kNumber,
+       "Mean entropy of the policy on the last batch.",
+       [](const ProgressRow& r) { return r.stats.algorithm.entropy; }},
+      {"approx_kl", "approx_kl", Metric::kGauge, Format::kNumber,
+       "Approximate KL divergence from the acting policy after the update.",
+       [](const ProgressRow& r) { return r.stats.algorithm.approx_kl; }},
+      {"clip_fraction", "clip_fraction", Metric::kGauge, Format::kNumber,
+       "Share of samples whose ratio was clipped (PPO).",
+       [](const ProgressRow& r) { return r.stats.algorithm.clip_fraction; }},
+      {"explained_variance", "explained_variance", Metric::kGauge,
+       Format::kNumber,
+       "1 - Var(returns - values) / Var(returns) of the last batch.",
+       [](const ProgressRow& r) { return r.stats.explained_variance; }},
+      {"biased_fraction", "biased_fraction", Metric::kGauge, Format::kNumber,
+       "Share of the last batch's samples using the biased estimate.",
+       [](const ProgressRow& r) { return r.stats.biased_fraction; }},
+      {"mean_abs_bias", "mean_abs_bias", Metric::kGauge, Format::kNumber,
+       "Mean |biased - GAE| advantage over the last batch.",
+       [](const ProgressRow& r) { return r.stats.mean_abs_bias; }},
+      {"rejected_segments", "batch_rejected_segments_total", Metric::kCounter,
+       Format::kInteger,
+       "Segments the learner's stitcher refused or dropped as stale.",
+       [](const ProgressRow& r) { return double(r.stats.rejected_segments); }},
+      {"rolled_back_updates", "rolled_back_updates_total", Metric::kCounter,
+       Format::kInteger,
+       "Updates undone because they produced non-finite numbers.",
+       [](const ProgressRow& r) {
+         return double(r.stats.rolled_back_updates);
+       }},
+      {"elapsed_s", "run_elapsed_seconds", Metric::kGauge,
+       Format::kMilliseconds, "Wall time of the whole run, across resumes.",
+       [](const ProgressRow& r) { return r.elapsed_seconds; }},
+      {"sps", "steps_per_second", Metric::kGauge, Format::kTenths,
+       "Environment steps consumed per second since the process started.",
+       [](const ProgressRow& r) { return r.steps_per_second; }},
+  };
+  return columns;
+}
+
+std::string ProgressHeader() {
+  std::vector<std::string> names;
+  for (const ProgressColumn& column : ProgressColumns()) {
+    names.push_back(column.name);
+  }
+  return absl::StrJoin(names, ",");
+}
+
+std::string FormatProgressRow(const ProgressRow& row) {
+  std::vector<std::string> fields;
+  for (const ProgressColumn& column : ProgressColumns()) {
+    fields.push_back(FormatValue(column.format, column.value(row)));
+  }
+  return absl::StrJoin(fields, ",");
+}
+
+}  // namespace vantage
