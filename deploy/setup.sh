@@ -24,7 +24,11 @@ done
 # otherwise run on; serial, because every vantage process computes on one
 # thread of its own and several share the machine (docs/benchmarks.md).
 # prometheus (with promtool) serves deploy/prometheus/ and its test;
-# python3-matplotlib draws `vantage plot`'s figures.
+# python3-matplotlib draws `vantage plot`'s figures. `vantage rollout
+# --video` renders MuJoCo offscreen on OSMesa (libosmesa6-dev), draws the
+# Bullet characters with Cairo (libcairo2-dev) and encodes with FFmpeg's
+# libraries (libav*-dev, libswscale-dev); its tests read the files back
+# with ffprobe and ffmpeg (ffmpeg).
 packages=(
   build-essential cmake ninja-build pkgconf clang-format openssl
   libtorch-dev libgloo-dev libopenblas0-serial
@@ -36,6 +40,8 @@ packages=(
   prometheus-cpp-dev
   libminizip-dev
   prometheus python3-matplotlib
+  libosmesa6-dev libcairo2-dev
+  libavcodec-dev libavformat-dev libswscale-dev libavutil-dev ffmpeg
 )
 
 "${repo_root}/deploy/install_packages.sh" setup.sh "${packages[@]}"

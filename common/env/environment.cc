@@ -20,6 +20,11 @@ absl::Status Environment::RestoreState(absl::string_view) {
       spec().name, ": this environment cannot restore a saved state"));
 }
 
+absl::StatusOr<Frame> Environment::Render(int, int) {
+  return absl::UnimplementedError(
+      absl::StrCat(spec().name, ": this environment cannot render"));
+}
+
 absl::Status CheckAction(const EnvSpec& spec, absl::Span<const double> action) {
   const size_t expected = spec.discrete ? 1 : spec.action_size;
   if (action.size() != expected) {

@@ -12,6 +12,7 @@
 #include "absl/status/statusor.h"
 #include "absl/strings/string_view.h"
 #include "absl/types/span.h"
+#include "common/env/frame.h"
 
 namespace vantage {
 
@@ -71,6 +72,12 @@ class Environment {
   // come from an environment of the same name and model; anything else is
   // InvalidArgument and leaves this environment as it was.
   virtual absl::Status RestoreState(absl::string_view state);
+
+  // A picture of the current state, `width` x `height` pixels (both >= 1),
+  // for videos of episodes. It only reads the simulation: rendering or not
+  // changes nothing the environment later produces. The default says the
+  // environment cannot.
+  virtual absl::StatusOr<Frame> Render(int width, int height);
 };
 
 // Checks an action's size and finiteness against the spec (and, if

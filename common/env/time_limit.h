@@ -23,6 +23,9 @@ class TimeLimit : public Environment {
   // The step count and whether an episode runs, around the inner state.
   absl::StatusOr<std::string> SaveState() const override;
   absl::Status RestoreState(absl::string_view state) override;
+  absl::StatusOr<Frame> Render(int width, int height) override {
+    return inner_->Render(width, height);
+  }
 
   int64_t elapsed_steps() const { return elapsed_steps_; }
   // The wrapped environment (benchmarks reach the physics through it).

@@ -10,11 +10,14 @@
 #include <vector>
 
 #include "absl/flags/flag.h"
+#include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_replace.h"
+#include "absl/strings/str_split.h"
 #include "actor/envs/env_registry.h"
 #include "deploy/cli/shared_flags.h"
 #include "deploy/trained_policy.h"
+#include "deploy/video_writer.h"
 
 ABSL_FLAG(int64_t, episodes, 10, "number of episodes");
 ABSL_FLAG(std::string, checkpoint, "",
@@ -22,6 +25,13 @@ ABSL_FLAG(std::string, checkpoint, "",
           "uniform-random policy)");
 ABSL_FLAG(bool, stochastic, false,
           "with --checkpoint: sample actions instead of the mean / mode");
+ABSL_FLAG(std::string, video, "",
+          "write the episodes to this video file: .mp4 (H.264) or .gif, "
+          "one frame after each reset and each step");
+ABSL_FLAG(std::string, video_size, "480x320",
+          "with --video: WIDTHxHEIGHT in pixels, both even");
+ABSL_FLAG(int64_t, video_episodes, 0,
+          "with --video: how many of the first episodes it shows (0: all)");
 
 namespace vantage {
 namespace {
@@ -32,6 +42,75 @@ struct RolloutRequest {
   uint64_t seed = 0;
   std::string checkpoint;   // run directory or checkpoint file
   bool stochastic = false;  // sample instead of the mean / mode
+  std::string video;        // empty: no video
+  int video_width = 480;
+  int video_height = 320;
+  int64_t video_episodes = 0;  // 0: all
+};
+
+absl::Status ParseVideoSize(const std::string& text, RolloutRequest* request) {
+  const std::vector<std::string> parts = absl::StrSplit(text, 'x');
+  if (parts.size() != 2 || !absl::SimpleAtoi(parts[0], &request->video_width) ||
+      !absl::SimpleAtoi(parts[1], &request->video_height)) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "--video_size=", text, ": expected WIDTHxHEIGHT, e.g. 480x320"));
+  }
+  return absl::OkStatus();
+}
+
+// The frames of a rollout's first episodes, into a file opened at the first
+// frame (once the environment has shown it can render).
+class VideoRecorder {
+ public:
+  VideoRecorder(const RolloutRequest& request, const EnvSpec& spec)
+      : request_(request), spec_(spec) {}
+
+  bool recording(int64_t episode) const {
+    return !request_.video.empty() &&
+           (request_.video_episodes == 0 || episode < request_.video_episodes);
+  }
+
+  // Renders `env` as it stands; `code` says how the command should end
+  // when it fails.
+  absl::Status Add(Environment& env, int* code) {
+    absl::StatusOr<Frame> frame =
+        env.Render(request_.video_width, request_.video_height);
+    if (!frame.ok()) {
+      *code =
+          absl::IsUnimplemented(frame.status()) ? kUsageError : kRuntimeError;
+      return absl::Status(
+          frame.status().code(),
+          absl::StrCat(spec_.name, " cannot render a video frame: ",
+                       frame.status().message()));
+    }
+    if (writer_ == nullptr) {
+      absl::StatusOr<std::unique_ptr<VideoWriter>> opened =
+          VideoWriter::Open(request_.video, request_.video_width,
+                            request_.video_height, 1.0 / spec_.control_dt);
+      if (!opened.ok()) {
+        *code = kUsageError;
+        return opened.status();
+      }
+      writer_ = *std::move(opened);
+    }
+    *code = kRuntimeError;
+    return writer_->Write(*frame);
+  }
+
+  absl::Status Finish() {
+    if (writer_ == nullptr) return absl::OkStatus();
+    if (absl::Status status = writer_->Finish(); !status.ok()) return status;
+    std::printf("video: %s (%ld frames, %dx%d, %g fps)\n",
+                request_.video.c_str(),
+                static_cast<long>(writer_->frames_written()),
+                request_.video_width, request_.video_height, writer_->fps());
+    return absl::OkStatus();
+  }
+
+ private:
+  const RolloutRequest& request_;
+  const EnvSpec& spec_;
+  std::unique_ptr<VideoWriter> writer_;
 };
 
 // `code`: kUsageError for what the flags asked for, kRuntimeError for a
@@ -75,6 +154,17 @@ int RunRollout(const std::vector<std::string>&) {
   request.seed = absl::GetFlag(FLAGS_seed);
   request.checkpoint = absl::GetFlag(FLAGS_checkpoint);
   request.stochastic = absl::GetFlag(FLAGS_stochastic);
+  request.video = absl::GetFlag(FLAGS_video);
+  request.video_episodes = absl::GetFlag(FLAGS_video_episodes);
+  if (absl::Status status =
+          ParseVideoSize(absl::GetFlag(FLAGS_video_size), &request);
+      !status.ok()) {
+    return Fail("rollout", status);
+  }
+  if (request.video_episodes < 0) {
+    return Fail("rollout", absl::InvalidArgumentError(
+                               "--video_episodes must be >= 0 (0: all)"));
+  }
   const int64_t episodes = request.episodes;
   const uint64_t seed = request.seed;
   std::string env_name = request.env;
@@ -112,6 +202,8 @@ int RunRollout(const std::vector<std::string>&) {
   std::mt19937_64 rng(seed);
   std::vector<double> observation(spec.observation_size);
   std::vector<double> action(spec.discrete ? 1 : spec.action_size);
+  VideoRecorder video(request, spec);
+  int video_code = kRuntimeError;
   Digest digest;
   double total_return = 0.0;
   int64_t total_length = 0;
@@ -122,6 +214,12 @@ int RunRollout(const std::vector<std::string>&) {
       return Fail("rollout", status, kRuntimeError);
     }
     digest.Add(observation);
+    const bool recording = video.recording(episode);
+    if (recording) {
+      if (absl::Status status = video.Add(env, &video_code); !status.ok()) {
+        return Fail("rollout", status, video_code);
+      }
+    }
     double episode_return = 0.0;
     int64_t length = 0;
     while (true) {
@@ -144,6 +242,11 @@ int RunRollout(const std::vector<std::string>&) {
           env.Step(action, absl::MakeSpan(observation));
       if (!result.ok()) return Fail("rollout", result.status(), kRuntimeError);
       digest.Add(observation);
+      if (recording) {
+        if (absl::Status status = video.Add(env, &video_code); !status.ok()) {
+          return Fail("rollout", status, video_code);
+        }
+      }
       episode_return += result->reward;
       ++length;
       if (result->terminated || result->truncated) {
@@ -156,6 +259,9 @@ int RunRollout(const std::vector<std::string>&) {
     }
     total_return += episode_return;
     total_length += length;
+  }
+  if (absl::Status status = video.Finish(); !status.ok()) {
+    return Fail("rollout", status, kRuntimeError);
   }
   std::printf(
       "RESULT rollout env=%s obs_dim=%ld act_dim=%ld episodes=%ld "
@@ -192,10 +298,18 @@ Command RolloutCommand() {
       "--checkpoint the policy of a run directory's newest checkpoint (its\n"
       "mean action unless --stochastic), one line per episode, then\n"
       "`RESULT rollout ... mean_return=R mean_length=L digest=D` (the digest\n"
-      "hashes every observation: equal digests, equal episodes).";
-  command.flags = {"env", "episodes", "seed", "checkpoint", "stochastic"};
+      "hashes every observation: equal digests, equal episodes).\n"
+      "--video=FILE renders the episodes offscreen (MuJoCo's renderer on\n"
+      "OSMesa; the Bullet characters side-on with Cairo) into an MP4 or GIF\n"
+      "at the control frequency, one frame after each reset and each step,\n"
+      "and prints `video: FILE (N frames, WxH, F fps)`; the episodes and\n"
+      "the RESULT line are the same with or without it (docs/videos.md).";
+  command.flags = {"env",        "episodes", "seed",       "checkpoint",
+                   "stochastic", "video",    "video_size", "video_episodes"};
   command.defaults = {{"env", "the checkpoint's, else required"}};
-  command.example = "vantage rollout --checkpoint=runs/hopper --episodes=5";
+  command.example =
+      "vantage rollout --checkpoint=runs/hopper --episodes=5 "
+      "--video=hopper.mp4";
   command.run = RunRollout;
   return command;
 }

@@ -5,7 +5,9 @@
 #include <cstring>
 #include <utility>
 
+#include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
+#include "actor/render/planar_drawing.h"
 #include "common/util/state_bytes.h"
 
 namespace vantage {
@@ -118,6 +120,38 @@ absl::Status BulletEnv::Replay(uint64_t seed, absl::Span<const double> log) {
     log_.insert(log_.end(), clipped.begin(), clipped.end());
   }
   return absl::OkStatus();
+}
+
+absl::StatusOr<Frame> BulletEnv::Render(int width, int height) {
+  if (world_ == nullptr || needs_reset_) {
+    return absl::FailedPreconditionError(
+        absl::StrCat(spec_.name, ": nothing to render before a Reset"));
+  }
+  PlanarScene scene;
+  scene.slope = model_.slope;
+  // The whole standing body fits in the frame, with room to jump.
+  double top = 0.0;
+  for (int i = 0; i < world_->num_links(); ++i) {
+    const CapsulePose pose = world_->LinkCapsule(i);
+    PlanarCapsule capsule;
+    capsule.from_x = pose.from_x;
+    capsule.from_z = pose.from_z;
+    capsule.to_x = pose.to_x;
+    capsule.to_z = pose.to_z;
+    capsule.radius = pose.radius;
+    capsule.far_side = absl::StartsWith(model_.links[i].name, "left");
+    scene.capsules.push_back(capsule);
+    const PlanarLink& link = model_.links[i];
+    top = std::max(top, std::max(link.from_z, link.to_z) + link.radius);
+  }
+  scene.view_height = 1.8 * top;
+  const PlanarCapsule& root = scene.capsules[0];
+  scene.centre_x = 0.5 * (root.from_x + root.to_x);
+  // The ground stays at the same height in the frame (a tenth above its
+  // bottom edge) however the body bobs.
+  scene.centre_z =
+      world_->GroundHeight(scene.centre_x) + 0.4 * scene.view_height;
+  return DrawPlanarScene(scene, width, height);
 }
 
 uint64_t BulletEnv::Signature() const {

@@ -38,6 +38,9 @@ class BulletEnv : public Environment {
   // tasks stop after 1000 steps.
   absl::StatusOr<std::string> SaveState() const override;
   absl::Status RestoreState(absl::string_view state) override;
+  // Side-on, drawn from the capsules (actor/render/planar_drawing.h); the
+  // view follows the root link. Needs a running episode.
+  absl::StatusOr<Frame> Render(int width, int height) override;
 
   const PlanarModel& model() const { return model_; }
   // N m per unit of action, one per hinge.

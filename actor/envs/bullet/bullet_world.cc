@@ -307,4 +307,22 @@ double BulletWorld::LinkMass(int link) const {
   return body_->getLinkMass(LinkIndex(link));
 }
 
+CapsulePose BulletWorld::LinkCapsule(int link) const {
+  const btMultiBodyLinkCollider* collider = colliders_[link].get();
+  const auto* shape =
+      static_cast<const btCapsuleShape*>(collider->getCollisionShape());
+  btVector3 half(0, 0, 0);
+  half[shape->getUpAxis()] = shape->getHalfHeight();
+  const btTransform& pose = collider->getWorldTransform();
+  const btVector3 from = pose * -half;
+  const btVector3 to = pose * half;
+  CapsulePose capsule;
+  capsule.from_x = from.x();
+  capsule.from_z = from.z();
+  capsule.to_x = to.x();
+  capsule.to_z = to.z();
+  capsule.radius = shape->getRadius();
+  return capsule;
+}
+
 }  // namespace vantage

@@ -74,6 +74,16 @@ struct PlanarModel {
   int solver_iterations = 10;
 };
 
+// Where a link's capsule is now: its segment's end points in the x-z
+// plane and its radius (metres), for pictures.
+struct CapsulePose {
+  double from_x = 0.0;
+  double from_z = 0.0;
+  double to_x = 0.0;
+  double to_z = 0.0;
+  double radius = 0.0;
+};
+
 // Checks what BulletWorld relies on; the message names the link.
 absl::Status ValidatePlanarModel(const PlanarModel& model);
 
@@ -107,6 +117,10 @@ class BulletWorld {
   // Positions and velocities are all finite.
   bool IsFinite() const;
   double LinkMass(int link) const;
+  int num_links() const { return static_cast<int>(colliders_.size()); }
+  // Read from the link's collider, as the last physics step or SetState
+  // left it.
+  CapsulePose LinkCapsule(int link) const;
 
  private:
   // Bullet's link index of q(i), and of link `link`.

@@ -24,6 +24,9 @@ class Humanoid : public MujocoEnv {
 
   void BeforeStep() override { x_before_ = MassCenterX(); }
 
+  // The torso, the root of the free joint.
+  int TrackedBody() const override { return 1; }
+
   StepResult Evaluate(absl::Span<const double> action) override {
     // cvel and cfrc_ext of the final state, as Gymnasium's v4 computes them.
     mj_rnePostConstraint(model(), mutable_data());

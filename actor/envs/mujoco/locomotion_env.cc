@@ -26,6 +26,8 @@ class LocomotionEnv : public MujocoEnv {
 
   void BeforeStep() override { x_before_ = ForwardX(); }
 
+  int TrackedBody() const override { return forward_body_; }
+
   StepResult Evaluate(absl::Span<const double> action) override {
     StepResult result;
     const bool healthy = Healthy();

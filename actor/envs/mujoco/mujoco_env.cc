@@ -9,6 +9,7 @@
 #include <utility>
 
 #include "absl/strings/str_cat.h"
+#include "actor/render/mujoco_renderer.h"
 #include "common/util/state_bytes.h"
 
 namespace vantage {
@@ -64,6 +65,26 @@ MujocoEnv::MujocoEnv(EnvSpec spec, MjModelPtr model, MjDataPtr data,
   std::string mjb(mj_sizeModel(m), '\0');
   mj_saveModel(m, nullptr, mjb.data(), static_cast<int>(mjb.size()));
   model_fingerprint_ = Fingerprint(mjb);
+}
+
+MujocoEnv::~MujocoEnv() = default;
+
+absl::StatusOr<Frame> MujocoEnv::Render(int width, int height) {
+  if (needs_reset_) {
+    return absl::FailedPreconditionError(
+        absl::StrCat(spec_.name, ": nothing to render before a Reset"));
+  }
+  if (renderer_ == nullptr || renderer_->width() != width ||
+      renderer_->height() != height) {
+    renderer_.reset();
+    absl::StatusOr<std::unique_ptr<MujocoRenderer>> made =
+        MujocoRenderer::Create(model_.get(), width, height);
+    if (!made.ok()) return made.status();
+    renderer_ = *std::move(made);
+  }
+  MujocoView view;
+  view.track_body = TrackedBody();
+  return renderer_->Render(data_.get(), view);
 }
 
 absl::Status MujocoEnv::Reset(uint64_t seed, absl::Span<double> observation) {

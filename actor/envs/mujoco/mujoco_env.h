@@ -1,6 +1,7 @@
 #ifndef VANTAGE_ACTOR_ENVS_MUJOCO_MUJOCO_ENV_H_
 #define VANTAGE_ACTOR_ENVS_MUJOCO_MUJOCO_ENV_H_
 
+#include <memory>
 #include <random>
 #include <string>
 #include <vector>
@@ -10,12 +11,16 @@
 
 namespace vantage {
 
+class MujocoRenderer;
+
 // The shared part of every MuJoCo task: seeding, resetting, clipping the
 // action into ctrl, frame skip, and turning MuJoCo errors and numerical
 // blow-ups into errors. Tasks supply the observation, the reset noise and
 // the reward and termination rules.
 class MujocoEnv : public Environment {
  public:
+  ~MujocoEnv() override;
+
   const EnvSpec& spec() const override { return spec_; }
   absl::Status Reset(uint64_t seed, absl::Span<double> observation) override;
   absl::StatusOr<StepResult> Step(absl::Span<const double> action,
@@ -30,6 +35,10 @@ class MujocoEnv : public Environment {
   // version, the model's sizes and a fingerprint of the model.
   absl::StatusOr<std::string> SaveState() const override;
   absl::Status RestoreState(absl::string_view state) override;
+  // MuJoCo's own renderer on an offscreen OSMesa context
+  // (actor/render/mujoco_renderer.h), made at the first call and again
+  // when the size changes. Needs a running episode.
+  absl::StatusOr<Frame> Render(int width, int height) override;
 
   const mjModel* model() const { return model_.get(); }
   const mjData* data() const { return data_.get(); }
@@ -58,6 +67,10 @@ class MujocoEnv : public Environment {
   // applied only if it succeeds.
   virtual absl::Status RestoreTaskState(absl::string_view state);
 
+  // The body a video's camera follows side-on (a character's root), or -1
+  // for the model's fixed camera or a view of the whole model.
+  virtual int TrackedBody() const { return -1; }
+
   mjData* mutable_data() { return data_.get(); }
 
   // The usual ResetState: qpos += U(-scale, scale) and qvel +=
@@ -77,6 +90,8 @@ class MujocoEnv : public Environment {
   std::vector<double> clipped_;
   // Set after an error left the simulation in an unknown state.
   bool needs_reset_ = true;
+  // Made by the first Render.
+  std::unique_ptr<MujocoRenderer> renderer_;
 };
 
 }  // namespace vantage
