@@ -8,6 +8,8 @@ ABSL_FLAG(int, envs, 1, "environments stepped together");
 ABSL_FLAG(uint64_t, seed, 0, "random seed");
 ABSL_FLAG(std::string, metrics, "",
           "serve Prometheus metrics on PORT (127.0.0.1) or HOST:PORT (port "
-          "0: a free one, printed on stderr); empty: none");
+          "0: a free one, printed on stderr); with train, the learner there "
+          "and the actors on the next ports, listed in "
+          "RUN_DIR/prometheus_targets.json (docs/metrics.md); empty: none");
 ABSL_FLAG(std::string, metrics_port_file, "",
           "with --metrics, write the metrics port to this file once serving");

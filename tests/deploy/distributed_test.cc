@@ -17,11 +17,11 @@
 #include "absl/strings/str_join.h"
 #include "absl/strings/str_split.h"
 #include "absl/strings/strip.h"
+#include "deploy/progress_columns.h"
 #include "gmock/gmock.h"
 #include "google/protobuf/struct.pb.h"
 #include "google/protobuf/util/json_util.h"
 #include "gtest/gtest.h"
-#include "deploy/progress_columns.h"
 #include "tests/deploy/cli/run_vantage.h"
 #include "tests/fakes/http_get.h"
 #include "tests/fakes/learner_process.h"
@@ -104,8 +104,7 @@ std::map<std::string, std::string> ScrapeTargets(const std::string& run) {
     EXPECT_EQ(labels.at("run").string_value(),
               std::filesystem::absolute(run).lexically_normal().string());
     EXPECT_EQ(labels.at("env").string_value(), "InvertedPendulum");
-    targets[who] =
-        fields.at("targets").list_value().values(0).string_value();
+    targets[who] = fields.at("targets").list_value().values(0).string_value();
   }
   return targets;
 }
@@ -149,8 +148,8 @@ TEST(DistributedTest, TrainRestartsAKilledActor) {
           : "actor-0";
   kill(actors[0], SIGKILL);
   std::map<std::string, std::string> after = targets;
-  for (int i = 0; i < 600 && after[killed] == targets[killed] &&
-                  kill(train, 0) == 0;
+  for (int i = 0;
+       i < 600 && after[killed] == targets[killed] && kill(train, 0) == 0;
        ++i) {
     std::this_thread::sleep_for(std::chrono::milliseconds(50));
     after = ScrapeTargets(run);

@@ -10,10 +10,10 @@
 
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_split.h"
 #include "absl/strings/strip.h"
 #include "absl/time/clock.h"
 #include "absl/time/time.h"
-#include "absl/strings/str_split.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
 #include "tests/fakes/http_get.h"
@@ -242,10 +242,10 @@ TEST(LearnerMetricsTest, StatisticsAreGaugesOrCountersByKind) {
   metrics->RecordUpdate(1, 4096, 3, 0.5, 7.0, 1000);
   // A statistic the algorithm has not got keeps its gauge; totals only
   // grow by their difference.
-  metrics->RecordStatistics({{"value_loss", "Critic loss.", nan},
-                             {"batch_rejected_segments_total", "Refused.", 6,
-                              true},
-                             {"env_steps_total", "Steps.", 4096, true}});
+  metrics->RecordStatistics(
+      {{"value_loss", "Critic loss.", nan},
+       {"batch_rejected_segments_total", "Refused.", 6, true},
+       {"env_steps_total", "Steps.", 4096, true}});
   const std::vector<std::string> lines = Scrape(*metrics);
   for (const char* line : {
            "vantage_learner_value_loss 2.5",
