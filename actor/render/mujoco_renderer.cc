@@ -1,6 +1,7 @@
 #include "actor/render/mujoco_renderer.h"
 
 #include <GL/osmesa.h>
+#include <dlfcn.h>
 
 #include <algorithm>
 #include <cmath>
@@ -98,9 +99,56 @@ void PaintSky(const float* depth, int width, int height, uint8_t* rgb) {
   }
 }
 
+// libOSMesa (and the LLVM it pulls in: ~50 MB of a process's memory and
+// ~50 ms of its start) is loaded at the first frame instead of linked, so
+// the actors and learners, which never render, do not carry it. RTLD_GLOBAL
+// puts its symbols in the process's global scope, where MuJoCo's GL loader
+// looks for OSMesaGetCurrentContext (docs/videos.md).
+struct OsmesaApi {
+  decltype(&OSMesaCreateContextExt) create_context = nullptr;
+  decltype(&OSMesaMakeCurrent) make_current = nullptr;
+  decltype(&OSMesaDestroyContext) destroy_context = nullptr;
+};
+
+absl::StatusOr<const OsmesaApi*> LoadOsmesa() {
+  static const absl::StatusOr<OsmesaApi>* const api =
+      new absl::StatusOr<OsmesaApi>([]() -> absl::StatusOr<OsmesaApi> {
+        void* library = nullptr;
+        for (const char* name : {"libOSMesa.so.8", "libOSMesa.so"}) {
+          library = dlopen(name, RTLD_NOW | RTLD_GLOBAL);
+          if (library != nullptr) break;
+        }
+        if (library == nullptr) {
+          return absl::FailedPreconditionError(absl::StrCat(
+              "MuJoCo renderer: cannot load libOSMesa (", dlerror(),
+              "; deploy/setup.sh installs libosmesa6-dev)"));
+        }
+        OsmesaApi loaded;
+        loaded.create_context =
+            reinterpret_cast<decltype(&OSMesaCreateContextExt)>(
+                dlsym(library, "OSMesaCreateContextExt"));
+        loaded.make_current = reinterpret_cast<decltype(&OSMesaMakeCurrent)>(
+            dlsym(library, "OSMesaMakeCurrent"));
+        loaded.destroy_context =
+            reinterpret_cast<decltype(&OSMesaDestroyContext)>(
+                dlsym(library, "OSMesaDestroyContext"));
+        if (loaded.create_context == nullptr ||
+            loaded.make_current == nullptr ||
+            loaded.destroy_context == nullptr) {
+          return absl::FailedPreconditionError(
+              "MuJoCo renderer: libOSMesa lacks OSMesaCreateContextExt, "
+              "OSMesaMakeCurrent or OSMesaDestroyContext");
+        }
+        return loaded;
+      }());
+  if (!api->ok()) return api->status();
+  return &**api;
+}
+
 struct OsmesaDeleter {
   void operator()(osmesa_context* context) const {
-    OSMesaDestroyContext(context);
+    // A context exists only once the library is loaded.
+    (*LoadOsmesa())->destroy_context(context);
   }
 };
 using OsmesaPtr = std::unique_ptr<osmesa_context, OsmesaDeleter>;
@@ -138,8 +186,9 @@ struct MujocoRenderer::Gl {
   double distance = 0.0;
 
   bool MakeCurrent(int width, int height) {
-    return OSMesaMakeCurrent(context.get(), window.data(), GL_UNSIGNED_BYTE,
-                             width, height);
+    return (*LoadOsmesa())
+        ->make_current(context.get(), window.data(), GL_UNSIGNED_BYTE, width,
+                       height);
   }
 };
 
@@ -149,10 +198,12 @@ absl::StatusOr<std::unique_ptr<MujocoRenderer>> MujocoRenderer::Create(
     return absl::InvalidArgumentError(absl::StrCat(
         "MuJoCo renderer: a frame of ", width, "x", height, " pixels"));
   }
+  absl::StatusOr<const OsmesaApi*> osmesa = LoadOsmesa();
+  if (!osmesa.ok()) return osmesa.status();
   auto gl = std::make_unique<Gl>();
   gl->window.resize(static_cast<size_t>(width) * height * 4);
   // RGBA with a 24-bit depth and 8-bit stencil buffer, as mjr needs.
-  gl->context.reset(OSMesaCreateContextExt(OSMESA_RGBA, 24, 8, 0, nullptr));
+  gl->context.reset((*osmesa)->create_context(OSMESA_RGBA, 24, 8, 0, nullptr));
   if (gl->context == nullptr) {
     return absl::InternalError(
         "MuJoCo renderer: OSMesa cannot create a context");
