@@ -203,10 +203,13 @@ absl::Status RunLearnerServer(
     metrics->SetQueueDepth(static_cast<int64_t>(queue.size()),
                            buffered_steps.load());
     std::vector<LearnerMetrics::ActorActivity> actors;
+    const absl::Time now = absl::Now();
     for (const ActorActivity& actor : gateway.activity()) {
-      actors.push_back(
-          {actor.actor_id, actor.accepted_steps,
-           absl::ToDoubleSeconds(actor.last_seen - absl::UnixEpoch())});
+      // An open stream is an actor heard from now, even one that waits
+      // for room in the queue.
+      const absl::Time seen = actor.connected ? now : actor.last_seen;
+      actors.push_back({actor.actor_id, actor.accepted_steps,
+                        absl::ToDoubleSeconds(seen - absl::UnixEpoch())});
     }
     metrics->RecordActorActivity(actors);
   };

@@ -6,7 +6,6 @@
 #include <fstream>
 
 #include "absl/strings/str_cat.h"
-#include "common/metrics/metrics_endpoint.h"
 #include "google/protobuf/struct.pb.h"
 #include "google/protobuf/util/json_util.h"
 
@@ -49,12 +48,12 @@ absl::Status WriteScrapeTargets(const std::string& path,
   return absl::OkStatus();
 }
 
-std::string ScrapeAddress(const std::string& bind_address, int port) {
-  const std::string resolved = ResolveMetricsAddress(bind_address);
-  std::string host = resolved.substr(0, resolved.rfind(':'));
-  if (host.empty() || host == "0.0.0.0" || host == "[::]" || host == "::") {
+std::string ScrapeAddress(const std::string& host, int port) {
+  if (host.empty() || host == "0.0.0.0" || host == "[::]") {
     char name[256] = {};
-    host = gethostname(name, sizeof(name) - 1) == 0 ? name : "localhost";
+    return absl::StrCat(
+        gethostname(name, sizeof(name) - 1) == 0 ? name : "localhost", ":",
+        port);
   }
   return absl::StrCat(host, ":", port);
 }

@@ -27,10 +27,11 @@ std::string ScrapeTargetsJson(const std::vector<ScrapeTarget>& targets);
 absl::Status WriteScrapeTargets(const std::string& path,
                                 const std::vector<ScrapeTarget>& targets);
 
-// The address to scrape an endpoint bound on `bind_address` ("IP:PORT" or
-// "PORT") at, once it serves on `port`: a wildcard bind is reached through
-// this machine's host name, anything else as bound.
-std::string ScrapeAddress(const std::string& bind_address, int port);
+// The address to scrape an endpoint bound on `host` ("127.0.0.1",
+// "0.0.0.0", "[::1]", a name) at, once it serves on `port`: a wildcard
+// bind is reached through this machine's host name, anything else as
+// bound.
+std::string ScrapeAddress(const std::string& host, int port);
 
 }  // namespace vantage
 

@@ -322,8 +322,8 @@ std::vector<ActorActivity> ActorGateway::activity() const {
   std::vector<ActorActivity> activity;
   activity.reserve(actors_.size());
   for (const auto& [actor_id, registration] : actors_) {
-    activity.push_back(
-        {actor_id, registration.accepted_steps, registration.last_seen});
+    activity.push_back({actor_id, registration.accepted_steps,
+                        registration.last_seen, registration.open_calls > 0});
   }
   return activity;
 }

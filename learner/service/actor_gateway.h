@@ -85,12 +85,14 @@ struct GatewayCounters {
   std::map<std::string, int64_t> rejected;  // reason -> segments or calls
 };
 
-// What one live registration has done: the steps of its admitted segments
-// and when it was last heard from.
+// What one live registration has done: the steps of its admitted segments,
+// when it was last heard from, and whether a call of it is open now (a
+// stream blocked by backpressure is one: the actor is there).
 struct ActorActivity {
   int64_t actor_id = 0;
   int64_t accepted_steps = 0;
   absl::Time last_seen;
+  bool connected = false;
 };
 
 class ActorGateway {
