@@ -12,6 +12,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <thread>
 #include <vector>
 
@@ -22,6 +23,7 @@
 #include "bench/consuming_learner.h"
 #include "bench/fastest.h"
 #include "bench/raw_physics.h"
+#include "common/net/port_file.h"
 #include "common/nn/networks.h"
 #include "common/util/self_process.h"
 #include "proto/vantage.grpc.pb.h"
@@ -270,9 +272,7 @@ ProcessFootprint FootprintOf(pid_t pid) {
 // Waits for `path` to hold a port; 0 if `pid` ends first or 60 s pass.
 int WaitForPortFile(pid_t pid, const std::string& path) {
   for (int i = 0; i < 3000; ++i) {
-    std::ifstream file(path);
-    int port = 0;
-    if (file >> port && port > 0) return port;
+    if (const std::optional<int> port = ReadPortFile(path)) return *port;
     if (waitpid(pid, nullptr, WNOHANG) == pid) return 0;
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }

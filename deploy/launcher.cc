@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <thread>
 #include <vector>
 
@@ -81,10 +82,9 @@ int WaitForPorts(const std::vector<pid_t>& pids,
   while (!stop && waiting > 0) {
     for (size_t rank = 0; rank < pids.size(); ++rank) {
       if (serving[rank]) continue;
-      std::ifstream file(port_files[rank]);
-      std::string line;
-      if (std::getline(file, line) && !line.empty()) {
-        ports[rank] = line;
+      if (const std::optional<int> port = ReadPortFile(port_files[rank]);
+          port.has_value()) {
+        ports[rank] = absl::StrCat(*port);
         serving[rank] = true;
         --waiting;
       } else if (waitpid(pids[rank], &status, WNOHANG) == pids[rank]) {
