@@ -24,7 +24,8 @@ LearnerConfig MakeLearnerConfig(const LocalTrainingConfig& config,
 
 absl::Status RunLocalTraining(
     const LocalTrainingConfig& config,
-    const std::function<bool(const ProgressRow&)>& on_update) {
+    const std::function<bool(const ProgressRow&)>& on_update,
+    const std::atomic<bool>* stop) {
   ActorConfig actor_config;
   actor_config.env = config.env;
   actor_config.num_envs = config.num_envs;
@@ -68,6 +69,7 @@ absl::Status RunLocalTraining(
   // One horizon of segments per version, all queued before the update.
   SegmentQueue queue(static_cast<size_t>(config.num_envs * rounds));
   while (!(*run)->done()) {
+    if (stop != nullptr && *stop) return (*run)->CheckpointNow(actor_state);
     if (absl::Status status = (*actor)->SetWeights(learner.CurrentWeights());
         !status.ok()) {
       return status;

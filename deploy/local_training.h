@@ -1,6 +1,7 @@
 #ifndef VANTAGE_DEPLOY_LOCAL_TRAINING_H_
 #define VANTAGE_DEPLOY_LOCAL_TRAINING_H_
 
+#include <atomic>
 #include <cstdint>
 #include <functional>
 #include <string>
@@ -47,10 +48,13 @@ LearnerConfig MakeLearnerConfig(const LocalTrainingConfig& config,
 // one horizon per environment with the latest weights, the learner updates
 // and publishes the next version. `on_update` sees every update (after its
 // progress row and checkpoint are written) and returns false to stop the
-// run there, as an interruption would (a later resume continues it).
+// run there, as an interruption would (a later resume continues it). Once
+// `stop` (if given) is set, the run stops after the update in progress with
+// a checkpoint of it, as a signalled learner does, and returns OK.
 absl::Status RunLocalTraining(
     const LocalTrainingConfig& config,
-    const std::function<bool(const ProgressRow&)>& on_update);
+    const std::function<bool(const ProgressRow&)>& on_update,
+    const std::atomic<bool>* stop = nullptr);
 
 }  // namespace vantage
 

@@ -14,7 +14,6 @@
 #include "absl/strings/str_split.h"
 
 namespace vantage {
-namespace {
 
 absl::Status WriteFileAtomically(const std::string& path,
                                  const std::string& text) {
@@ -33,8 +32,6 @@ absl::Status WriteFileAtomically(const std::string& path,
   }
   return absl::OkStatus();
 }
-
-}  // namespace
 
 absl::Status RunDirectory::CheckFree(const std::string& path) {
   if (std::filesystem::exists(RunDirectory(path).config_path())) {

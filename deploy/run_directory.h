@@ -16,6 +16,11 @@
 
 namespace vantage {
 
+// Writes `text` to `path` through a temporary file renamed over it, so a
+// reader never sees half of it.
+absl::Status WriteFileAtomically(const std::string& path,
+                                 const std::string& text);
+
 class RunDirectory {
  public:
   // Starts a new run in `path` (created if missing). A directory that

@@ -24,7 +24,8 @@ done
 # otherwise run on; serial, because every vantage process computes on one
 # thread of its own and several share the machine (docs/benchmarks.md).
 # prometheus (with promtool) serves deploy/prometheus/ and its test;
-# python3-matplotlib draws `vantage plot`'s figures. `vantage rollout
+# python3-matplotlib draws `vantage plot`'s figures and python3-scipy computes
+# the statistics of `vantage experiment report`. `vantage rollout
 # --video` renders MuJoCo offscreen on OSMesa (libosmesa6-dev), draws the
 # Bullet characters with Cairo (libcairo2-dev) and encodes with FFmpeg's
 # libraries (libav*-dev, libswscale-dev); its tests read the files back
@@ -39,7 +40,7 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   prometheus-cpp-dev
   libminizip-dev
-  prometheus python3-matplotlib
+  prometheus python3-matplotlib python3-scipy
   libosmesa6-dev libcairo2-dev
   libavcodec-dev libavformat-dev libswscale-dev libavutil-dev ffmpeg
 )

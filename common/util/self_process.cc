@@ -8,7 +8,7 @@
 namespace vantage {
 
 absl::StatusOr<pid_t> SpawnSelf(const std::vector<std::string>& args,
-                                const std::string& output_path) {
+                                const std::string& output_path, bool append) {
   std::error_code error;
   const std::string self =
       std::filesystem::read_symlink("/proc/self/exe", error).string();
@@ -24,7 +24,8 @@ absl::StatusOr<pid_t> SpawnSelf(const std::vector<std::string>& args,
   if (pid == 0) {
     if (!output_path.empty()) {
       const int fd =
-          open(output_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+          open(output_path.c_str(),
+               O_WRONLY | O_CREAT | (append ? O_APPEND : O_TRUNC), 0644);
       if (fd < 0) _exit(127);
       dup2(fd, STDOUT_FILENO);
       dup2(fd, STDERR_FILENO);

@@ -14,9 +14,11 @@
 namespace vantage {
 
 // Runs this binary with `args` (argv[1..]) as a child process; with
-// `output_path`, its stdout and stderr go to that file (truncated).
+// `output_path`, its stdout and stderr go to that file (truncated, or
+// appended to with `append`).
 absl::StatusOr<pid_t> SpawnSelf(const std::vector<std::string>& args,
-                                const std::string& output_path = "");
+                                const std::string& output_path = "",
+                                bool append = false);
 
 }  // namespace vantage
 

@@ -5,6 +5,7 @@
 #include "deploy/cli/actor_command.h"
 #include "deploy/cli/advantages_command.h"
 #include "deploy/cli/env_commands.h"
+#include "deploy/cli/experiment_command.h"
 #include "deploy/cli/learner_command.h"
 #include "deploy/cli/plot_command.h"
 #include "deploy/cli/train_command.h"
@@ -17,8 +18,9 @@ namespace vantage {
 const std::vector<Command>& AllCommands() {
   static const auto* commands = [] {
     auto* all = new std::vector<Command>{
-        ActorCommand(), AdvantagesCommand(), EnvsCommand(),  LearnerCommand(),
-        PlotCommand(),  RolloutCommand(),    TrainCommand(),
+        ActorCommand(),      AdvantagesCommand(), EnvsCommand(),
+        ExperimentCommand(), LearnerCommand(),    PlotCommand(),
+        RolloutCommand(),    TrainCommand(),
     };
 #ifdef VANTAGE_WITH_BENCHMARKS
     all->push_back(BenchCommand());

@@ -271,6 +271,12 @@ std::string RunConfigFieldText(const pb::RunConfig& config,
   return holder == nullptr ? "" : FieldText(*holder, *run_flag->field);
 }
 
+std::vector<std::string> RunSettingNames() {
+  std::vector<std::string> names = {"algo"};
+  for (const RunFlag& flag : RunFlags()) names.push_back(flag.name);
+  return names;
+}
+
 std::vector<std::string> RunFlagNames(bool with_mode) {
   std::vector<std::string> names;
   for (const RunFlag& flag : RunFlags()) {
@@ -325,10 +331,12 @@ std::map<std::string, std::string> RunFlagDefaults(bool with_mode) {
   return defaults;
 }
 
-absl::StatusOr<RunRequest> RunRequestFromFlags() {
+absl::StatusOr<RunRequest> RunRequestFromSettings(
+    const std::vector<std::pair<std::string, std::string>>& settings) {
   RunRequest request;
-  if (FlagGiven("algo")) {
-    request.algo = absl::GetFlag(FLAGS_algo);
+  for (const auto& [name, text] : settings) {
+    if (name != "algo") continue;
+    request.algo = text;
     request.given_flags.push_back("algo");
     if (absl::Status status = SelectAlgorithm(request.algo, request.flags);
         !status.ok()) {
@@ -337,39 +345,58 @@ absl::StatusOr<RunRequest> RunRequestFromFlags() {
     }
   }
   const RunFlag* algorithm_flag = nullptr;
-  for (const RunFlag& flag : RunFlags()) {
-    if (!FlagGiven(flag.name)) continue;
-    request.given_flags.push_back(flag.name);
-    if (flag.algorithm()) {
-      const std::string& algo = flag.section->name();
+  for (const auto& [name, text] : settings) {
+    if (name == "algo") continue;
+    const RunFlag* flag = FindRunFlag(name);
+    if (flag == nullptr) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("'", name, "' is not a run setting; the run flags: ",
+                       absl::StrJoin(RunSettingNames(), ", ")));
+    }
+    request.given_flags.push_back(name);
+    if (flag->algorithm()) {
+      const std::string& algo = flag->section->name();
       if (!request.algo.empty() && algo != request.algo) {
         return absl::InvalidArgumentError(
-            absl::StrCat("--", flag.name, " is a ", algo,
+            absl::StrCat("--", name, " is a ", algo,
                          " setting; this run's --algo is ", request.algo));
       }
       if (algorithm_flag != nullptr &&
-          algorithm_flag->section != flag.section) {
+          algorithm_flag->section != flag->section) {
         return absl::InvalidArgumentError(absl::StrCat(
-            "--", algorithm_flag->name, " and --", flag.name,
+            "--", algorithm_flag->name, " and --", name,
             " are settings of two algorithms; choose one with --algo"));
       }
-      algorithm_flag = &flag;
+      algorithm_flag = flag;
     }
+    if (absl::Status status = SetField(*flag, text, request.flags);
+        !status.ok()) {
+      return status;
+    }
+  }
+  return request;
+}
+
+absl::StatusOr<RunRequest> RunRequestFromFlags() {
+  std::vector<std::pair<std::string, std::string>> settings;
+  if (FlagGiven("algo")) {
+    settings.emplace_back("algo", absl::GetFlag(FLAGS_algo));
+  }
+  for (const RunFlag& flag : RunFlags()) {
+    if (!FlagGiven(flag.name)) continue;
     const absl::CommandLineFlag* absl_flag =
         absl::FindCommandLineFlag(flag.name);
     if (absl_flag == nullptr) {
       return absl::InternalError(
           absl::StrCat("run-config field ", flag.name, " has no flag"));
     }
-    if (absl::Status status =
-            SetField(flag, absl_flag->CurrentValue(), request.flags);
-        !status.ok()) {
-      return status;
-    }
+    settings.emplace_back(flag.name, absl_flag->CurrentValue());
   }
-  request.config_file = absl::GetFlag(FLAGS_config);
-  request.run_dir = absl::GetFlag(FLAGS_run_dir);
-  request.resume = absl::GetFlag(FLAGS_resume);
+  absl::StatusOr<RunRequest> request = RunRequestFromSettings(settings);
+  if (!request.ok()) return request.status();
+  request->config_file = absl::GetFlag(FLAGS_config);
+  request->run_dir = absl::GetFlag(FLAGS_run_dir);
+  request->resume = absl::GetFlag(FLAGS_resume);
   return request;
 }
 

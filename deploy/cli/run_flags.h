@@ -9,6 +9,7 @@
 
 #include <map>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "absl/status/statusor.h"
@@ -33,6 +34,16 @@ std::string RunConfigFieldText(const pb::RunConfig& config,
 // The given run flags; an unparsable value, or a setting of an algorithm
 // other than --algo's, is an error naming the flag.
 absl::StatusOr<RunRequest> RunRequestFromFlags();
+
+// The same from (flag name, value as on a command line) pairs, as an
+// experiment's cells set them; a name that is no run flag is an error that
+// lists them. Only `flags`, `algo` and `given_flags` are filled.
+absl::StatusOr<RunRequest> RunRequestFromSettings(
+    const std::vector<std::pair<std::string, std::string>>& settings);
+
+// The flags a run setting may name: --algo and one per run-config field
+// (not --config, --run_dir or --resume).
+std::vector<std::string> RunSettingNames();
 
 }  // namespace vantage
 

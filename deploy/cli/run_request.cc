@@ -14,7 +14,9 @@ namespace {
 // The given config file (if any) with the given flags on top.
 absl::StatusOr<pb::RunConfig> MergeFlags(const RunRequest& request) {
   pb::RunConfig config;
-  if (!request.config_file.empty()) {
+  if (request.config.has_value()) {
+    config = *request.config;
+  } else if (!request.config_file.empty()) {
     absl::StatusOr<pb::RunConfig> file = ReadRunConfigFile(request.config_file);
     if (!file.ok()) return file.status();
     config = *file;

@@ -5,6 +5,7 @@
 // (a config file, the flags given on top, or a run to resume), and the one
 // resolved configuration that comes out.
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -25,8 +26,11 @@ struct RunRequest {
   // must be the file's algorithm's.
   std::string algo;
   std::string config_file;  // --config: JSON RunConfig under the flags
-  std::string run_dir;      // --run_dir: where the run is recorded
-  std::string resume;       // --resume: a run directory to continue
+  // A config already read, used instead of reading `config_file` (which
+  // then only names it in messages).
+  std::optional<pb::RunConfig> config;
+  std::string run_dir;  // --run_dir: where the run is recorded
+  std::string resume;   // --resume: a run directory to continue
 };
 
 struct ResolvedRun {

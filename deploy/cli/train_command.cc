@@ -94,8 +94,10 @@ int RunLocal(const ResolvedRun& run) {
   const bool terminal = ::isatty(STDOUT_FILENO) == 1;
   ProgressRow last;
   last.mean_return = std::nan("");
-  const absl::Status status =
-      RunLocalTraining(local, [&](const ProgressRow& progress) {
+  const std::atomic<bool>& stop = StopRequested();
+  const absl::Status status = RunLocalTraining(
+      local,
+      [&](const ProgressRow& progress) {
         last = progress;
         if (!terminal) return true;
         const double remaining =
@@ -111,9 +113,18 @@ int RunLocal(const ResolvedRun& run) {
             Duration(remaining).c_str());
         std::fflush(stdout);
         return true;
-      });
+      },
+      &stop);
   if (terminal) std::printf("\n");
   if (!status.ok()) return Fail(kRuntimeError, status.message());
+  if (stop && last.stats.env_steps < config.training().steps()) {
+    std::printf("stopped at %ld of %ld steps%s%s\n",
+                static_cast<long>(last.stats.env_steps),
+                static_cast<long>(config.training().steps()),
+                local.run_dir.empty() ? "" : "; continue with --resume=",
+                local.run_dir.c_str());
+    return 0;
+  }
   PrintTrainResult(config, last);
   return 0;
 }

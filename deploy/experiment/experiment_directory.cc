@@ -1,0 +1,155 @@
+#include "deploy/experiment/experiment_directory.h"
+
+#include <filesystem>
+#include <fstream>
+
+#include "absl/strings/numbers.h"
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_split.h"
+#include "deploy/run_config.h"
+#include "deploy/run_directory.h"
+#include "google/protobuf/util/json_util.h"
+#include "google/protobuf/util/message_differencer.h"
+#include "learner/checkpoint.h"
+
+namespace vantage {
+namespace {
+
+std::string JsonOf(const google::protobuf::Message& message) {
+  google::protobuf::util::JsonPrintOptions options;
+  options.add_whitespace = true;
+  options.preserve_proto_field_names = true;
+  std::string json;
+  // Messages of known types always print.
+  (void)google::protobuf::util::MessageToJsonString(message, &json, options);
+  return json;
+}
+
+// The first difference between two run configs, as "field: a vs b".
+std::string FirstDifference(const pb::RunConfig& held,
+                            const pb::RunConfig& wanted) {
+  std::string report;
+  google::protobuf::util::MessageDifferencer differencer;
+  differencer.ReportDifferencesToString(&report);
+  differencer.Compare(wanted, held);
+  const std::vector<std::string> lines =
+      absl::StrSplit(report, '\n', absl::SkipEmpty());
+  return lines.empty() ? "the configs differ" : lines.front();
+}
+
+}  // namespace
+
+std::string ExpandedExperimentToJson(const pb::ExpandedExperiment& experiment) {
+  return JsonOf(experiment);
+}
+
+std::string ExperimentDirectory::RunDir(const pb::ExperimentCell& cell) const {
+  return absl::StrCat(path_, "/", cell.dir());
+}
+
+std::string ExperimentDirectory::LogPath(const pb::ExperimentCell& cell) const {
+  return absl::StrCat(RunDir(cell), "/train.log");
+}
+
+std::string ExperimentDirectory::BaseConfigPath() const {
+  return path_ + "/base.json";
+}
+
+std::string ExperimentDirectory::ExperimentPath() const {
+  return path_ + "/experiment.json";
+}
+
+absl::Status ExperimentDirectory::CheckRuns(
+    const pb::ExpandedExperiment& experiment) const {
+  for (const pb::ExperimentCell& cell : experiment.cells()) {
+    const std::string config_path = RunDir(cell) + "/config.json";
+    if (!std::filesystem::exists(config_path)) continue;
+    absl::StatusOr<pb::RunConfig> held = ReadRunConfigFile(config_path);
+    if (!held.ok()) {
+      return absl::FailedPreconditionError(
+          absl::StrCat(RunDir(cell),
+                       " holds a run this experiment cannot "
+                       "read: ",
+                       held.status().message()));
+    }
+    if (!google::protobuf::util::MessageDifferencer::Equals(*held,
+                                                            cell.config())) {
+      return absl::FailedPreconditionError(absl::StrCat(
+          RunDir(cell),
+          " holds a run made with other settings than this experiment's "
+          "cell (",
+          FirstDifference(*held, cell.config()),
+          "): the experiment file or --budget changed; use another --out "
+          "or remove that run"));
+    }
+  }
+  return absl::OkStatus();
+}
+
+absl::Status ExperimentDirectory::Prepare(
+    const pb::ExpandedExperiment& experiment, const pb::RunConfig& base) const {
+  if (absl::Status status = CheckRuns(experiment); !status.ok()) return status;
+  std::error_code error;
+  std::filesystem::create_directories(path_, error);
+  if (error) {
+    return absl::FailedPreconditionError(absl::StrCat(
+        "cannot create experiment directory ", path_, ": ", error.message()));
+  }
+  if (absl::Status status = WriteFileAtomically(BaseConfigPath(), JsonOf(base));
+      !status.ok()) {
+    return status;
+  }
+  return WriteFileAtomically(ExperimentPath(),
+                             ExpandedExperimentToJson(experiment));
+}
+
+int64_t LastProgressSteps(const std::string& run_dir) {
+  std::ifstream file(run_dir + "/progress.csv");
+  std::string line;
+  int64_t steps = 0;
+  bool header = true;
+  while (std::getline(file, line)) {
+    if (header) {
+      header = false;
+      continue;
+    }
+    const std::vector<absl::string_view> fields = absl::StrSplit(line, ',');
+    int64_t row_steps = 0;
+    // A torn last line (a killed run) counts for nothing.
+    if (fields.size() < 2 || !absl::SimpleAtoi(fields[0], &row_steps)) break;
+    steps = row_steps;
+  }
+  return steps;
+}
+
+CellStatus ExperimentDirectory::Inspect(const pb::ExperimentCell& cell) const {
+  CellStatus status;
+  const std::string run_dir = RunDir(cell);
+  if (!std::filesystem::exists(run_dir + "/config.json")) return status;
+  status.env_steps = LastProgressSteps(run_dir);
+  if (status.env_steps >= cell.config().training().steps()) {
+    status.state = CellState::kFinished;
+  } else if (!ListCheckpoints(run_dir + "/checkpoints").empty()) {
+    status.state = CellState::kResumable;
+  } else {
+    status.state = CellState::kNoCheckpoint;
+  }
+  return status;
+}
+
+absl::Status ExperimentDirectory::ClearRun(
+    const pb::ExperimentCell& cell) const {
+  const std::string run_dir = RunDir(cell);
+  for (const char* name :
+       {"config.json", "progress.csv", "checkpoints", "launch"}) {
+    std::error_code error;
+    std::filesystem::remove_all(absl::StrCat(run_dir, "/", name), error);
+    if (error) {
+      return absl::InternalError(absl::StrCat("cannot remove ", run_dir, "/",
+                                              name, ": ", error.message()));
+    }
+  }
+  return absl::OkStatus();
+}
+
+}  // namespace vantage

@@ -1,0 +1,146 @@
+#include "deploy/experiment/experiment_runner.h"
+
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <map>
+#include <thread>
+
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_join.h"
+#include "deploy/experiment/experiment_backend.h"
+
+namespace vantage {
+namespace {
+
+int CoresPerCell(const pb::RunConfig& config) {
+  if (config.mode() != "distributed") return 1;
+  return std::max(
+      1, config.distributed().learners() + config.distributed().actors());
+}
+
+}  // namespace
+
+int DefaultJobs(const pb::ExpandedExperiment& experiment) {
+  int widest = 1;
+  for (const pb::ExperimentCell& cell : experiment.cells()) {
+    widest = std::max(widest, CoresPerCell(cell.config()));
+  }
+  const int cores =
+      std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+  return std::max(1, cores / widest);
+}
+
+std::vector<std::string> TrainArguments(const ExperimentDirectory& directory,
+                                        const pb::ExperimentCell& cell,
+                                        bool resume) {
+  const std::string run_dir = directory.RunDir(cell);
+  if (resume) return {"train", absl::StrCat("--resume=", run_dir)};
+  std::vector<std::string> args = {
+      "train", absl::StrCat("--config=", directory.BaseConfigPath())};
+  // Sorted, so that the same cell is always the same command.
+  const std::map<std::string, std::string> flags(cell.flags().begin(),
+                                                 cell.flags().end());
+  for (const auto& [flag, value] : flags) {
+    args.push_back(absl::StrCat("--", flag, "=", value));
+  }
+  args.push_back(absl::StrCat("--run_dir=", run_dir));
+  return args;
+}
+
+absl::Status RunExperiment(const pb::ExpandedExperiment& experiment,
+                           const pb::RunConfig& base,
+                           const ExperimentRunOptions& options,
+                           const std::atomic<bool>& stop) {
+  const ExperimentDirectory directory(options.exp_dir);
+  if (absl::Status status = directory.Prepare(experiment, base); !status.ok()) {
+    return status;
+  }
+  BackendOptions backend_options;
+  backend_options.jobs =
+      options.jobs > 0 ? options.jobs : DefaultJobs(experiment);
+  absl::StatusOr<std::unique_ptr<ExperimentBackend>> backend =
+      MakeExperimentBackend(options.backend, backend_options);
+  if (!backend.ok()) return backend.status();
+
+  GridTotals totals;
+  totals.cells = experiment.cells_size();
+  std::vector<CellTask> tasks;
+  int resumed = 0;
+  for (const pb::ExperimentCell& cell : experiment.cells()) {
+    const int64_t steps = cell.config().training().steps();
+    totals.steps += steps;
+    CellStatus status = directory.Inspect(cell);
+    if (status.state == CellState::kFinished) {
+      ++totals.finished_before;
+      totals.steps_before += steps;
+      continue;
+    }
+    if (status.state == CellState::kNoCheckpoint) {
+      std::printf(
+          "experiment: %s stopped before its first checkpoint; starting it "
+          "again\n",
+          cell.dir().c_str());
+      if (absl::Status cleared = directory.ClearRun(cell); !cleared.ok()) {
+        return cleared;
+      }
+      status = CellStatus();
+    }
+    const bool resume = status.state == CellState::kResumable;
+    resumed += resume ? 1 : 0;
+    totals.steps_before += status.env_steps;
+    std::error_code error;
+    std::filesystem::create_directories(directory.RunDir(cell), error);
+    if (error) {
+      return absl::FailedPreconditionError(absl::StrCat(
+          "cannot create ", directory.RunDir(cell), ": ", error.message()));
+    }
+    CellTask task;
+    task.name = cell.dir();
+    task.train_args = TrainArguments(directory, cell, resume);
+    task.run_dir = directory.RunDir(cell);
+    task.log_path = directory.LogPath(cell);
+    task.steps = steps;
+    tasks.push_back(std::move(task));
+  }
+  std::printf(
+      "experiment %s: %d cells (%d finished, %d to resume, %zu to start), "
+      "%d at a time (%s backend), in %s\n",
+      experiment.name().empty() ? "(unnamed)" : experiment.name().c_str(),
+      totals.cells, totals.finished_before, resumed, tasks.size() - resumed,
+      backend_options.jobs, options.backend.c_str(), options.exp_dir.c_str());
+  std::fflush(stdout);
+  const std::vector<CellOutcome> outcomes =
+      (*backend)->Run(tasks, totals, stop);
+
+  std::vector<std::string> failed;
+  int stopped = 0;
+  for (size_t i = 0; i < tasks.size(); ++i) {
+    if (outcomes[i].kind == CellOutcome::Kind::kFailed) {
+      failed.push_back(tasks[i].name);
+    } else if (outcomes[i].kind == CellOutcome::Kind::kStopped) {
+      ++stopped;
+    }
+  }
+  const int finished = totals.cells - static_cast<int>(failed.size()) - stopped;
+  std::printf("experiment %s: %d of %d cells finished\n",
+              experiment.name().c_str(), finished, totals.cells);
+  std::fflush(stdout);
+  if (!failed.empty()) {
+    return absl::AbortedError(
+        absl::StrCat(failed.size(), " of ", totals.cells,
+                     " cells failed (their train.log says why): ",
+                     absl::StrJoin(failed, ", "),
+                     stopped > 0 ? absl::StrCat("; ", stopped, " stopped") : "",
+                     "; the same command again retries them"));
+  }
+  if (stopped > 0) {
+    return absl::CancelledError(
+        absl::StrCat("stopped with ", stopped,
+                     " cells unfinished; the same command again resumes "
+                     "them"));
+  }
+  return absl::OkStatus();
+}
+
+}  // namespace vantage

@@ -1,0 +1,246 @@
+// The "local" experiment backend: cells as child processes of this binary
+// on this machine, `jobs` at a time, with one progress line for the grid.
+
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <map>
+#include <thread>
+
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
+#include "common/util/self_process.h"
+#include "deploy/experiment/experiment_backend.h"
+#include "deploy/experiment/experiment_directory.h"
+
+namespace vantage {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// How long a stopped cell may take to write its checkpoint and exit (a
+// distributed one stops its learner and actors first).
+constexpr std::chrono::seconds kStopGrace(120);
+
+std::string LastLine(const std::string& path) {
+  std::ifstream file(path);
+  std::string line;
+  std::string last;
+  while (std::getline(file, line)) {
+    if (!line.empty()) last = line;
+  }
+  return last;
+}
+
+std::string Duration(double seconds) {
+  if (!std::isfinite(seconds) || seconds < 0) return "?";
+  const long s = std::lround(seconds);
+  if (s >= 3600) return absl::StrCat(s / 3600, "h", (s % 3600) / 60, "m");
+  return absl::StrCat(s / 60, "m", s % 60, "s");
+}
+
+std::string Count(double value) {
+  if (value >= 1e6) return absl::StrFormat("%.2fM", value / 1e6);
+  if (value >= 1e4) return absl::StrFormat("%.1fk", value / 1e3);
+  return absl::StrFormat("%.0f", value);
+}
+
+class LocalBackend : public ExperimentBackend {
+ public:
+  explicit LocalBackend(const BackendOptions& options)
+      : jobs_(std::max(1, options.jobs)) {}
+
+  std::vector<CellOutcome> Run(const std::vector<CellTask>& tasks,
+                               const GridTotals& totals,
+                               const std::atomic<bool>& stop) override {
+    std::vector<CellOutcome> outcomes(tasks.size());
+    for (CellOutcome& outcome : outcomes) {
+      outcome.kind = CellOutcome::Kind::kStopped;
+      outcome.message = "not started";
+    }
+    std::map<pid_t, size_t> running;
+    size_t next = 0;
+    const Clock::time_point started = Clock::now();
+    Progress progress{totals, started};
+    std::vector<bool> started_task(tasks.size(), false);
+    std::vector<int64_t> start_steps;
+    for (const CellTask& task : tasks) {
+      start_steps.push_back(LastProgressSteps(task.run_dir));
+    }
+    while (true) {
+      if (stop) {
+        StopAll(running, tasks, outcomes);
+        break;
+      }
+      while (static_cast<int>(running.size()) < jobs_ && next < tasks.size()) {
+        const CellTask& task = tasks[next];
+        absl::StatusOr<pid_t> pid =
+            SpawnSelf(task.train_args, task.log_path, /*append=*/true);
+        if (pid.ok()) {
+          running[*pid] = next;
+          started_task[next] = true;
+        } else {
+          outcomes[next] = {CellOutcome::Kind::kFailed,
+                            std::string(pid.status().message())};
+          ++progress.failed;
+          Report(progress, "failed", task.name, outcomes[next].message);
+        }
+        ++next;
+      }
+      if (running.empty() && next >= tasks.size()) break;
+      for (auto it = running.begin(); it != running.end();) {
+        int status = 0;
+        if (waitpid(it->first, &status, WNOHANG) != it->first) {
+          ++it;
+          continue;
+        }
+        const CellTask& task = tasks[it->second];
+        CellOutcome& outcome = outcomes[it->second];
+        outcome = Classify(task, status, stop);
+        it = running.erase(it);
+        progress.running = static_cast<int>(running.size());
+        if (outcome.kind == CellOutcome::Kind::kFinished) {
+          ++progress.finished;
+          Report(progress, "finished", task.name, "");
+        } else if (outcome.kind == CellOutcome::Kind::kFailed) {
+          ++progress.failed;
+          Report(progress, "failed", task.name, outcome.message);
+        }
+      }
+      progress.running = static_cast<int>(running.size());
+      progress.waiting = static_cast<int>(tasks.size() - next);
+      int64_t steps = totals.steps_before;
+      for (size_t i = 0; i < tasks.size(); ++i) {
+        if (started_task[i]) {
+          steps += LastProgressSteps(tasks[i].run_dir) - start_steps[i];
+        }
+      }
+      progress.steps = steps;
+      PrintProgress(progress);
+      std::this_thread::sleep_for(std::chrono::milliseconds(200));
+    }
+    if (terminal_) std::printf("\n");
+    std::fflush(stdout);
+    return outcomes;
+  }
+
+ private:
+  struct Progress {
+    GridTotals totals;
+    Clock::time_point started;
+    int finished = 0;
+    int failed = 0;
+    int running = 0;
+    int waiting = 0;
+    int64_t steps = 0;
+  };
+
+  // How a cell's command ended: its progress.csv says whether the run is
+  // complete; `stopped` tells an interruption from a failure.
+  static CellOutcome Classify(const CellTask& task, int status, bool stopped) {
+    const int64_t steps = LastProgressSteps(task.run_dir);
+    if (steps >= task.steps) return {CellOutcome::Kind::kFinished, ""};
+    if (stopped) {
+      return {CellOutcome::Kind::kStopped,
+              absl::StrCat("stopped at ", steps, " of ", task.steps, " steps")};
+    }
+    std::string how;
+    if (WIFEXITED(status)) {
+      how = absl::StrCat("exit code ", WEXITSTATUS(status));
+    } else if (WIFSIGNALED(status)) {
+      how = absl::StrCat("signal ", WTERMSIG(status));
+    }
+    return {CellOutcome::Kind::kFailed,
+            absl::StrCat(how, " at ", steps, " of ", task.steps, " steps; ",
+                         task.log_path, ": ", LastLine(task.log_path))};
+  }
+
+  void StopAll(std::map<pid_t, size_t>& running,
+               const std::vector<CellTask>& tasks,
+               std::vector<CellOutcome>& outcomes) {
+    if (terminal_) std::printf("\n");
+    std::printf(
+        "experiment: stopping %zu running cells (each writes a "
+        "checkpoint)\n",
+        running.size());
+    std::fflush(stdout);
+    for (const auto& [pid, index] : running) kill(pid, SIGTERM);
+    const Clock::time_point deadline = Clock::now() + kStopGrace;
+    for (const auto& [pid, index] : running) {
+      int status = 0;
+      while (waitpid(pid, &status, WNOHANG) == 0) {
+        if (Clock::now() > deadline) {
+          kill(pid, SIGKILL);
+          waitpid(pid, &status, 0);
+          break;
+        }
+        std::this_thread::sleep_for(std::chrono::milliseconds(50));
+      }
+      outcomes[index] = Classify(tasks[index], status, /*stopped=*/true);
+    }
+    running.clear();
+  }
+
+  void Report(const Progress& progress, const char* what,
+              const std::string& name, const std::string& message) {
+    if (terminal_) std::printf("\r\033[K");
+    std::printf("experiment: %s %s%s%s\n", what, name.c_str(),
+                message.empty() ? "" : ": ", message.c_str());
+    last_line_.clear();
+    PrintProgress(progress);
+  }
+
+  void PrintProgress(const Progress& p) {
+    const double elapsed =
+        std::chrono::duration<double>(Clock::now() - p.started).count();
+    const double rate =
+        elapsed > 0 ? (p.steps - p.totals.steps_before) / elapsed : 0;
+    const double remaining = static_cast<double>(p.totals.steps - p.steps);
+    const std::string counts =
+        absl::StrFormat("cells %d/%d done, %d running, %d failed, %d waiting",
+                        p.totals.finished_before + p.finished, p.totals.cells,
+                        p.running, p.failed, p.waiting);
+    const std::string line = absl::StrCat(
+        counts, " | steps ", Count(static_cast<double>(p.steps)), "/",
+        Count(static_cast<double>(p.totals.steps)), ", ", Count(rate),
+        " steps/s, ETA ", rate > 0 ? Duration(remaining / rate) : "?");
+    const Clock::time_point now = Clock::now();
+    if (terminal_) {
+      if (now - last_print_ < std::chrono::seconds(1) && !last_line_.empty()) {
+        return;
+      }
+      std::printf("\r\033[Kexperiment: %s", line.c_str());
+    } else {
+      // A log gets a line when the counts change, and once a minute.
+      if (counts == last_counts_ &&
+          now - last_print_ < std::chrono::seconds(60)) {
+        return;
+      }
+      std::printf("experiment: %s\n", line.c_str());
+    }
+    std::fflush(stdout);
+    last_print_ = now;
+    last_line_ = line;
+    last_counts_ = counts;
+  }
+
+  const int jobs_;
+  const bool terminal_ = ::isatty(STDOUT_FILENO) == 1;
+  Clock::time_point last_print_;
+  std::string last_line_;
+  std::string last_counts_;
+};
+
+}  // namespace
+
+absl::StatusOr<std::unique_ptr<ExperimentBackend>> MakeLocalBackend(
+    const BackendOptions& options) {
+  return std::make_unique<LocalBackend>(options);
+}
+
+}  // namespace vantage

@@ -1,0 +1,396 @@
+#!/usr/bin/python3
+"""The report of an experiment directory made by `vantage experiment run`.
+
+`vantage experiment report` executes this file with Debian's
+/usr/bin/python3 and passes its arguments through; `--help` prints USAGE.
+Statistics come from scipy (python3-scipy), figures from the plotting
+script (deploy/plot/plot_runs.py, matplotlib).
+
+Exit codes follow the vantage CLI: 0 done, 2 a usage error (flags, the
+directory and the files in it), 1 a failure while running.
+"""
+
+import argparse
+import csv
+import json
+import math
+import os
+import statistics
+import sys
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)),
+                                "..", "plot"))
+import plot_runs  # noqa: E402  (the figures; found beside this folder)
+
+PROG = "vantage experiment report"
+USAGE_ERROR = 2
+RUNTIME_ERROR = 1
+CONFIDENCE = 0.95
+RESAMPLES = 10000
+# Flags that place a cell or that the comparison is about: a group's
+# baseline is the group with the same other settings.
+NOT_MATCHED = {"env", "seed", "steps", "estimator", "rho", "ensemble"}
+
+USAGE = """\
+usage: vantage experiment report EXP_DIR [flags]
+
+  Writes a Markdown report of the experiment in EXP_DIR (made by `vantage
+  experiment run`): per env, a table of every group of cells (its
+  settings but the seed) over its finished runs: the final return (the
+  last progress.csv row's mean_return, the mean of the last 100 episodes)
+  as mean +- sample sd and the number of runs, the area under the learning
+  curve (as the mean return over training: the trapezoidal area under
+  mean_return against env_steps divided by the steps it spans), the steps
+  at which mean_return first reached the env's threshold (median over the
+  runs that reached it), and the difference of the final return to the
+  baseline group (the --baseline estimator with the same other settings)
+  with a 95% percentile-bootstrap confidence interval (10,000 resamples
+  of the seeds of each group, seeded, so reports repeat) and Welch's
+  t-test p-value. A group beats (or trails) the baseline "with
+  confidence" when the interval excludes 0 and p < 0.05; the report says
+  so in words. Unfinished cells are listed, not counted. One learning-
+  curve figure per env (`vantage plot`) goes beside the report.
+  Ends with a line `wrote FILE: E envs, G groups, R finished runs`.
+
+flags:
+  --out=EXP_DIR/report.md
+      the Markdown file to write (its figures go to a figures/ folder
+      beside it)
+  --baseline=""
+      the estimator every group is compared with (empty: the experiment's
+      report.baseline, itself gae by default)
+  --threshold=""
+      ENV=RETURN[,ENV=RETURN...]: the returns whose first crossing is
+      reported (empty: the experiment's report.thresholds)
+  --no_figures
+      write the tables only
+  --help
+      this text
+
+example:
+  vantage experiment report experiments/mujoco --threshold=Hopper=1000
+"""
+
+
+class ReportError(Exception):
+
+  def __init__(self, message, code=USAGE_ERROR):
+    super().__init__(message)
+    self.code = code
+
+
+class _ArgumentParser(argparse.ArgumentParser):
+
+  def error(self, message):
+    raise ReportError(message)
+
+
+def parse_arguments(argv):
+  if any(a in ("--help", "-h", "-help") for a in argv):
+    print(USAGE, end="")
+    sys.exit(0)
+  parser = _ArgumentParser(prog=PROG, add_help=False)
+  parser.add_argument("exp_dir", nargs="?")
+  parser.add_argument("--out", default="")
+  parser.add_argument("--baseline", default="")
+  parser.add_argument("--threshold", default="")
+  parser.add_argument("--no_figures", action="store_true")
+  args = parser.parse_args(argv)
+  if not args.exp_dir:
+    raise ReportError("name the experiment directory: vantage experiment "
+                      "report EXP_DIR")
+  args.thresholds = {}
+  for entry in filter(None, args.threshold.split(",")):
+    env, _, value = entry.partition("=")
+    try:
+      number = float(value)
+    except ValueError:
+      number = math.nan
+    if not env or not math.isfinite(number):
+      raise ReportError(f"--threshold entry '{entry}' is not ENV=RETURN")
+    args.thresholds[env] = number
+  return args
+
+
+def read_experiment(exp_dir):
+  path = os.path.join(exp_dir, "experiment.json")
+  if not os.path.isdir(exp_dir):
+    raise ReportError(f"no such directory: {exp_dir}")
+  try:
+    with open(path, encoding="utf-8") as f:
+      experiment = json.load(f)
+  except FileNotFoundError:
+    raise ReportError(f"{exp_dir} holds no experiment.json (made by "
+                      f"`vantage experiment run`)")
+  except (OSError, UnicodeDecodeError, json.JSONDecodeError) as e:
+    raise ReportError(f"{path}: cannot read it ({e})")
+  cells = experiment.get("cells") if isinstance(experiment, dict) else None
+  if not isinstance(cells, list) or not cells:
+    raise ReportError(f"{path}: lists no cells")
+  for i, cell in enumerate(cells):
+    for key in ("dir", "env", "group", "config"):
+      if key not in cell:
+        raise ReportError(f"{path}: cells[{i}] has no \"{key}\"")
+  return experiment
+
+
+def read_curve(run_dir):
+  """(env_steps, mean_return) pairs of the rows with a return, or None."""
+  path = os.path.join(run_dir, "progress.csv")
+  if not os.path.isfile(path):
+    return None
+  with open(path, newline="", encoding="utf-8") as f:
+    lines = [row for row in csv.reader(f) if row]
+  if len(lines) < 2:
+    return []
+  columns = lines[0]
+  try:
+    xi, yi = columns.index("env_steps"), columns.index("mean_return")
+  except ValueError:
+    raise ReportError(f"{path}: no env_steps or mean_return column")
+  curve = []
+  for row in lines[1:]:
+    if len(row) != len(columns):
+      break  # a torn last line of a run that was killed
+    try:
+      x, y = float(row[xi]), float(row[yi]) if row[yi] else math.nan
+    except ValueError:
+      raise ReportError(f"{path}: a row with a non-number: {','.join(row)}")
+    curve.append((x, y))
+  return curve
+
+
+class RunResult:
+
+  def __init__(self, cell, curve):
+    self.cell = cell
+    self.curve = curve
+    steps = int(cell["config"]["training"]["steps"])
+    self.finished = bool(curve) and curve[-1][0] >= steps
+    finite = [(x, y) for x, y in curve or [] if math.isfinite(y)]
+    self.final = curve[-1][1] if curve else math.nan
+    if len(finite) >= 2 and finite[-1][0] > finite[0][0]:
+      area = sum((x1 - x0) * (y0 + y1) / 2
+                 for (x0, y0), (x1, y1) in zip(finite, finite[1:]))
+      self.auc = area / (finite[-1][0] - finite[0][0])
+    else:
+      self.auc = finite[0][1] if finite else math.nan
+
+  def steps_to(self, threshold):
+    for x, y in self.curve:
+      if math.isfinite(y) and y >= threshold:
+        return x
+    return None
+
+
+def group_key(cell):
+  """What a group's baseline must share with it."""
+  flags = cell.get("flags", {})
+  return tuple(sorted((k, v) for k, v in flags.items()
+                      if k not in NOT_MATCHED))
+
+
+def estimator_of(cell):
+  return cell["config"].get("advantage", {}).get("estimator", "gae")
+
+
+def mean_sd(values):
+  import numpy as np
+  if not values:
+    return math.nan, math.nan
+  sd = float(np.std(values, ddof=1)) if len(values) > 1 else math.nan
+  return float(np.mean(values)), sd
+
+
+def compare(values, baseline):
+  """(difference of means, CI low, CI high, Welch p); NaNs where n < 2."""
+  import numpy as np
+  from scipy import stats
+  difference = float(np.mean(values) - np.mean(baseline))
+  if len(values) < 2 or len(baseline) < 2:
+    return difference, math.nan, math.nan, math.nan
+  result = stats.bootstrap(
+      (np.asarray(values), np.asarray(baseline)),
+      lambda a, b, axis: np.mean(a, axis=axis) - np.mean(b, axis=axis),
+      vectorized=True, paired=False, confidence_level=CONFIDENCE,
+      n_resamples=RESAMPLES, method="percentile",
+      random_state=np.random.default_rng(0))
+  low = float(result.confidence_interval.low)
+  high = float(result.confidence_interval.high)
+  with np.errstate(all="ignore"):
+    p = float(stats.ttest_ind(values, baseline, equal_var=False).pvalue)
+  return difference, low, high, p
+
+
+def number(value, digits=1):
+  if value is None or not math.isfinite(value):
+    return "n/a"
+  return f"{value:,.{digits}f}"
+
+
+def signed(value):
+  return "n/a" if not math.isfinite(value) else f"{value:+,.1f}"
+
+
+def verdict(difference, low, high, p):
+  if not (math.isfinite(low) and math.isfinite(p)):
+    return "unknown"
+  if low > 0 and p < 0.05:
+    return "better"
+  if high < 0 and p < 0.05:
+    return "worse"
+  return "unclear"
+
+
+def env_section(env, results, baseline_name, threshold, figure):
+  groups = {}
+  for result in results:
+    groups.setdefault(result.cell["group"], []).append(result)
+  lines = [f"## {env}", ""]
+  if figure:
+    lines += [f"![learning curves on {env}]({figure})", ""]
+  header = ["group", "runs", "final return", "AUC (mean return)"]
+  if threshold is not None:
+    header.append(f"steps to {number(threshold)}")
+  header += [f"final - {baseline_name} [95% CI]", "Welch p"]
+  lines += ["| " + " | ".join(header) + " |",
+            "|" + "|".join(["---"] * len(header)) + "|"]
+  finished = {g: [r for r in rs if r.finished and math.isfinite(r.final)]
+              for g, rs in groups.items()}
+  baselines = {}
+  for group, runs in groups.items():
+    cell = runs[0].cell
+    if estimator_of(cell) == baseline_name:
+      baselines.setdefault(group_key(cell), group)
+  words = []
+  unfinished = []
+  for group in sorted(groups, key=lambda g: (estimator_of(
+      groups[g][0].cell) != baseline_name, g)):
+    runs = finished[group]
+    unfinished += [r.cell["dir"] for r in groups[group] if not r.finished]
+    finals = [r.final for r in runs]
+    mean, sd = mean_sd(finals)
+    auc_mean, auc_sd = mean_sd([r.auc for r in runs])
+    row = [f"`{group}`", f"{len(runs)}/{len(groups[group])}",
+           f"{number(mean)} ± {number(sd)}",
+           f"{number(auc_mean)} ± {number(auc_sd)}"]
+    if threshold is not None:
+      reached = [s for s in (r.steps_to(threshold) for r in runs)
+                 if s is not None]
+      median = statistics.median(reached) if reached else None
+      row.append(f"{number(median, 0)} ({len(reached)}/{len(runs)} reached)"
+                 if reached else f"not reached (0/{len(runs)})")
+    base = baselines.get(group_key(groups[group][0].cell))
+    if base is None or base == group or not runs or not finished[base]:
+      row += ["—" if base == group else "no baseline", ""]
+    else:
+      base_finals = [r.final for r in finished[base]]
+      difference, low, high, p = compare(finals, base_finals)
+      row += [f"{signed(difference)} [{signed(low)}, {signed(high)}]",
+              number(p, 3)]
+      kind = verdict(difference, low, high, p)
+      counts = f"{len(finals)} vs {len(base_finals)} runs"
+      if kind == "better":
+        words.append(f"`{group}` beats `{base}` with confidence: "
+                     f"{signed(difference)} final return, 95% CI "
+                     f"[{signed(low)}, {signed(high)}], p = {number(p, 3)} "
+                     f"({counts}).")
+      elif kind == "worse":
+        words.append(f"`{group}` is worse than `{base}` with confidence: "
+                     f"{signed(difference)}, 95% CI [{signed(low)}, "
+                     f"{signed(high)}], p = {number(p, 3)} ({counts}).")
+      elif kind == "unclear":
+        words.append(f"`{group}` is not distinguishable from `{base}`: "
+                     f"{signed(difference)}, 95% CI [{signed(low)}, "
+                     f"{signed(high)}], p = {number(p, 3)} ({counts}).")
+      else:
+        words.append(f"`{group}` vs `{base}`: {signed(difference)}; too few "
+                     f"runs for a confidence interval ({counts}).")
+    lines.append("| " + " | ".join(row) + " |")
+  lines.append("")
+  lines += [f"- {w}" for w in words] or ["- No group has a baseline to be "
+                                          "compared with."]
+  if unfinished:
+    lines += ["", f"Unfinished, not counted: {', '.join(unfinished)}."]
+  lines.append("")
+  return lines, len(groups), sum(len(r) for r in finished.values())
+
+
+def make_figure(exp_dir, results, path, env):
+  run_dirs = [os.path.join(exp_dir, r.cell["dir"]) for r in results
+              if r.curve]
+  if not run_dirs:
+    return False
+  try:
+    plot_runs.main(run_dirs + [f"--out={path}", f"--title={env}"])
+  except plot_runs.PlotError as e:
+    raise ReportError(f"the figure of {env}: {e}", RUNTIME_ERROR)
+  return True
+
+
+def main(argv):
+  args = parse_arguments(argv)
+  experiment = read_experiment(args.exp_dir)
+  report = experiment.get("report", {})
+  baseline_name = args.baseline or report.get("baseline") or "gae"
+  thresholds = dict(report.get("thresholds", {}))
+  thresholds.update(args.thresholds)
+  out = args.out or os.path.join(args.exp_dir, "report.md")
+  out_dir = os.path.dirname(os.path.abspath(out))
+  if not os.path.isdir(out_dir):
+    raise ReportError(f"--out={out}: its directory does not exist")
+  by_env = {}
+  for cell in experiment["cells"]:
+    curve = read_curve(os.path.join(args.exp_dir, cell["dir"]))
+    by_env.setdefault(cell["env"], []).append(RunResult(cell, curve))
+  for env in thresholds:
+    if env not in by_env:
+      raise ReportError(f"--threshold: no cell runs {env} (envs: "
+                        f"{', '.join(sorted(by_env))})")
+  name = experiment.get("name") or os.path.basename(
+      os.path.normpath(args.exp_dir))
+  lines = [f"# Experiment {name}", ""]
+  if experiment.get("description"):
+    lines += [experiment["description"], ""]
+  budget = experiment.get("budget", 1)
+  lines += [f"From `{experiment.get('file', '?')}` at budget {budget:g} "
+            f"(every cell's steps x {budget:g}); "
+            f"{len(experiment['cells'])} cells. Final return: the last "
+            f"100 episodes' mean at the end of a run. Groups are compared "
+            f"with `{baseline_name}` by a 95% percentile bootstrap over "
+            f"seeds and Welch's t-test; \"with confidence\" means the "
+            f"interval excludes 0 and p < 0.05.", ""]
+  groups_total = runs_total = 0
+  for env in sorted(by_env):
+    figure = None
+    if not args.no_figures:
+      figure_path = os.path.join(out_dir, "figures", f"{env}.png")
+      os.makedirs(os.path.dirname(figure_path), exist_ok=True)
+      if make_figure(args.exp_dir, by_env[env], figure_path, env):
+        figure = os.path.relpath(figure_path, out_dir)
+    section, groups, runs = env_section(env, by_env[env], baseline_name,
+                                        thresholds.get(env), figure)
+    lines += section
+    groups_total += groups
+    runs_total += runs
+  with open(out, "w", encoding="utf-8") as f:
+    f.write("\n".join(lines))
+  print(f"wrote {out}: {len(by_env)} envs, {groups_total} groups, "
+        f"{runs_total} finished runs")
+  return 0
+
+
+if __name__ == "__main__":
+  try:
+    sys.exit(main(sys.argv[1:]))
+  except ReportError as e:
+    print(f"{PROG}: {e}", file=sys.stderr)
+    sys.exit(e.code)
+  except KeyboardInterrupt:
+    sys.exit(130)
+  except Exception as e:  # a bug: still one line, the details on request
+    if os.environ.get("VANTAGE_REPORT_DEBUG"):
+      raise
+    print(f"{PROG}: internal error: {type(e).__name__}: {e} (set "
+          f"VANTAGE_REPORT_DEBUG=1 for the traceback)", file=sys.stderr)
+    sys.exit(RUNTIME_ERROR)

@@ -1,0 +1,258 @@
+#!/usr/bin/python3
+"""Tests of `vantage experiment report` (deploy/experiment/report.py).
+
+  /usr/bin/python3 tests/deploy/experiment/experiment_report_test.py \
+      --vantage=build/vantage
+
+The experiment directory is written by hand (experiment.json, config.json
+and progress.csv of every cell) with returns chosen so that every number of
+the report can be computed here independently: means, sample standard
+deviations and areas by hand, Welch's t-test by integrating Student's t
+density, and the bootstrap interval from the exact bootstrap distribution
+(every resample enumerated).
+"""
+
+import itertools
+import json
+import math
+import os
+import re
+import shutil
+import subprocess
+import sys
+import tempfile
+import unittest
+
+REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.dirname(
+    os.path.abspath(__file__)))))
+VANTAGE = os.path.join(REPO, "build", "vantage")
+
+STEPS = 3000
+# env -> group -> estimator, seeds' curves (mean_return at 1000, 2000 and
+# 3000 steps; None: no episode had ended yet).
+CURVES = {
+    "Hopper": {
+        "gae": ("gae", [[10, 50, 100], [20, 60, 110], [None, 70, 120]]),
+        "max-rho0.4-E1-16-64-2048": (
+            "max", [[30, 90, 130], [40, 100, 150], [50, 110, 170],
+                    [60, 120]]),  # the last one is unfinished
+    },
+    "InvertedPendulum": {
+        "gae": ("gae", [[50, 90, 95], [60, 80, 99]]),
+        "min-rho0.4-E1-16-64-2048": ("min", [[100, 200, 300],
+                                             [50, 150, 310]]),
+    },
+}
+
+
+def take_vantage_flag(argv):
+  rest, path = [argv[0]], None
+  for argument in argv[1:]:
+    if argument.startswith("--vantage="):
+      path = argument.split("=", 1)[1]
+    else:
+      rest.append(argument)
+  argv[:] = rest
+  return path
+
+
+def write_experiment(root):
+  cells = []
+  for env, groups in CURVES.items():
+    for group, (estimator, curves) in groups.items():
+      for seed, curve in enumerate(curves):
+        directory = f"{env}/{group}/seed-{seed}"
+        config = {"mode": "local",
+                  "training": {"env": env, "seed": str(seed),
+                               "steps": str(STEPS)},
+                  "advantage": {"estimator": estimator, "rho": 0.4},
+                  "ppo": {}}
+        flags = {"env": env, "seed": str(seed), "estimator": estimator}
+        cells.append({"dir": directory, "env": env, "group": group,
+                      "seed": str(seed), "flags": flags, "config": config})
+        path = os.path.join(root, directory)
+        os.makedirs(path)
+        with open(os.path.join(path, "config.json"), "w") as f:
+          json.dump(config, f)
+        with open(os.path.join(path, "progress.csv"), "w") as f:
+          f.write("env_steps,updates,mean_return,elapsed_s,sps\n")
+          for i, value in enumerate(curve):
+            shown = "" if value is None else str(value)
+            f.write(f"{1000 * (i + 1)},{i + 1},{shown},1,1\n")
+  with open(os.path.join(root, "experiment.json"), "w") as f:
+    json.dump({"name": "handmade", "file": "handmade.json", "budget": 1,
+               "report": {"baseline": "gae",
+                          "thresholds": {"InvertedPendulum": 100}},
+               "cells": cells}, f)
+
+
+def mean(values):
+  return sum(values) / len(values)
+
+
+def sd(values):
+  m = mean(values)
+  return math.sqrt(sum((v - m) ** 2 for v in values) / (len(values) - 1))
+
+
+def welch_p(a, b):
+  """Two-sided p of Welch's t-test, by integrating Student's t density."""
+  va, vb = sd(a) ** 2 / len(a), sd(b) ** 2 / len(b)
+  t = abs(mean(a) - mean(b)) / math.sqrt(va + vb)
+  df = (va + vb) ** 2 / (va ** 2 / (len(a) - 1) + vb ** 2 / (len(b) - 1))
+  c = math.gamma((df + 1) / 2) / (math.sqrt(df * math.pi) * math.gamma(df / 2))
+
+  def density(x):
+    return c * (1 + x * x / df) ** (-(df + 1) / 2)
+
+  # The tail beyond t, with x = t / u (u in (0, 1]) to make it finite.
+  n = 200000
+  h = 1.0 / n
+  total = 0.0
+  for i in range(n):
+    u = (i + 0.5) * h
+    total += density(t / u) * t / (u * u) * h
+  return 2 * total
+
+
+def exact_bootstrap_interval(a, b):
+  """The 2.5th and 97.5th percentiles of the exact bootstrap distribution
+  of mean(a*) - mean(b*) (every resample with replacement, equally likely)."""
+  differences = sorted(
+      mean(ra) - mean(rb)
+      for ra in itertools.product(a, repeat=len(a))
+      for rb in itertools.product(b, repeat=len(b)))
+  n = len(differences)
+  return differences[int(0.025 * n)], differences[min(n - 1, int(0.975 * n))]
+
+
+def parse_number(text):
+  text = text.replace(",", "").replace("+", "")
+  return math.nan if text == "n/a" else float(text)
+
+
+def table_rows(report, env):
+  section = report.split(f"## {env}\n", 1)[1].split("\n## ", 1)[0]
+  rows = {}
+  for line in section.splitlines():
+    match = re.match(r"\| `([^`]+)` \| (.*) \|$", line)
+    if match:
+      rows[match.group(1)] = [c.strip() for c in match.group(2).split(" | ")]
+  return section, rows
+
+
+class ReportTest(unittest.TestCase):
+
+  @classmethod
+  def setUpClass(cls):
+    cls.root = tempfile.mkdtemp(prefix="vantage-report-")
+    cls.exp = os.path.join(cls.root, "exp")
+    write_experiment(cls.exp)
+    cls.result = subprocess.run([VANTAGE, "experiment", "report", cls.exp],
+                                capture_output=True, text=True, timeout=300)
+    with open(os.path.join(cls.exp, "report.md")) as f:
+      cls.report = f.read()
+
+  @classmethod
+  def tearDownClass(cls):
+    shutil.rmtree(cls.root, ignore_errors=True)
+
+  def test_ends_with_a_summary_line(self):
+    self.assertEqual(self.result.returncode, 0, self.result.stderr)
+    self.assertEqual(
+        self.result.stdout.strip().splitlines()[-1],
+        f"wrote {self.exp}/report.md: 2 envs, 4 groups, 10 finished runs")
+
+  def test_final_returns_areas_and_the_comparison_by_hand(self):
+    section, rows = table_rows(self.report, "Hopper")
+    gae_finals, max_finals = [100, 110, 120], [130, 150, 170]
+    gae_areas = [(30 * 1000 + 75 * 1000) / 2000,
+                 (40 * 1000 + 85 * 1000) / 2000,
+                 (70 + 120) / 2]  # from the first row with a return
+    max_areas = [(60 + 110) / 2, (70 + 125) / 2, (80 + 140) / 2]
+    gae, biased = rows["gae"], rows["max-rho0.4-E1-16-64-2048"]
+    self.assertEqual(gae[0], "3/3")
+    self.assertEqual(biased[0], "3/4")  # the unfinished run is not counted
+    for row, finals, areas in ((gae, gae_finals, gae_areas),
+                               (biased, max_finals, max_areas)):
+      final_mean, final_sd = map(parse_number, row[1].split(" ± "))
+      self.assertAlmostEqual(final_mean, mean(finals), places=1)
+      self.assertAlmostEqual(final_sd, sd(finals), places=1)
+      area_mean, area_sd = map(parse_number, row[2].split(" ± "))
+      self.assertAlmostEqual(area_mean, mean(areas), places=1)
+      self.assertAlmostEqual(area_sd, sd(areas), places=1)
+    self.assertEqual(gae[3], "—")
+    match = re.fullmatch(r"(\S+) \[(\S+), (\S+)\]", biased[3])
+    self.assertIsNotNone(match, biased[3])
+    difference, low, high = map(parse_number, match.groups())
+    self.assertAlmostEqual(difference, 40.0, places=1)
+    exact_low, exact_high = exact_bootstrap_interval(max_finals, gae_finals)
+    self.assertLess(abs(low - exact_low), 4, (low, exact_low))
+    self.assertLess(abs(high - exact_high), 4, (high, exact_high))
+    self.assertAlmostEqual(parse_number(biased[4]),
+                           welch_p(max_finals, gae_finals), places=3)
+    # p = 0.055: the interval excludes 0 but the test does not agree.
+    self.assertIn("`max-rho0.4-E1-16-64-2048` is not distinguishable from "
+                  "`gae`", section)
+    self.assertIn("Unfinished, not counted: "
+                  "Hopper/max-rho0.4-E1-16-64-2048/seed-3.", section)
+
+  def test_threshold_and_a_confident_win(self):
+    section, rows = table_rows(self.report, "InvertedPendulum")
+    self.assertEqual(rows["gae"][3], "not reached (0/2)")
+    # Reached at 1000 and 2000 steps: the median is 1500.
+    self.assertEqual(rows["min-rho0.4-E1-16-64-2048"][3],
+                     "1,500 (2/2 reached)")
+    p = welch_p([300, 310], [95, 99])
+    self.assertLess(p, 0.05)
+    self.assertAlmostEqual(parse_number(rows["min-rho0.4-E1-16-64-2048"][5]),
+                           p, places=3)
+    # Two runs a side: the exact bootstrap interval is [201, 215].
+    self.assertIn("+208.0 [+201.0, +215.0]",
+                  rows["min-rho0.4-E1-16-64-2048"][4])
+    self.assertIn("`min-rho0.4-E1-16-64-2048` beats `gae` with confidence: "
+                  "+208.0 final return", section)
+
+  def test_figures_beside_the_report(self):
+    for env in CURVES:
+      path = os.path.join(self.exp, "figures", f"{env}.png")
+      with open(path, "rb") as f:
+        self.assertEqual(f.read(8), b"\x89PNG\r\n\x1a\n")
+      self.assertIn(f"![learning curves on {env}](figures/{env}.png)",
+                    self.report)
+
+  def test_the_same_report_again(self):
+    out = os.path.join(self.root, "again.md")
+    result = subprocess.run([VANTAGE, "experiment", "report", self.exp,
+                             f"--out={out}", "--no_figures"],
+                            capture_output=True, text=True, timeout=300)
+    self.assertEqual(result.returncode, 0, result.stderr)
+    with open(out) as f:
+      again = f.read()
+    strip = lambda text: re.sub(r"!\[.*\n\n", "", text)
+    self.assertEqual(strip(again), strip(self.report))
+
+  def test_bad_input_is_one_line_with_exit_2(self):
+    cases = [
+        ([os.path.join(self.root, "missing")], "no such directory"),
+        ([self.root], "holds no experiment.json"),
+        ([self.exp, "--threshold=Hopper"], "--threshold entry 'Hopper' is "
+         "not ENV=RETURN"),
+        ([self.exp, "--threshold=Ant=5"], "--threshold: no cell runs Ant"),
+        ([self.exp, "--out=/no/such/dir/r.md"], "its directory does not "
+         "exist"),
+        ([self.exp, "--colour=red"], "unrecognized arguments"),
+    ]
+    for args, message in cases:
+      result = subprocess.run([VANTAGE, "experiment", "report"] + args,
+                              capture_output=True, text=True, timeout=60)
+      self.assertEqual(result.returncode, 2, (args, result.stderr))
+      self.assertIn(message, result.stderr)
+      self.assertEqual(result.stderr.count("\n"), 1, result.stderr)
+      self.assertTrue(
+          result.stderr.startswith("vantage experiment report: "))
+
+
+if __name__ == "__main__":
+  VANTAGE = take_vantage_flag(sys.argv) or VANTAGE
+  unittest.main()
