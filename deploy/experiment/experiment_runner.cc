@@ -1,7 +1,13 @@
 #include "deploy/experiment/experiment_runner.h"
 
+#include <fcntl.h>
+#include <sys/file.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <map>
 #include <thread>
@@ -12,6 +18,39 @@
 
 namespace vantage {
 namespace {
+
+// An exclusive lock on EXP_DIR/.lock for as long as this runner or any cell
+// it started lives: the descriptor is inherited by the cells (no
+// close-on-exec), so cells orphaned by a killed runner still hold it and a
+// second runner cannot start the same runs beside them.
+class DirectoryLock {
+ public:
+  static absl::StatusOr<DirectoryLock> Take(const std::string& exp_dir) {
+    const std::string path = exp_dir + "/.lock";
+    const int fd = ::open(path.c_str(), O_RDWR | O_CREAT, 0644);
+    if (fd < 0) {
+      return absl::FailedPreconditionError(
+          absl::StrCat("cannot open ", path, ": ", std::strerror(errno)));
+    }
+    if (::flock(fd, LOCK_EX | LOCK_NB) != 0) {
+      ::close(fd);
+      return absl::FailedPreconditionError(absl::StrCat(
+          exp_dir,
+          " is in use by another `vantage experiment run` (or by cells it "
+          "started, which go on after it is killed)"));
+    }
+    return DirectoryLock(fd);
+  }
+  DirectoryLock(DirectoryLock&& other) : fd_(other.fd_) { other.fd_ = -1; }
+  DirectoryLock& operator=(DirectoryLock&&) = delete;
+  ~DirectoryLock() {
+    if (fd_ >= 0) ::close(fd_);
+  }
+
+ private:
+  explicit DirectoryLock(int fd) : fd_(fd) {}
+  int fd_;
+};
 
 int CoresPerCell(const pb::RunConfig& config) {
   if (config.mode() != "distributed") return 1;
@@ -53,6 +92,15 @@ absl::Status RunExperiment(const pb::ExpandedExperiment& experiment,
                            const ExperimentRunOptions& options,
                            const std::atomic<bool>& stop) {
   const ExperimentDirectory directory(options.exp_dir);
+  std::error_code error;
+  std::filesystem::create_directories(options.exp_dir, error);
+  if (error) {
+    return absl::FailedPreconditionError(
+        absl::StrCat("cannot create experiment directory ", options.exp_dir,
+                     ": ", error.message()));
+  }
+  absl::StatusOr<DirectoryLock> lock = DirectoryLock::Take(options.exp_dir);
+  if (!lock.ok()) return lock.status();
   if (absl::Status status = directory.Prepare(experiment, base); !status.ok()) {
     return status;
   }
@@ -89,7 +137,6 @@ absl::Status RunExperiment(const pb::ExpandedExperiment& experiment,
     const bool resume = status.state == CellState::kResumable;
     resumed += resume ? 1 : 0;
     totals.steps_before += status.env_steps;
-    std::error_code error;
     std::filesystem::create_directories(directory.RunDir(cell), error);
     if (error) {
       return absl::FailedPreconditionError(absl::StrCat(

@@ -2,7 +2,10 @@
 // stops cleanly on SIGTERM, resumes to what an uninterrupted run gives,
 // skips what is finished, reports failed cells and refuses a changed grid.
 
+#include <fcntl.h>
 #include <signal.h>
+#include <sys/file.h>
+#include <unistd.h>
 
 #include <chrono>
 #include <filesystem>
@@ -134,6 +137,22 @@ TEST(ExperimentCommandTest, AFailedCellIsReportedAndTheOthersGoOn) {
   for (const std::string& cell : {kCells[0], kCells[2], kCells[3]}) {
     EXPECT_EQ(ProgressRows(absl::StrCat(dir, "/", cell)), 2) << cell;
   }
+}
+
+// While a runner or any of its cells lives, another runner keeps out.
+TEST(ExperimentCommandTest, ADirectoryInUseIsRefused) {
+  const std::string dir = FreshDirectory("in_use");
+  std::filesystem::create_directories(dir);
+  const int fd = open((dir + "/.lock").c_str(), O_RDWR | O_CREAT, 0644);
+  ASSERT_GE(fd, 0);
+  ASSERT_EQ(flock(fd, LOCK_EX | LOCK_NB), 0);
+  const Outcome outcome = RunVantage(absl::StrCat(
+      "experiment run ", TinyExperiment("busy.json"), " --out=", dir));
+  close(fd);
+  EXPECT_EQ(outcome.exit_code, 2);
+  EXPECT_THAT(outcome.err, HasSubstr("is in use by another `vantage "
+                                     "experiment run`"));
+  EXPECT_FALSE(std::filesystem::exists(dir + "/experiment.json"));
 }
 
 TEST(ExperimentCommandTest, DryRunPrintsEachCellsCommand) {
