@@ -81,9 +81,9 @@ std::string RunDirectory::checkpoint_directory() const {
   return path_ + "/checkpoints";
 }
 
-absl::Status RunDirectory::TruncateProgress(int64_t updates) const {
-  std::ifstream file(progress_path());
-  std::string text = absl::StrCat(ProgressHeader(), "\n");
+std::vector<ProgressLine> ReadProgressLines(const std::string& run_dir) {
+  std::ifstream file(RunDirectory(run_dir).progress_path());
+  std::vector<ProgressLine> rows;
   std::string line;
   bool header = true;
   while (std::getline(file, line)) {
@@ -92,12 +92,22 @@ absl::Status RunDirectory::TruncateProgress(int64_t updates) const {
       continue;
     }
     const std::vector<absl::string_view> fields = absl::StrSplit(line, ',');
-    int64_t row_updates = 0;
-    if (fields.size() < 2 || !absl::SimpleAtoi(fields[1], &row_updates)) {
+    ProgressLine row;
+    if (fields.size() < 2 || !absl::SimpleAtoi(fields[0], &row.env_steps) ||
+        !absl::SimpleAtoi(fields[1], &row.updates)) {
       break;  // a torn last line from a crash
     }
-    if (row_updates > updates) break;
-    absl::StrAppend(&text, line, "\n");
+    row.text = line;
+    rows.push_back(std::move(row));
+  }
+  return rows;
+}
+
+absl::Status RunDirectory::TruncateProgress(int64_t updates) const {
+  std::string text = absl::StrCat(ProgressHeader(), "\n");
+  for (const ProgressLine& row : ReadProgressLines(path_)) {
+    if (row.updates > updates) break;
+    absl::StrAppend(&text, row.text, "\n");
   }
   return WriteFileAtomically(progress_path(), text);
 }

@@ -9,6 +9,7 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
@@ -20,6 +21,17 @@ namespace vantage {
 // reader never sees half of it.
 absl::Status WriteFileAtomically(const std::string& path,
                                  const std::string& text);
+
+// A whole row of progress.csv with the two columns that place it.
+struct ProgressLine {
+  int64_t env_steps = 0;
+  int64_t updates = 0;
+  std::string text;
+};
+
+// progress.csv's rows in `run_dir`, up to the first that is not whole (the
+// torn last line of a killed run); none if there is no file.
+std::vector<ProgressLine> ReadProgressLines(const std::string& run_dir);
 
 class RunDirectory {
  public:
@@ -43,6 +55,7 @@ class RunDirectory {
   absl::Status AppendProgress(const ProgressRow& row) const;
 
  private:
+  friend std::vector<ProgressLine> ReadProgressLines(const std::string&);
   explicit RunDirectory(std::string path) : path_(std::move(path)) {}
   std::string progress_path() const;
 

@@ -1,9 +1,7 @@
 #include "deploy/experiment/experiment_directory.h"
 
 #include <filesystem>
-#include <fstream>
 
-#include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_split.h"
 #include "deploy/run_config.h"
@@ -104,22 +102,8 @@ absl::Status ExperimentDirectory::Prepare(
 }
 
 int64_t LastProgressSteps(const std::string& run_dir) {
-  std::ifstream file(run_dir + "/progress.csv");
-  std::string line;
-  int64_t steps = 0;
-  bool header = true;
-  while (std::getline(file, line)) {
-    if (header) {
-      header = false;
-      continue;
-    }
-    const std::vector<absl::string_view> fields = absl::StrSplit(line, ',');
-    int64_t row_steps = 0;
-    // A torn last line (a killed run) counts for nothing.
-    if (fields.size() < 2 || !absl::SimpleAtoi(fields[0], &row_steps)) break;
-    steps = row_steps;
-  }
-  return steps;
+  const std::vector<ProgressLine> rows = ReadProgressLines(run_dir);
+  return rows.empty() ? 0 : rows.back().env_steps;
 }
 
 CellStatus ExperimentDirectory::Inspect(const pb::ExperimentCell& cell) const {

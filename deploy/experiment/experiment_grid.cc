@@ -1,6 +1,7 @@
 #include "deploy/experiment/experiment_grid.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <fstream>
 #include <map>
