@@ -85,15 +85,14 @@ std::vector<ProgressLine> ReadProgressLines(const std::string& run_dir) {
   std::ifstream file(RunDirectory(run_dir).progress_path());
   std::vector<ProgressLine> rows;
   std::string line;
-  bool header = true;
+  if (!std::getline(file, line)) return rows;
+  const size_t columns =
+      std::vector<absl::string_view>(absl::StrSplit(line, ',')).size();
   while (std::getline(file, line)) {
-    if (header) {
-      header = false;
-      continue;
-    }
     const std::vector<absl::string_view> fields = absl::StrSplit(line, ',');
     ProgressLine row;
-    if (fields.size() < 2 || !absl::SimpleAtoi(fields[0], &row.env_steps) ||
+    if (fields.size() != columns || columns < 2 ||
+        !absl::SimpleAtoi(fields[0], &row.env_steps) ||
         !absl::SimpleAtoi(fields[1], &row.updates)) {
       break;  // a torn last line from a crash
     }

@@ -29,8 +29,9 @@ struct ProgressLine {
   std::string text;
 };
 
-// progress.csv's rows in `run_dir`, up to the first that is not whole (the
-// torn last line of a killed run); none if there is no file.
+// progress.csv's rows in `run_dir`, up to the first that is not whole (as
+// many fields as the header, the first two numbers: the torn last line of a
+// killed run is not); none if there is no file.
 std::vector<ProgressLine> ReadProgressLines(const std::string& run_dir);
 
 class RunDirectory {

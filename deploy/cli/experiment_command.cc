@@ -2,6 +2,7 @@
 
 #include <fnmatch.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <string>
 #include <vector>
@@ -10,6 +11,7 @@
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_join.h"
+#include "actor/envs/env_registry.h"
 #include "deploy/cli/command_line.h"
 #include "deploy/cli/python_script.h"
 #include "deploy/cli/run_flags.h"
@@ -79,6 +81,14 @@ RunSettingsSchema ExperimentRunSchema() {
     request->config_file = "the experiment's base";
     absl::StatusOr<ResolvedRun> run = ResolveRunRequest(*request);
     if (!run.ok()) return run.status();
+    // What `train` checks when a run starts, checked before any runs.
+    const std::vector<std::string> envs = RegisteredEnvironments();
+    if (std::find(envs.begin(), envs.end(), run->config.training().env()) ==
+        envs.end()) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          "--env '", run->config.training().env(),
+          "' is not an environment; registered: ", absl::StrJoin(envs, ", ")));
+    }
     return run->config;
   };
   return schema;

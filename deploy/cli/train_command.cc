@@ -94,11 +94,13 @@ int RunLocal(const ResolvedRun& run) {
   const bool terminal = ::isatty(STDOUT_FILENO) == 1;
   ProgressRow last;
   last.mean_return = std::nan("");
+  bool updated = false;
   const std::atomic<bool>& stop = StopRequested();
   const absl::Status status = RunLocalTraining(
       local,
       [&](const ProgressRow& progress) {
         last = progress;
+        updated = true;
         if (!terminal) return true;
         const double remaining =
             (config.training().steps() - progress.stats.env_steps) /
@@ -117,10 +119,12 @@ int RunLocal(const ResolvedRun& run) {
       &stop);
   if (terminal) std::printf("\n");
   if (!status.ok()) return Fail(kRuntimeError, status.message());
-  if (stop && last.stats.env_steps < config.training().steps()) {
-    std::printf("stopped at %ld of %ld steps%s%s\n",
-                static_cast<long>(last.stats.env_steps),
-                static_cast<long>(config.training().steps()),
+  if (stop && (!updated || last.stats.env_steps < config.training().steps())) {
+    const std::string where =
+        updated ? absl::StrCat("at ", last.stats.env_steps, " of ",
+                               config.training().steps(), " steps")
+                : "before its first update in this process";
+    std::printf("stopped %s%s%s\n", where.c_str(),
                 local.run_dir.empty() ? "" : "; continue with --resume=",
                 local.run_dir.c_str());
     return 0;

@@ -1,6 +1,9 @@
 #include "deploy/experiment/experiment_directory.h"
 
 #include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_split.h"
@@ -84,9 +87,56 @@ absl::Status ExperimentDirectory::CheckRuns(
   return absl::OkStatus();
 }
 
+absl::StatusOr<pb::ExpandedExperiment> ExperimentDirectory::Merged(
+    const pb::ExpandedExperiment& experiment) const {
+  std::ifstream file(ExperimentPath());
+  if (!file) return experiment;
+  std::stringstream text;
+  text << file.rdbuf();
+  pb::ExpandedExperiment held;
+  if (!google::protobuf::util::JsonStringToMessage(text.str(), &held).ok()) {
+    return absl::FailedPreconditionError(absl::StrCat(
+        ExperimentPath(), " is not an experiment record; use another --out"));
+  }
+  if (held.budget() != experiment.budget()) {
+    return absl::FailedPreconditionError(absl::StrCat(
+        path_, " holds cells run at --budget=", held.budget(),
+        "; this run asks for ", experiment.budget(), ": use another --out"));
+  }
+  std::map<std::string, const pb::ExperimentCell*> fresh;
+  for (const pb::ExperimentCell& cell : experiment.cells()) {
+    fresh[cell.dir()] = &cell;
+  }
+  pb::ExpandedExperiment merged = experiment;
+  merged.clear_cells();
+  for (const pb::ExperimentCell& cell : held.cells()) {
+    const auto it = fresh.find(cell.dir());
+    if (it == fresh.end()) {
+      *merged.add_cells() = cell;
+      continue;
+    }
+    if (!google::protobuf::util::MessageDifferencer::Equals(
+            cell.config(), it->second->config())) {
+      return absl::FailedPreconditionError(
+          absl::StrCat(ExperimentPath(), " records ", cell.dir(),
+                       " with other settings than this experiment's cell (",
+                       FirstDifference(cell.config(), it->second->config()),
+                       "): use another --out"));
+    }
+    *merged.add_cells() = *it->second;
+    fresh.erase(it);
+  }
+  for (const pb::ExperimentCell& cell : experiment.cells()) {
+    if (fresh.count(cell.dir()) > 0) *merged.add_cells() = cell;
+  }
+  return merged;
+}
+
 absl::Status ExperimentDirectory::Prepare(
     const pb::ExpandedExperiment& experiment, const pb::RunConfig& base) const {
   if (absl::Status status = CheckRuns(experiment); !status.ok()) return status;
+  absl::StatusOr<pb::ExpandedExperiment> merged = Merged(experiment);
+  if (!merged.ok()) return merged.status();
   std::error_code error;
   std::filesystem::create_directories(path_, error);
   if (error) {
@@ -98,7 +148,7 @@ absl::Status ExperimentDirectory::Prepare(
     return status;
   }
   return WriteFileAtomically(ExperimentPath(),
-                             ExpandedExperimentToJson(experiment));
+                             ExpandedExperimentToJson(*merged));
 }
 
 int64_t LastProgressSteps(const std::string& run_dir) {

@@ -44,8 +44,14 @@ class ExperimentDirectory {
   // directory and the first setting that differs: the experiment file or
   // --budget changed, so its results would not be this grid's).
   absl::Status CheckRuns(const pb::ExpandedExperiment& experiment) const;
-  // CheckRuns, then creates the directory and writes experiment.json and
-  // base.json.
+  // The experiment's cells added to those experiment.json already records
+  // (a run of other seeds or cells, or with --only, extends the record):
+  // FailedPrecondition if the record was made at another budget or holds
+  // one of the cells with other settings.
+  absl::StatusOr<pb::ExpandedExperiment> Merged(
+      const pb::ExpandedExperiment& experiment) const;
+  // CheckRuns, then creates the directory and writes experiment.json (the
+  // merged record) and base.json.
   absl::Status Prepare(const pb::ExpandedExperiment& experiment,
                        const pb::RunConfig& base) const;
 

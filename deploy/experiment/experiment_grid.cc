@@ -43,10 +43,33 @@ bool NamedByGroupOrPath(const std::string& flag) {
   return named->count(flag) > 0;
 }
 
+// More cells than any machine or cluster would run: a file that expands
+// beyond it is refused before the grid is built.
+constexpr size_t kMaxCells = 100000;
+
 absl::Status Invalid(const std::string& file, const std::string& field,
                      const std::string& message) {
   return absl::InvalidArgumentError(
       absl::StrCat(file, ": ", field, ": ", message));
+}
+
+// Letters, digits, '.', '_' and '-' stay; ':' goes (order:2 -> order2);
+// anything else becomes '_'.
+std::string PathSafe(const std::string& text) {
+  std::string safe;
+  for (char c : text) {
+    if (std::isalnum(static_cast<unsigned char>(c)) || c == '.' || c == '_' ||
+        c == '-') {
+      safe.push_back(c);
+    } else if (c == ',') {
+      safe.push_back('-');
+    } else if (c != ':') {
+      safe.push_back('_');
+    }
+  }
+  // Never a name that walks out of the experiment directory.
+  if (safe.empty() || safe == "." || safe == "..") safe = "_" + safe;
+  return safe;
 }
 
 class Expander {
@@ -106,6 +129,11 @@ class Expander {
       points.insert(points.end(), product->begin(), product->end());
     }
     if (absl::Status status = CheckReport(); !status.ok()) return status;
+    if (points.size() * seeds.size() > kMaxCells) {
+      return absl::InvalidArgumentError(
+          absl::StrCat(options_.file, ": ", points.size() * seeds.size(),
+                       " cells, more than ", kMaxCells));
+    }
 
     pb::ExpandedExperiment expanded;
     expanded.set_name(experiment_.name());
@@ -234,6 +262,11 @@ class Expander {
       absl::StatusOr<std::vector<Point>> points =
           AxisPoints(axes[a], absl::StrCat(field, "[", a, "]"));
       if (!points.ok()) return points.status();
+      if (product.size() * points->size() > kMaxCells) {
+        return Invalid(
+            options_.file, absl::StrCat(field, "[", a, "]"),
+            absl::StrCat("the grid grows beyond ", kMaxCells, " cells"));
+      }
       std::vector<Point> next;
       for (const Point& start : product) {
         for (const Point& point : *points) next.push_back(Join(start, point));
@@ -292,9 +325,13 @@ class Expander {
         schema_.resolve(experiment_.base(), settings);
     if (!config.ok()) return fail(config.status());
     if (options_.budget != 1.0) {
-      const int64_t steps = std::max<int64_t>(
-          1, std::llround(static_cast<double>(config->training().steps()) *
-                          options_.budget));
+      const double scaled =
+          static_cast<double>(config->training().steps()) * options_.budget;
+      if (scaled > 1e15) {
+        return fail(absl::InvalidArgumentError(absl::StrCat(
+            "--budget=", options_.budget, " makes ", scaled, " steps")));
+      }
+      const int64_t steps = std::max<int64_t>(1, std::llround(scaled));
       auto given =
           std::find_if(settings.begin(), settings.end(),
                        [](const auto& s) { return s.first == "steps"; });
@@ -314,7 +351,8 @@ class Expander {
     cell.set_env(config->training().env());
     cell.set_group(GroupName(*config, extra));
     cell.set_seed(seed);
-    cell.set_dir(absl::StrCat(cell.env(), "/", cell.group(), "/seed-", seed));
+    cell.set_dir(
+        absl::StrCat(PathSafe(cell.env()), "/", cell.group(), "/seed-", seed));
     for (const auto& [flag, value] : settings)
       (*cell.mutable_flags())[flag] = value;
     for (const auto& [flag, origin] : origins) {
@@ -329,23 +367,6 @@ class Expander {
   const RunSettingsSchema& schema_;
   const std::set<std::string> known_;
 };
-
-// Letters, digits, '.', '_' and '-' stay; ':' goes (order:2 -> order2);
-// anything else becomes '_'.
-std::string PathSafe(const std::string& text) {
-  std::string safe;
-  for (char c : text) {
-    if (std::isalnum(static_cast<unsigned char>(c)) || c == '.' || c == '_' ||
-        c == '-') {
-      safe.push_back(c);
-    } else if (c == ',') {
-      safe.push_back('-');
-    } else if (c != ':') {
-      safe.push_back('_');
-    }
-  }
-  return safe;
-}
 
 }  // namespace
 

@@ -5,8 +5,11 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
+#include <csignal>
 #include <cstdio>
 #include <fstream>
 #include <map>
@@ -58,6 +61,9 @@ class LocalBackend : public ExperimentBackend {
   std::vector<CellOutcome> Run(const std::vector<CellTask>& tasks,
                                const GridTotals& totals,
                                const std::atomic<bool>& stop) override {
+    // Children are reaped here: an ignored SIGCHLD inherited from the
+    // parent would make the kernel reap them and waitpid fail.
+    std::signal(SIGCHLD, SIG_DFL);
     std::vector<CellOutcome> outcomes(tasks.size());
     for (CellOutcome& outcome : outcomes) {
       outcome.kind = CellOutcome::Kind::kStopped;
@@ -65,25 +71,32 @@ class LocalBackend : public ExperimentBackend {
     }
     std::map<pid_t, size_t> running;
     size_t next = 0;
-    const Clock::time_point started = Clock::now();
-    Progress progress{totals, started};
-    std::vector<bool> started_task(tasks.size(), false);
+    Progress progress{totals, Clock::now()};
+    // Steps each task made in this invocation, within its run's steps.
     std::vector<int64_t> start_steps;
+    std::vector<int64_t> gained(tasks.size(), 0);
     for (const CellTask& task : tasks) {
       start_steps.push_back(LastProgressSteps(task.run_dir));
     }
+    auto count_steps = [&](size_t i) {
+      const int64_t now = LastProgressSteps(tasks[i].run_dir);
+      gained[i] = std::clamp<int64_t>(
+          now - start_steps[i], 0,
+          std::max<int64_t>(0, tasks[i].steps - start_steps[i]));
+    };
+    Clock::time_point last_count;
     while (true) {
       if (stop) {
         StopAll(running, tasks, outcomes);
         break;
       }
-      while (static_cast<int>(running.size()) < jobs_ && next < tasks.size()) {
+      while (!stop && static_cast<int>(running.size()) < jobs_ &&
+             next < tasks.size()) {
         const CellTask& task = tasks[next];
         absl::StatusOr<pid_t> pid =
             SpawnSelf(task.train_args, task.log_path, /*append=*/true);
         if (pid.ok()) {
           running[*pid] = next;
-          started_task[next] = true;
         } else {
           outcomes[next] = {CellOutcome::Kind::kFailed,
                             std::string(pid.status().message())};
@@ -95,13 +108,18 @@ class LocalBackend : public ExperimentBackend {
       if (running.empty() && next >= tasks.size()) break;
       for (auto it = running.begin(); it != running.end();) {
         int status = 0;
-        if (waitpid(it->first, &status, WNOHANG) != it->first) {
+        const pid_t ended = waitpid(it->first, &status, WNOHANG);
+        if (ended == 0 || (ended < 0 && errno == EINTR)) {
           ++it;
           continue;
         }
-        const CellTask& task = tasks[it->second];
-        CellOutcome& outcome = outcomes[it->second];
-        outcome = Classify(task, status, stop);
+        // ended < 0 otherwise: the child is gone without a status to read;
+        // its progress.csv still says how far it got.
+        const size_t index = it->second;
+        const CellTask& task = tasks[index];
+        CellOutcome& outcome = outcomes[index];
+        outcome = Classify(task, ended > 0 ? status : -1, stop);
+        count_steps(index);
         it = running.erase(it);
         progress.running = static_cast<int>(running.size());
         if (outcome.kind == CellOutcome::Kind::kFinished) {
@@ -114,13 +132,14 @@ class LocalBackend : public ExperimentBackend {
       }
       progress.running = static_cast<int>(running.size());
       progress.waiting = static_cast<int>(tasks.size() - next);
-      int64_t steps = totals.steps_before;
-      for (size_t i = 0; i < tasks.size(); ++i) {
-        if (started_task[i]) {
-          steps += LastProgressSteps(tasks[i].run_dir) - start_steps[i];
-        }
+      // Reading the running cells' progress files once a second is enough
+      // for a progress line.
+      if (Clock::now() - last_count >= std::chrono::seconds(1)) {
+        for (const auto& [pid, index] : running) count_steps(index);
+        last_count = Clock::now();
       }
-      progress.steps = steps;
+      progress.steps = totals.steps_before;
+      for (int64_t steps : gained) progress.steps += steps;
       PrintProgress(progress);
       std::this_thread::sleep_for(std::chrono::milliseconds(200));
     }
@@ -149,10 +168,11 @@ class LocalBackend : public ExperimentBackend {
       return {CellOutcome::Kind::kStopped,
               absl::StrCat("stopped at ", steps, " of ", task.steps, " steps")};
     }
-    std::string how;
-    if (WIFEXITED(status)) {
+    // A negative status: the child ended without one to read (see Run).
+    std::string how = "an end with no status";
+    if (status >= 0 && WIFEXITED(status)) {
       how = absl::StrCat("exit code ", WEXITSTATUS(status));
-    } else if (WIFSIGNALED(status)) {
+    } else if (status >= 0 && WIFSIGNALED(status)) {
       how = absl::StrCat("signal ", WTERMSIG(status));
     }
     return {CellOutcome::Kind::kFailed,
@@ -176,7 +196,8 @@ class LocalBackend : public ExperimentBackend {
       while (waitpid(pid, &status, WNOHANG) == 0) {
         if (Clock::now() > deadline) {
           kill(pid, SIGKILL);
-          waitpid(pid, &status, 0);
+          while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+          }
           break;
         }
         std::this_thread::sleep_for(std::chrono::milliseconds(50));

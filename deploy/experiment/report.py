@@ -128,9 +128,19 @@ def read_experiment(exp_dir):
   if not isinstance(cells, list) or not cells:
     raise ReportError(f"{path}: lists no cells")
   for i, cell in enumerate(cells):
+    if not isinstance(cell, dict):
+      raise ReportError(f"{path}: cells[{i}] is not an object")
     for key in ("dir", "env", "group", "config"):
       if key not in cell:
         raise ReportError(f"{path}: cells[{i}] has no \"{key}\"")
+    try:
+      int(cell["config"]["training"]["steps"])
+    except (KeyError, TypeError, ValueError):
+      raise ReportError(f"{path}: cells[{i}] has no config.training.steps")
+    if not isinstance(cell.get("flags", {}), dict):
+      raise ReportError(f"{path}: cells[{i}].flags is not an object")
+    if ".." in cell["dir"].split("/") or os.path.isabs(cell["dir"]):
+      raise ReportError(f"{path}: cells[{i}].dir leaves the experiment")
   return experiment
 
 
@@ -242,13 +252,16 @@ def verdict(difference, low, high, p):
   return "unclear"
 
 
-def env_section(env, results, baseline_name, threshold, figure):
+def env_section(env, results, baseline_name, threshold, figure,
+                figure_problem):
   groups = {}
   for result in results:
     groups.setdefault(result.cell["group"], []).append(result)
   lines = [f"## {env}", ""]
   if figure:
     lines += [f"![learning curves on {env}]({figure})", ""]
+  elif figure_problem:
+    lines += [f"(No figure: {figure_problem}.)", ""]
   header = ["group", "runs", "final return", "AUC (mean return)"]
   if threshold is not None:
     header.append(f"steps to {number(threshold)}")
@@ -264,10 +277,13 @@ def env_section(env, results, baseline_name, threshold, figure):
       baselines.setdefault(group_key(cell), group)
   words = []
   unfinished = []
+  no_return = []
   for group in sorted(groups, key=lambda g: (estimator_of(
       groups[g][0].cell) != baseline_name, g)):
     runs = finished[group]
     unfinished += [r.cell["dir"] for r in groups[group] if not r.finished]
+    no_return += [r.cell["dir"] for r in groups[group]
+                  if r.finished and not math.isfinite(r.final)]
     finals = [r.final for r in runs]
     mean, sd = mean_sd(finals)
     auc_mean, auc_sd = mean_sd([r.auc for r in runs])
@@ -303,20 +319,28 @@ def env_section(env, results, baseline_name, threshold, figure):
         words.append(f"`{group}` is not distinguishable from `{base}`: "
                      f"{signed(difference)}, 95% CI [{signed(low)}, "
                      f"{signed(high)}], p = {number(p, 3)} ({counts}).")
-      else:
+      elif min(len(finals), len(base_finals)) < 2:
         words.append(f"`{group}` vs `{base}`: {signed(difference)}; too few "
                      f"runs for a confidence interval ({counts}).")
+      else:
+        words.append(f"`{group}` vs `{base}`: {signed(difference)}; every "
+                     f"run of both ended at the same return, so there is "
+                     f"no test ({counts}).")
     lines.append("| " + " | ".join(row) + " |")
   lines.append("")
   lines += [f"- {w}" for w in words] or ["- No group has a baseline to be "
                                           "compared with."]
   if unfinished:
     lines += ["", f"Unfinished, not counted: {', '.join(unfinished)}."]
+  if no_return:
+    lines += ["", f"Finished without a completed episode in their last 100 "
+              f"(no final return), not counted: {', '.join(no_return)}."]
   lines.append("")
   return lines, len(groups), sum(len(r) for r in finished.values())
 
 
 def make_figure(exp_dir, results, path, env):
+  """True when drawn, False when no run has rows yet, else why not."""
   run_dirs = [os.path.join(exp_dir, r.cell["dir"]) for r in results
               if r.curve]
   if not run_dirs:
@@ -324,7 +348,7 @@ def make_figure(exp_dir, results, path, env):
   try:
     plot_runs.main(run_dirs + [f"--out={path}", f"--title={env}"])
   except plot_runs.PlotError as e:
-    raise ReportError(f"the figure of {env}: {e}", RUNTIME_ERROR)
+    return str(e)
   return True
 
 
@@ -333,6 +357,10 @@ def main(argv):
   experiment = read_experiment(args.exp_dir)
   report = experiment.get("report", {})
   baseline_name = args.baseline or report.get("baseline") or "gae"
+  estimators = sorted({estimator_of(c) for c in experiment["cells"]})
+  if args.baseline and args.baseline not in estimators:
+    raise ReportError(f"--baseline={args.baseline}: no cell uses that "
+                      f"estimator (the experiment's: {', '.join(estimators)})")
   thresholds = dict(report.get("thresholds", {}))
   thresholds.update(args.thresholds)
   out = args.out or os.path.join(args.exp_dir, "report.md")
@@ -362,14 +390,17 @@ def main(argv):
             f"interval excludes 0 and p < 0.05.", ""]
   groups_total = runs_total = 0
   for env in sorted(by_env):
-    figure = None
+    figure = problem = None
     if not args.no_figures:
       figure_path = os.path.join(out_dir, "figures", f"{env}.png")
       os.makedirs(os.path.dirname(figure_path), exist_ok=True)
-      if make_figure(args.exp_dir, by_env[env], figure_path, env):
+      drawn = make_figure(args.exp_dir, by_env[env], figure_path, env)
+      if drawn is True:
         figure = os.path.relpath(figure_path, out_dir)
+      elif drawn:
+        problem = drawn
     section, groups, runs = env_section(env, by_env[env], baseline_name,
-                                        thresholds.get(env), figure)
+                                        thresholds.get(env), figure, problem)
     lines += section
     groups_total += groups
     runs_total += runs

@@ -25,14 +25,15 @@ namespace {
 using ::testing::HasSubstr;
 
 // 2 estimators x 2 seeds of PPO on InvertedPendulum, 48 updates of 512
-// steps each, a checkpoint every 4.
+// steps each (10 epochs, so that an update takes long enough for a stop to
+// land mid-run), a checkpoint every 4.
 std::string TinyExperiment(const std::string& name, int64_t steps = 24576) {
   return WriteTemp(name, absl::StrCat(R"({
     "name": "tiny",
     "base": {"mode": "local",
              "training": {"env": "InvertedPendulum", "steps": ")",
                                       steps, R"(", "horizon": "512"},
-             "ppo": {"epochs": 2, "minibatches": 4},
+             "ppo": {"epochs": 10, "minibatches": 4},
              "recording": {"checkpoint_every": 4}},
     "seeds": [0, 1],
     "variants": [{"set": {"estimator": "max"}}, {"set": {"estimator": "gae"}}]
@@ -74,11 +75,11 @@ TEST(ExperimentCommandTest, StoppedAndResumedGridEqualsAnUninterruptedOne) {
   const std::string first = absl::StrCat(broken, "/", kCells[0]);
   const auto deadline =
       std::chrono::steady_clock::now() + std::chrono::seconds(120);
-  while (ProgressRows(first) < 10 &&
+  while (ProgressRows(first) < 5 &&
          std::chrono::steady_clock::now() < deadline) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
-  ASSERT_GE(ProgressRows(first), 10);
+  ASSERT_GE(ProgressRows(first), 5);
   kill(pid, SIGTERM);
   EXPECT_EQ(WaitVantage(pid, 120), 1);
   EXPECT_THAT(ReadFile(err), HasSubstr("the same command again resumes them"));
@@ -153,6 +154,40 @@ TEST(ExperimentCommandTest, ADirectoryInUseIsRefused) {
   EXPECT_THAT(outcome.err, HasSubstr("is in use by another `vantage "
                                      "experiment run`"));
   EXPECT_FALSE(std::filesystem::exists(dir + "/experiment.json"));
+}
+
+// A runner killed outright leaves its cells running; they keep the
+// directory until they end.
+TEST(ExperimentCommandTest, CellsOfAKilledRunnerKeepTheDirectory) {
+  const std::string file = TinyExperiment("orphans.json", 65536);
+  const std::string dir = FreshDirectory("orphans");
+  const int pid = StartVantage(
+      absl::StrCat("experiment run ", file, " --out=", dir, " --jobs=1"),
+      TempPath("orphans.out"), TempPath("orphans.err"));
+  const std::string first = absl::StrCat(dir, "/", kCells[0]);
+  const auto deadline =
+      std::chrono::steady_clock::now() + std::chrono::seconds(120);
+  while (ProgressRows(first) < 1 &&
+         std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  ASSERT_GE(ProgressRows(first), 1);
+  kill(pid, SIGKILL);
+  WaitVantage(pid, 10);
+  const Outcome second = RunVantage(
+      absl::StrCat("experiment run ", file, " --out=", dir, " --jobs=1"));
+  EXPECT_EQ(second.exit_code, 2);
+  EXPECT_THAT(second.err, HasSubstr("is in use by another"));
+  EXPECT_LT(ProgressRows(first), 128) << "the orphan ended too early to test";
+  // The orphaned cell finishes its run, then the directory is free.
+  const int fd = open((dir + "/.lock").c_str(), O_RDWR);
+  ASSERT_GE(fd, 0);
+  while (flock(fd, LOCK_EX | LOCK_NB) != 0 &&
+         std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  close(fd);
+  EXPECT_EQ(ProgressRows(first), 128);
 }
 
 TEST(ExperimentCommandTest, DryRunPrintsEachCellsCommand) {

@@ -100,7 +100,7 @@ TEST(ExperimentGridTest, BudgetScalesStepsAndSeedsFlagReplacesTheFilesSeeds) {
   options.seeds = {7};
   absl::StatusOr<pb::ExpandedExperiment> expanded =
       Expand(absl::StrCat("{", kBase, R"(, "seeds": [0, 1],
-        "axes": [{"flag": "steps", "values": ["10000", "2"]}]})"),
+        "axes": [{"flag": "steps", "values": ["10000", "1"]}]})"),
              options);
   ASSERT_TRUE(expanded.ok()) << expanded.status();
   ASSERT_EQ(expanded->cells_size(), 2);

@@ -242,6 +242,8 @@ class ReportTest(unittest.TestCase):
         ([self.exp, "--out=/no/such/dir/r.md"], "its directory does not "
          "exist"),
         ([self.exp, "--colour=red"], "unrecognized arguments"),
+        ([self.exp, "--baseline=maxabs"], "--baseline=maxabs: no cell uses "
+         "that estimator (the experiment's: gae, max, min)"),
     ]
     for args, message in cases:
       result = subprocess.run([VANTAGE, "experiment", "report"] + args,
