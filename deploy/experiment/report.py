@@ -17,6 +17,7 @@ import math
 import os
 import statistics
 import sys
+import warnings
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)),
                                 "..", "plot"))
@@ -46,7 +47,8 @@ usage: vantage experiment report EXP_DIR [flags]
   baseline group (the --baseline estimator with the same other settings)
   with a 95% percentile-bootstrap confidence interval (10,000 resamples
   of the seeds of each group, seeded, so reports repeat) and Welch's
-  t-test p-value. A group beats (or trails) the baseline "with
+  t-test p-value, and the difference of the areas with its interval (for
+  tasks whose final returns all reach the maximum). A group beats (or trails) the baseline "with
   confidence" when the interval excludes 0 and p < 0.05; the report says
   so in words. Unfinished cells are listed, not counted. One learning-
   curve figure per env (`vantage plot`) goes beside the report.
@@ -227,7 +229,10 @@ def compare(values, baseline):
       random_state=np.random.default_rng(0))
   low = float(result.confidence_interval.low)
   high = float(result.confidence_interval.high)
-  with np.errstate(all="ignore"):
+  # Equal returns on both sides (a task's maximum) leave no variance: the
+  # p-value is then NaN, which the words say, without scipy's warning.
+  with np.errstate(all="ignore"), warnings.catch_warnings():
+    warnings.simplefilter("ignore")
     p = float(stats.ttest_ind(values, baseline, equal_var=False).pvalue)
   return difference, low, high, p
 
@@ -265,7 +270,8 @@ def env_section(env, results, baseline_name, threshold, figure,
   header = ["group", "runs", "final return", "AUC (mean return)"]
   if threshold is not None:
     header.append(f"steps to {number(threshold)}")
-  header += [f"final - {baseline_name} [95% CI]", "Welch p"]
+  header += [f"final - {baseline_name} [95% CI]", "Welch p",
+             f"AUC - {baseline_name} [95% CI]"]
   lines += ["| " + " | ".join(header) + " |",
             "|" + "|".join(["---"] * len(header)) + "|"]
   finished = {g: [r for r in rs if r.finished and math.isfinite(r.final)]
@@ -298,12 +304,16 @@ def env_section(env, results, baseline_name, threshold, figure,
                  if reached else f"not reached (0/{len(runs)})")
     base = baselines.get(group_key(groups[group][0].cell))
     if base is None or base == group or not runs or not finished[base]:
-      row += ["—" if base == group else "no baseline", ""]
+      row += ["—" if base == group else "no baseline", "", ""]
     else:
       base_finals = [r.final for r in finished[base]]
       difference, low, high, p = compare(finals, base_finals)
+      auc_difference, auc_low, auc_high, _ = compare(
+          [r.auc for r in runs], [r.auc for r in finished[base]])
       row += [f"{signed(difference)} [{signed(low)}, {signed(high)}]",
-              number(p, 3)]
+              number(p, 3),
+              f"{signed(auc_difference)} [{signed(auc_low)}, "
+              f"{signed(auc_high)}]"]
       kind = verdict(difference, low, high, p)
       counts = f"{len(finals)} vs {len(base_finals)} runs"
       if kind == "better":

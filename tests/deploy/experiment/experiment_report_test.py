@@ -191,6 +191,13 @@ class ReportTest(unittest.TestCase):
     self.assertLess(abs(high - exact_high), 4, (high, exact_high))
     self.assertAlmostEqual(parse_number(biased[4]),
                            welch_p(max_finals, gae_finals), places=3)
+    match = re.fullmatch(r"(\S+) \[(\S+), (\S+)\]", biased[5])
+    self.assertIsNotNone(match, biased[5])
+    self.assertAlmostEqual(parse_number(match.group(1)),
+                           mean(max_areas) - mean(gae_areas), places=1)
+    exact_low, exact_high = exact_bootstrap_interval(max_areas, gae_areas)
+    self.assertLess(abs(parse_number(match.group(2)) - exact_low), 4)
+    self.assertLess(abs(parse_number(match.group(3)) - exact_high), 4)
     # p = 0.055: the interval excludes 0 but the test does not agree.
     self.assertIn("`max-rho0.4-E1-16-64-2048` is not distinguishable from "
                   "`gae`", section)
