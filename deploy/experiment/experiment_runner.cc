@@ -114,6 +114,7 @@ absl::Status RunExperiment(const pb::ExpandedExperiment& experiment,
   GridTotals totals;
   totals.cells = experiment.cells_size();
   std::vector<CellTask> tasks;
+  std::vector<uint64_t> seeds;
   int resumed = 0;
   for (const pb::ExperimentCell& cell : experiment.cells()) {
     const int64_t steps = cell.config().training().steps();
@@ -148,8 +149,19 @@ absl::Status RunExperiment(const pb::ExpandedExperiment& experiment,
     task.run_dir = directory.RunDir(cell);
     task.log_path = directory.LogPath(cell);
     task.steps = steps;
+    seeds.push_back(cell.seed());
     tasks.push_back(std::move(task));
   }
+  // Seed by seed, so that a grid stopped halfway holds whole comparisons
+  // (every group, the baseline among them, with the first seeds) rather
+  // than some groups with all their seeds and others with none.
+  std::vector<size_t> order(tasks.size());
+  for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::stable_sort(order.begin(), order.end(),
+                   [&](size_t a, size_t b) { return seeds[a] < seeds[b]; });
+  std::vector<CellTask> ordered;
+  for (size_t i : order) ordered.push_back(std::move(tasks[i]));
+  tasks = std::move(ordered);
   std::printf(
       "experiment %s: %d cells (%d finished, %d to resume, %zu to start), "
       "%d at a time (%s backend), in %s\n",

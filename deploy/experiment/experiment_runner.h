@@ -32,7 +32,8 @@ std::vector<std::string> TrainArguments(const ExperimentDirectory& directory,
                                         const pb::ExperimentCell& cell,
                                         bool resume);
 
-// OK when every cell has finished; otherwise an error that says which
+// Cells run seed by seed (every group's first seed before any second
+// one). OK when every cell has finished; otherwise an error that says which
 // failed (and where their logs are) or how many a stop left unfinished.
 absl::Status RunExperiment(const pb::ExpandedExperiment& experiment,
                            const pb::RunConfig& base,

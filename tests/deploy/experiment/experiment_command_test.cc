@@ -182,8 +182,10 @@ TEST(ExperimentCommandTest, CellsOfAKilledRunnerKeepTheDirectory) {
   // The orphaned cell finishes its run, then the directory is free.
   const int fd = open((dir + "/.lock").c_str(), O_RDWR);
   ASSERT_GE(fd, 0);
+  const auto finish_deadline =
+      std::chrono::steady_clock::now() + std::chrono::seconds(300);
   while (flock(fd, LOCK_EX | LOCK_NB) != 0 &&
-         std::chrono::steady_clock::now() < deadline) {
+         std::chrono::steady_clock::now() < finish_deadline) {
     std::this_thread::sleep_for(std::chrono::milliseconds(50));
   }
   close(fd);
