@@ -2,12 +2,14 @@
 
 #include <ATen/ATen.h>
 #include <torch/serialize/archive.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 
+#include "absl/strings/str_cat.h"
 #include "actor/actor_core.h"
 #include "common/nn/networks.h"
 #include "gmock/gmock.h"
@@ -21,8 +23,28 @@ using ::testing::HasSubstr;
 
 constexpr int64_t kHorizon = kTestHorizon;
 
+// ctest runs the cases of one suite as parallel processes (-j2): each
+// process gets a directory of its own (removed when it ends), or two
+// fixtures write the same checkpoint at once.
+const std::string& TestDirectory() {
+  static const auto* directory = [] {
+    auto* path = new std::string(
+        absl::StrCat(::testing::TempDir(), "/checkpoint_test_", ::getpid()));
+    std::filesystem::create_directories(*path);
+    return path;
+  }();
+  return *directory;
+}
+
+class RemoveTestDirectory : public ::testing::Environment {
+ public:
+  void TearDown() override { std::filesystem::remove_all(TestDirectory()); }
+};
+::testing::Environment* const kRemoveTestDirectory =
+    ::testing::AddGlobalTestEnvironment(new RemoveTestDirectory);
+
 std::string TempFile(const std::string& name) {
-  return std::string(::testing::TempDir()) + "/" + name;
+  return absl::StrCat(TestDirectory(), "/", name);
 }
 
 LearnerConfig Config(const EnvSpec& spec, const std::string& algorithm) {
