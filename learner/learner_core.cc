@@ -479,7 +479,7 @@ absl::StatusOr<std::unique_ptr<LearnerCore>> LearnerCore::Load(
     if (!status.ok()) return status;
   }
   // Checkpoints written before rollbacks existed hold 6 counters.
-  if (counters.scalar_type() != at::kLong ||
+  if (counters.scalar_type() != at::kLong || counters.dim() != 1 ||
       (counters.numel() != 6 && counters.numel() != 7) ||
       returns.scalar_type() != at::kDouble || returns.dim() != 1 ||
       returns.numel() > 100) {

@@ -231,6 +231,19 @@ TEST_F(CheckpointErrorTest, NonFiniteWeightsAreRefused) {
   EXPECT_THAT(std::string(status.message()), HasSubstr("non-finite"));
 }
 
+// Six counters in two rows once reached item() on a row and aborted the
+// process. Found by tests/fuzz/checkpoint_entries_fuzzer.
+TEST_F(CheckpointErrorTest, CountersOfAnotherShapeAreRefused) {
+  torch::serialize::OutputArchive archive;
+  learner_->Save(archive);
+  archive.write("counters", at::zeros({2, 3}, at::kLong));
+  const std::string path = TempFile("counters_2x3.pt");
+  archive.save_to(path);
+  const absl::Status status = ReadCheckpoint(path, config_).status();
+  EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(std::string(status.message()), HasSubstr("'counters'"));
+}
+
 TEST_F(CheckpointErrorTest, UnwritableDirectoryIsAnErrorAndLeavesNoFile) {
   const std::string path = TempFile("no/such/dir/checkpoint.pt");
   EXPECT_FALSE(WriteCheckpoint(path, *learner_, {}).ok());
