@@ -39,8 +39,11 @@ using ::testing::HasSubstr;
 constexpr char kToken[] = "adversarial-test-token";
 constexpr int64_t kObs = kPendulumObservationSize;
 constexpr int64_t kSegmentSteps = 8;
-// How much the learner's resident memory may grow over a whole attack.
-constexpr int64_t kRssBoundBytes = 150 << 20;
+// How much the learner's resident memory may grow over a whole attack: the
+// 200 MiB registrations alone once took it from 186 MB to a 2.7 GB peak.
+// Growth of 163 MB was measured once under ctest -j2 (allocator retention
+// of gRPC's buffers varies run to run), hence 250 MB rather than 150.
+constexpr int64_t kRssBoundBytes = 250 << 20;
 
 pb::Tensor FloatTensor(std::vector<int64_t> shape, float value) {
   pb::Tensor tensor;
