@@ -1,6 +1,7 @@
 #include "deploy/run_config.h"
 
 #include <google/protobuf/util/json_util.h>
+#include <google/protobuf/util/message_differencer.h>
 
 #include <algorithm>
 #include <fstream>
@@ -9,6 +10,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_join.h"
 #include "absl/strings/str_replace.h"
+#include "absl/strings/str_split.h"
 #include "common/advantage/advantage_config.h"
 #include "learner/algorithms/algorithm.h"
 #include "proto/flat_run_config.pb.h"
@@ -330,6 +332,17 @@ LocalTrainingConfig ToLocalTrainingConfig(const pb::RunConfig& c) {
   advantage.ensemble.assign(a.ensemble().begin(), a.ensemble().end());
   learner.algorithm = AlgorithmConfigOf(c);
   return local;
+}
+
+std::string RunConfigDifference(const pb::RunConfig& held,
+                                const pb::RunConfig& wanted) {
+  std::string report;
+  google::protobuf::util::MessageDifferencer differencer;
+  differencer.ReportDifferencesToString(&report);
+  if (differencer.Compare(held, wanted)) return "";
+  const std::vector<std::string> lines =
+      absl::StrSplit(report, '\n', absl::SkipEmpty());
+  return lines.empty() ? "the configs differ" : lines.front();
 }
 
 }  // namespace vantage

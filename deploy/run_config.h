@@ -27,6 +27,11 @@ absl::StatusOr<pb::RunConfig> ReadRunConfigFile(const std::string& path);
 absl::StatusOr<pb::RunConfig> ParseRunConfigJson(const std::string& json);
 // Every field, with the proto's field names.
 std::string RunConfigToJson(const pb::RunConfig& config);
+// The first field in which two configs differ, as MessageDifferencer words
+// it ("modified: training.steps: 300000 -> 150000", from `held` to
+// `wanted`); empty when they are equal.
+std::string RunConfigDifference(const pb::RunConfig& held,
+                                const pb::RunConfig& wanted);
 
 // The local training a resolved config describes.
 LocalTrainingConfig ToLocalTrainingConfig(const pb::RunConfig& resolved);

@@ -42,6 +42,19 @@ absl::Status RunDirectory::CheckFree(const std::string& path) {
   return absl::OkStatus();
 }
 
+absl::Status RunDirectory::Clear(const std::string& path) {
+  for (const char* name :
+       {"config.json", "progress.csv", "checkpoints", "launch"}) {
+    std::error_code error;
+    std::filesystem::remove_all(absl::StrCat(path, "/", name), error);
+    if (error) {
+      return absl::InternalError(absl::StrCat("cannot remove ", path, "/", name,
+                                              ": ", error.message()));
+    }
+  }
+  return absl::OkStatus();
+}
+
 absl::StatusOr<RunDirectory> RunDirectory::Create(
     const std::string& path, const std::string& config_json) {
   if (absl::Status status = CheckFree(path); !status.ok()) return status;

@@ -43,6 +43,10 @@ class RunDirectory {
   // AlreadyExists if `path` holds a run (what Create refuses); creates
   // nothing.
   static absl::Status CheckFree(const std::string& path);
+  // Removes what a run writes into `path` (config.json, progress.csv,
+  // checkpoints/, the launcher's launch/), so that a run that never
+  // checkpointed can start over there; other files (a log) stay.
+  static absl::Status Clear(const std::string& path);
   // An existing run, to resume.
   static absl::StatusOr<RunDirectory> Open(const std::string& path);
 

@@ -13,7 +13,6 @@
 #include "deploy/cli/shared_flags.h"
 #include "deploy/cli/stop_signal.h"
 
-ABSL_FLAG(std::string, learner, "", "the learner's HOST:PORT");
 ABSL_FLAG(std::string, name, vantage::RemoteActorConfig().name,
           "a name for logs");
 ABSL_FLAG(int, max_reconnects, vantage::RemoteActorConfig().max_reconnects,

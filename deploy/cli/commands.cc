@@ -6,6 +6,7 @@
 #include "deploy/cli/advantages_command.h"
 #include "deploy/cli/env_commands.h"
 #include "deploy/cli/experiment_command.h"
+#include "deploy/cli/health_command.h"
 #include "deploy/cli/learner_command.h"
 #include "deploy/cli/plot_command.h"
 #include "deploy/cli/train_command.h"
@@ -19,8 +20,8 @@ const std::vector<Command>& AllCommands() {
   static const auto* commands = [] {
     auto* all = new std::vector<Command>{
         ActorCommand(),      AdvantagesCommand(), EnvsCommand(),
-        ExperimentCommand(), LearnerCommand(),    PlotCommand(),
-        RolloutCommand(),    TrainCommand(),
+        ExperimentCommand(), HealthCommand(),     LearnerCommand(),
+        PlotCommand(),       RolloutCommand(),    TrainCommand(),
     };
 #ifdef VANTAGE_WITH_BENCHMARKS
     all->push_back(BenchCommand());

@@ -135,6 +135,9 @@ int RunLearner(const std::vector<std::string>&) {
   if (absl::Status status = CheckRunCanStart(*resolved); !status.ok()) {
     return Fail(kUsageError, status.message());
   }
+  if (absl::Status status = PrepareRunDirectory(*resolved); !status.ok()) {
+    return Fail(kRuntimeError, status.message());
+  }
   LearnerServerConfig server;
   if (absl::Status status = ReadLimits(server); !status.ok()) {
     return Fail(kUsageError, status.message());

@@ -64,6 +64,11 @@ ABSL_FLAG(std::string, run_dir, "",
           "directory for config.json, progress.csv and checkpoints/");
 ABSL_FLAG(std::string, resume, "",
           "continue the run in this directory from its newest checkpoint");
+ABSL_FLAG(bool, resume_if_exists, false,
+          "with --run_dir: a directory already holding a run made with the "
+          "same settings continues it from its newest checkpoint (one that "
+          "never checkpointed starts over); other settings are refused. For "
+          "commands a scheduler repeats (requeued jobs, restarted pods)");
 
 // The algorithms' settings (learner/algorithms/<name>/<name>_config.h).
 ABSL_FLAG(int, ppo_epochs, 0, "ppo: epochs per update");
@@ -287,7 +292,7 @@ std::vector<std::string> RunFlagNames(bool with_mode) {
     }
     names.push_back(flag.name);
   }
-  for (const char* name : {"config", "run_dir", "resume"}) {
+  for (const char* name : {"config", "run_dir", "resume", "resume_if_exists"}) {
     names.push_back(name);
   }
   return names;
@@ -397,6 +402,7 @@ absl::StatusOr<RunRequest> RunRequestFromFlags() {
   request->config_file = absl::GetFlag(FLAGS_config);
   request->run_dir = absl::GetFlag(FLAGS_run_dir);
   request->resume = absl::GetFlag(FLAGS_resume);
+  request->resume_if_exists = absl::GetFlag(FLAGS_resume_if_exists);
   return request;
 }
 

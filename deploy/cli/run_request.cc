@@ -6,7 +6,9 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_join.h"
 #include "deploy/run_config.h"
+#include "deploy/run_directory.h"
 #include "learner/algorithms/algorithm.h"
+#include "learner/checkpoint.h"
 
 namespace vantage {
 namespace {
@@ -55,6 +57,40 @@ absl::Status CheckNoOverrides(const RunRequest& request) {
                    absl::StrJoin(given, ", ")));
 }
 
+// --resume_if_exists: what the directory holds decides between starting,
+// resuming and starting over; a run with other settings is never touched.
+absl::Status ApplyResumeIfExists(const RunRequest& request, ResolvedRun& run) {
+  if (request.run_dir.empty() || !request.resume.empty()) {
+    return absl::InvalidArgumentError(
+        "--resume_if_exists goes with --run_dir (and without --resume)");
+  }
+  const std::string& dir = request.run_dir;
+  absl::StatusOr<RunDirectory> existing = RunDirectory::Open(dir);
+  if (!existing.ok()) return absl::OkStatus();  // no run there: start it
+  absl::StatusOr<pb::RunConfig> saved =
+      ReadRunConfigFile(absl::StrCat(dir, "/config.json"));
+  if (!saved.ok()) return saved.status();
+  absl::StatusOr<pb::RunConfig> held = ResolveRunConfig(*saved);
+  if (!held.ok()) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(dir, "/config.json holds settings this vantage refuses: ",
+                     held.status().message()));
+  }
+  if (const std::string difference = RunConfigDifference(*held, run.config);
+      !difference.empty()) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(dir, " holds a run made with other settings (", difference,
+                     "); continue it as it is with --resume=", dir,
+                     " or choose another --run_dir"));
+  }
+  if (ListCheckpoints(existing->checkpoint_directory()).empty()) {
+    run.start_over = true;
+  } else {
+    run.local.resume = true;
+  }
+  return absl::OkStatus();
+}
+
 }  // namespace
 
 absl::StatusOr<ResolvedRun> ResolveRunRequest(const RunRequest& request) {
@@ -85,6 +121,11 @@ absl::StatusOr<ResolvedRun> ResolveRunRequest(const RunRequest& request) {
   run.local.config_json = RunConfigToJson(*config);
   run.local.run_dir = request.resume.empty() ? request.run_dir : request.resume;
   run.local.resume = !request.resume.empty();
+  if (request.resume_if_exists) {
+    if (absl::Status status = ApplyResumeIfExists(request, run); !status.ok()) {
+      return status;
+    }
+  }
   return run;
 }
 

@@ -31,17 +31,23 @@ struct RunRequest {
   std::optional<pb::RunConfig> config;
   std::string run_dir;  // --run_dir: where the run is recorded
   std::string resume;   // --resume: a run directory to continue
+  // --resume_if_exists: `run_dir` may hold this run already (continued).
+  bool resume_if_exists = false;
 };
 
 struct ResolvedRun {
   pb::RunConfig config;  // every field set
   LocalTrainingConfig local;
+  // --resume_if_exists found this run in its directory before its first
+  // checkpoint: the directory is cleared and the run starts over.
+  bool start_over = false;
 };
 
 // The config file (if any) under the given flags, or the resumed run's own
-// config.json (then no flag may change it), resolved and checked. Every
-// error is the request's: InvalidArgument or NotFound naming the flag or
-// file.
+// config.json (then no flag may change it), resolved and checked. With
+// resume_if_exists, a run directory holding a run resolved the same way is
+// resumed (or started over, before its first checkpoint). Every error is
+// the request's: InvalidArgument or NotFound naming the flag or file.
 absl::StatusOr<ResolvedRun> ResolveRunRequest(const RunRequest& request);
 
 // `RESULT train env=.. algo=.. estimator=.. rho=.. steps=.. mean_return=..

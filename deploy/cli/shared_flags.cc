@@ -6,6 +6,7 @@ ABSL_FLAG(std::string, env, "",
           "environment name (see `vantage envs`) or mjcf:PATH");
 ABSL_FLAG(int, envs, 1, "environments stepped together");
 ABSL_FLAG(uint64_t, seed, 0, "random seed");
+ABSL_FLAG(std::string, learner, "", "the learner's HOST:PORT");
 ABSL_FLAG(std::string, metrics, "",
           "serve Prometheus metrics on PORT (127.0.0.1) or HOST:PORT (port "
           "0: a free one, printed on stderr); with train, the learner there "

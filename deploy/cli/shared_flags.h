@@ -12,6 +12,7 @@
 ABSL_DECLARE_FLAG(std::string, env);
 ABSL_DECLARE_FLAG(int, envs);
 ABSL_DECLARE_FLAG(uint64_t, seed);
+ABSL_DECLARE_FLAG(std::string, learner);
 ABSL_DECLARE_FLAG(std::string, metrics);
 ABSL_DECLARE_FLAG(std::string, metrics_port_file);
 

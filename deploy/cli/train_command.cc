@@ -141,6 +141,9 @@ int RunTrain(const std::vector<std::string>&) {
   if (absl::Status status = CheckRunCanStart(*run); !status.ok()) {
     return Fail(kUsageError, status.message());
   }
+  if (absl::Status status = PrepareRunDirectory(*run); !status.ok()) {
+    return Fail(kRuntimeError, status.message());
+  }
   if (!absl::GetFlag(FLAGS_metrics).empty() &&
       run->config.mode() != "distributed") {
     return Fail(kUsageError,
@@ -161,7 +164,17 @@ absl::Status CheckRunCanStart(const ResolvedRun& run) {
   }
   if (run.local.run_dir.empty()) return absl::OkStatus();
   if (run.local.resume) return RunDirectory::Open(run.local.run_dir).status();
+  if (run.start_over) return absl::OkStatus();
   return RunDirectory::CheckFree(run.local.run_dir);
+}
+
+absl::Status PrepareRunDirectory(const ResolvedRun& run) {
+  if (!run.start_over) return absl::OkStatus();
+  std::fprintf(stderr,
+               "vantage: %s holds this run without a checkpoint; starting it "
+               "over\n",
+               run.local.run_dir.c_str());
+  return RunDirectory::Clear(run.local.run_dir);
 }
 
 Command TrainCommand() {

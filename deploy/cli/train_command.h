@@ -15,8 +15,13 @@ Command TrainCommand();
 // What train and learner check before any work starts, so that a run that
 // cannot start is a usage error (exit 2) and not a failure to restart: the
 // environment exists, and the run directory is free (new run) or holds a
-// run (resume).
+// run (resume), or holds this run before its first checkpoint
+// (--resume_if_exists: started over).
 absl::Status CheckRunCanStart(const ResolvedRun& run);
+
+// Clears the run directory of a run that starts over (`run.start_over`);
+// nothing otherwise.
+absl::Status PrepareRunDirectory(const ResolvedRun& run);
 
 }  // namespace vantage
 

@@ -26,18 +26,6 @@ std::string JsonOf(const google::protobuf::Message& message) {
   return json;
 }
 
-// The first difference between two run configs, as "field: a vs b".
-std::string FirstDifference(const pb::RunConfig& held,
-                            const pb::RunConfig& wanted) {
-  std::string report;
-  google::protobuf::util::MessageDifferencer differencer;
-  differencer.ReportDifferencesToString(&report);
-  differencer.Compare(wanted, held);
-  const std::vector<std::string> lines =
-      absl::StrSplit(report, '\n', absl::SkipEmpty());
-  return lines.empty() ? "the configs differ" : lines.front();
-}
-
 }  // namespace
 
 std::string ExpandedExperimentToJson(const pb::ExpandedExperiment& experiment) {
@@ -79,7 +67,7 @@ absl::Status ExperimentDirectory::CheckRuns(
           RunDir(cell),
           " holds a run made with other settings than this experiment's "
           "cell (",
-          FirstDifference(*held, cell.config()),
+          RunConfigDifference(cell.config(), *held),
           "): the experiment file or --budget changed; use another --out "
           "or remove that run"));
     }
@@ -120,7 +108,7 @@ absl::StatusOr<pb::ExpandedExperiment> ExperimentDirectory::Merged(
       return absl::FailedPreconditionError(
           absl::StrCat(ExperimentPath(), " records ", cell.dir(),
                        " with other settings than this experiment's cell (",
-                       FirstDifference(cell.config(), it->second->config()),
+                       RunConfigDifference(it->second->config(), cell.config()),
                        "): use another --out"));
     }
     *merged.add_cells() = *it->second;
@@ -173,17 +161,7 @@ CellStatus ExperimentDirectory::Inspect(const pb::ExperimentCell& cell) const {
 
 absl::Status ExperimentDirectory::ClearRun(
     const pb::ExperimentCell& cell) const {
-  const std::string run_dir = RunDir(cell);
-  for (const char* name :
-       {"config.json", "progress.csv", "checkpoints", "launch"}) {
-    std::error_code error;
-    std::filesystem::remove_all(absl::StrCat(run_dir, "/", name), error);
-    if (error) {
-      return absl::InternalError(absl::StrCat("cannot remove ", run_dir, "/",
-                                              name, ": ", error.message()));
-    }
-  }
-  return absl::OkStatus();
+  return RunDirectory::Clear(RunDir(cell));
 }
 
 }  // namespace vantage

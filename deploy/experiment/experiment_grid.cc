@@ -31,8 +31,8 @@ using Point = std::vector<Setting>;
 // (seeds, the run directory) or they would run something else than a
 // training cell.
 const std::set<std::string>& ReservedFlags() {
-  static const auto* reserved =
-      new std::set<std::string>{"seed", "config", "run_dir", "resume"};
+  static const auto* reserved = new std::set<std::string>{
+      "seed", "config", "run_dir", "resume", "resume_if_exists"};
   return *reserved;
 }
 

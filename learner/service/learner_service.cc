@@ -1,5 +1,6 @@
 #include "learner/service/learner_service.h"
 
+#include <grpcpp/health_check_service_interface.h>
 #include <grpcpp/support/proto_buffer_reader.h>
 
 #include <algorithm>
@@ -281,6 +282,10 @@ absl::StatusOr<RunningServer> StartServer(const ServerOptions& options,
       MakeServerCredentials(options.security);
   if (!credentials.ok()) return credentials.status();
   service.RequireAuthToken(options.security.auth_token);
+  // grpc.health.v1.Health, for orchestrators' probes (Kubernetes' gRPC
+  // probes, `vantage health`): it answers without the auth token, which a
+  // probe cannot carry, and tells only whether the server is up.
+  grpc::EnableDefaultHealthCheckService(true);
   RunningServer running;
   grpc::ServerBuilder builder;
   builder.AddListeningPort(options.listen, *credentials, &running.port);

@@ -6,11 +6,13 @@
 #include "deploy/cli/run_request.h"
 
 #include <filesystem>
+#include <fstream>
 #include <string>
 #include <utility>
 
 #include "deploy/cli/train_command.h"
 #include "deploy/run_config.h"
+#include "deploy/run_directory.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
 #include "tests/deploy/cli/run_vantage.h"
@@ -133,6 +135,58 @@ TEST(RunRequestTest, ARunThatCannotStartIsRefusedBeforeItStarts) {
   // Resuming a directory that holds no run.
   run->local.resume = true;
   EXPECT_FALSE(CheckRunCanStart(*run).ok());
+}
+
+// A scheduler repeats one command line (a requeued job, a restarted pod):
+// --resume_if_exists starts the run, resumes it after a checkpoint, starts
+// it over before one, and never touches a run made with other settings.
+TEST(RunRequestTest, ResumeIfExistsStartsResumesOrStartsOver) {
+  const std::string dir = FreshDirectory("resume_if_exists");
+  RunRequest request = FromJson(R"({"training": {"steps": 4096}})");
+  request.run_dir = dir;
+  request.resume_if_exists = true;
+
+  absl::StatusOr<ResolvedRun> fresh = ResolveRunRequest(request);
+  ASSERT_TRUE(fresh.ok()) << fresh.status();
+  EXPECT_FALSE(fresh->local.resume);
+  EXPECT_FALSE(fresh->start_over);
+  EXPECT_TRUE(CheckRunCanStart(*fresh).ok());
+
+  // Killed before its first checkpoint: config.json and a row, no checkpoint.
+  ASSERT_TRUE(RunDirectory::Create(dir, fresh->local.config_json).ok());
+  absl::StatusOr<ResolvedRun> unstarted = ResolveRunRequest(request);
+  ASSERT_TRUE(unstarted.ok()) << unstarted.status();
+  EXPECT_TRUE(unstarted->start_over);
+  EXPECT_FALSE(unstarted->local.resume);
+  EXPECT_TRUE(CheckRunCanStart(*unstarted).ok());
+  ASSERT_TRUE(PrepareRunDirectory(*unstarted).ok());
+  EXPECT_FALSE(std::filesystem::exists(dir + "/config.json"));
+  EXPECT_TRUE(RunDirectory::CheckFree(dir).ok());
+
+  ASSERT_TRUE(RunDirectory::Create(dir, fresh->local.config_json).ok());
+  std::ofstream(dir + "/checkpoints/checkpoint-00000002.pt") << "x";
+  absl::StatusOr<ResolvedRun> resumed = ResolveRunRequest(request);
+  ASSERT_TRUE(resumed.ok()) << resumed.status();
+  EXPECT_TRUE(resumed->local.resume);
+  EXPECT_FALSE(resumed->start_over);
+  EXPECT_EQ(resumed->local.run_dir, dir);
+  ASSERT_TRUE(PrepareRunDirectory(*resumed).ok());
+  EXPECT_TRUE(std::filesystem::exists(dir + "/checkpoints"));
+
+  RunRequest other = FromJson(R"({"training": {"steps": 8192}})");
+  other.run_dir = dir;
+  other.resume_if_exists = true;
+  const absl::Status refused = ResolveRunRequest(other).status();
+  EXPECT_EQ(refused.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(std::string(refused.message()),
+              HasSubstr("holds a run made with other settings (modified: "
+                        "training.steps: 4096 -> 8192)"));
+  EXPECT_TRUE(std::filesystem::exists(dir + "/config.json"));
+
+  RunRequest no_dir = FromJson("{}");
+  no_dir.resume_if_exists = true;
+  EXPECT_THAT(std::string(ResolveRunRequest(no_dir).status().message()),
+              HasSubstr("--resume_if_exists goes with --run_dir"));
 }
 
 }  // namespace
