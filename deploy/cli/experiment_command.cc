@@ -38,7 +38,11 @@ ABSL_FLAG(std::vector<std::string>, only, {},
           "matches one of these shell patterns (comma-separated), e.g. "
           "'Hopper/*' or '*/max-*'");
 ABSL_FLAG(std::string, backend, "local",
-          "run: where the cells run (local: this machine's processes)");
+          "run: where the cells run (local: this machine's processes; slurm: "
+          "a job array, --jobs tasks at a time)");
+ABSL_FLAG(std::vector<std::string>, sbatch_args, {},
+          "run, --backend=slurm: more sbatch options, comma-separated (e.g. "
+          "--partition=cpu,--time=04:00:00)");
 
 namespace vantage {
 namespace {
@@ -166,6 +170,9 @@ int RunGrid(const std::vector<std::string>& args) {
     return Fail(kUsageError,
                 absl::StrCat("--backend: ", made.status().message()));
   }
+  if (!absl::GetFlag(FLAGS_sbatch_args).empty() && backend != "slurm") {
+    return Fail(kUsageError, "--sbatch_args goes with --backend=slurm");
+  }
   absl::StatusOr<pb::Experiment> experiment = ReadExperimentFile(args[1]);
   if (!experiment.ok()) {
     return Fail(kUsageError, experiment.status().message());
@@ -194,6 +201,7 @@ int RunGrid(const std::vector<std::string>& args) {
   run_options.exp_dir = out;
   run_options.backend = backend;
   run_options.jobs = absl::GetFlag(FLAGS_jobs);
+  run_options.scheduler_args = absl::GetFlag(FLAGS_sbatch_args);
   const absl::Status status = RunExperiment(*expanded, experiment->base(),
                                             run_options, StopRequested());
   if (absl::IsFailedPrecondition(status)) {
@@ -235,8 +243,8 @@ Command BaseCommand() {
       "cells and resumes interrupted ones from their checkpoints; SIGINT or\n"
       "SIGTERM stops every cell with a checkpoint; a failed cell is reported\n"
       "and the others go on. report: see below. docs/experiments.md.";
-  command.flags = {"out",     "jobs", "budget", "seeds",
-                   "dry_run", "only", "backend"};
+  command.flags = {"out",     "jobs", "budget",  "seeds",
+                   "dry_run", "only", "backend", "sbatch_args"};
   command.defaults["backend"] = absl::StrCat(
       "local (backends: ", absl::StrJoin(ExperimentBackendNames(), ", "), ")");
   command.example =

@@ -6,6 +6,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_join.h"
 #include "deploy/experiment/local_backend.h"
+#include "deploy/experiment/slurm_backend.h"
 
 namespace vantage {
 namespace {
@@ -17,6 +18,7 @@ using BackendFactory =
 const std::map<std::string, BackendFactory>& Backends() {
   static const auto* backends = new std::map<std::string, BackendFactory>{
       {"local", MakeLocalBackend},
+      {"slurm", MakeSlurmBackend},
   };
   return *backends;
 }

@@ -22,6 +22,10 @@ struct CellTask {
   std::string run_dir;
   std::string log_path;  // the command's output is appended here
   int64_t steps = 0;     // the run's environment steps
+  // The same run as a command that may run again and again (a requeued
+  // job): `train ... --run_dir=RUN_DIR --resume_if_exists`.
+  std::vector<std::string> repeatable_args;
+  int cores = 1;  // processes the run starts (learners and actors)
 };
 
 struct CellOutcome {
@@ -47,13 +51,20 @@ class ExperimentBackend {
   virtual std::vector<CellOutcome> Run(const std::vector<CellTask>& tasks,
                                        const GridTotals& totals,
                                        const std::atomic<bool>& stop) = 0;
+  // FailedPrecondition while cells an earlier invocation started still run
+  // where this one cannot see them (a cluster's queue).
+  virtual absl::Status CheckIdle() { return absl::OkStatus(); }
 };
 
 struct BackendOptions {
-  int jobs = 1;  // commands at a time
+  int jobs = 1;          // commands at a time
+  std::string work_dir;  // the backend's own files (EXP_DIR/<backend>)
+  // Passed to the scheduler as they are (sbatch: --partition=.., --time=..).
+  std::vector<std::string> scheduler_args;
 };
 
-// A backend by name ("local"); an unknown name lists the known ones.
+// A backend by name ("local", "slurm"); an unknown name lists the known
+// ones.
 absl::StatusOr<std::unique_ptr<ExperimentBackend>> MakeExperimentBackend(
     const std::string& name, const BackendOptions& options);
 std::vector<std::string> ExperimentBackendNames();

@@ -164,4 +164,14 @@ absl::Status ExperimentDirectory::ClearRun(
   return RunDirectory::Clear(RunDir(cell));
 }
 
+std::string LastLogLine(const std::string& log_path) {
+  std::ifstream file(log_path);
+  std::string line;
+  std::string last;
+  while (std::getline(file, line)) {
+    if (!line.empty()) last = line;
+  }
+  return last;
+}
+
 }  // namespace vantage

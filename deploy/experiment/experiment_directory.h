@@ -68,6 +68,8 @@ class ExperimentDirectory {
 
 // The env_steps of progress.csv's last row in `run_dir` (0 if none).
 int64_t LastProgressSteps(const std::string& run_dir);
+// The last non-empty line of a cell's log ("" if none), for failure reports.
+std::string LastLogLine(const std::string& log_path);
 
 // experiment.json's content.
 std::string ExpandedExperimentToJson(const pb::ExpandedExperiment& experiment);

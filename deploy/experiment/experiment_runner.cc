@@ -101,15 +101,20 @@ absl::Status RunExperiment(const pb::ExpandedExperiment& experiment,
   }
   absl::StatusOr<DirectoryLock> lock = DirectoryLock::Take(options.exp_dir);
   if (!lock.ok()) return lock.status();
-  if (absl::Status status = directory.Prepare(experiment, base); !status.ok()) {
-    return status;
-  }
   BackendOptions backend_options;
   backend_options.jobs =
       options.jobs > 0 ? options.jobs : DefaultJobs(experiment);
+  backend_options.work_dir =
+      absl::StrCat(options.exp_dir, "/", options.backend);
+  backend_options.scheduler_args = options.scheduler_args;
   absl::StatusOr<std::unique_ptr<ExperimentBackend>> backend =
       MakeExperimentBackend(options.backend, backend_options);
   if (!backend.ok()) return backend.status();
+  if (absl::Status idle = (*backend)->CheckIdle(); !idle.ok()) return idle;
+  if (absl::Status status = directory.Prepare(experiment, base); !status.ok()) {
+    return status;
+  }
+  std::filesystem::create_directories(backend_options.work_dir, error);
 
   GridTotals totals;
   totals.cells = experiment.cells_size();
@@ -149,6 +154,9 @@ absl::Status RunExperiment(const pb::ExpandedExperiment& experiment,
     task.run_dir = directory.RunDir(cell);
     task.log_path = directory.LogPath(cell);
     task.steps = steps;
+    task.repeatable_args = TrainArguments(directory, cell, /*resume=*/false);
+    task.repeatable_args.push_back("--resume_if_exists");
+    task.cores = CoresPerCell(cell.config());
     seeds.push_back(cell.seed());
     tasks.push_back(std::move(task));
   }

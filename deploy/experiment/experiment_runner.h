@@ -18,7 +18,8 @@ namespace vantage {
 struct ExperimentRunOptions {
   std::string exp_dir;
   std::string backend = "local";
-  int jobs = 0;  // cells at a time; 0: DefaultJobs
+  int jobs = 0;                             // cells at a time; 0: DefaultJobs
+  std::vector<std::string> scheduler_args;  // BackendOptions::scheduler_args
 };
 
 // Cells at a time that this machine's cores allow: a local-mode cell takes

@@ -30,16 +30,6 @@ using Clock = std::chrono::steady_clock;
 // distributed one stops its learner and actors first).
 constexpr std::chrono::seconds kStopGrace(120);
 
-std::string LastLine(const std::string& path) {
-  std::ifstream file(path);
-  std::string line;
-  std::string last;
-  while (std::getline(file, line)) {
-    if (!line.empty()) last = line;
-  }
-  return last;
-}
-
 std::string Duration(double seconds) {
   if (!std::isfinite(seconds) || seconds < 0) return "?";
   const long s = std::lround(seconds);
@@ -177,7 +167,7 @@ class LocalBackend : public ExperimentBackend {
     }
     return {CellOutcome::Kind::kFailed,
             absl::StrCat(how, " at ", steps, " of ", task.steps, " steps; ",
-                         task.log_path, ": ", LastLine(task.log_path))};
+                         task.log_path, ": ", LastLogLine(task.log_path))};
   }
 
   void StopAll(std::map<pid_t, size_t>& running,
