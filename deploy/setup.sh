@@ -45,7 +45,19 @@ packages=(
   libavcodec-dev libavformat-dev libswscale-dev libavutil-dev ffmpeg
 )
 
-"${repo_root}/deploy/install_packages.sh" setup.sh "${packages[@]}"
+# Only the tests of deploy/ need these (kept apart from packages=(...),
+# which the container image's build stage installs): Slurm's daemons
+# (slurm-wlm, munge) for tests/deploy/slurm/; buildah and debootstrap to
+# build the image here (tests/deploy/docker/); python3-yaml to read the
+# rendered Kubernetes manifests (tests/deploy/k8s/), kubectl to render them
+# and Node.js with npm to validate them. A machine that has kubectl or
+# npm from elsewhere keeps them (Debian's packages would conflict).
+test_packages=(slurm-wlm munge buildah debootstrap python3-yaml)
+command -v kubectl >/dev/null || test_packages+=(kubernetes-client)
+command -v npm >/dev/null || test_packages+=(nodejs npm)
+
+"${repo_root}/deploy/install_packages.sh" setup.sh "${packages[@]}" \
+  "${test_packages[@]}"
 
 cmake -S "${repo_root}" -B "${build_dir}" -G Ninja -DCMAKE_BUILD_TYPE="${build_type}"
 cmake --build "${build_dir}"

@@ -161,7 +161,8 @@ TEST(CommandLineTest, HelpDefaultsAreTheRunsConfigAndBehaviour) {
     ASSERT_TRUE(config.ok()) << config.status();
     for (const std::string& name : RunFlagNames(/*with_mode=*/true)) {
       if (name == "mode" || name == "algo" || name == "steps" ||
-          name == "config" || name == "run_dir" || name == "resume") {
+          name == "config" || name == "run_dir" || name == "resume" ||
+          name == "resume_if_exists") {
         continue;
       }
       // Another algorithm's settings are not in this run's config.
