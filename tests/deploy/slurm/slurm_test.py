@@ -2,11 +2,13 @@
 """deploy/slurm/ against a real Slurm: munged, slurmctld and slurmd started
 here by deploy/slurm/local_cluster.sh (this machine the only node) and
 stopped at the end, whatever happens. (1) train.sbatch trains InvertedPendulum
-with a learner and two actor tasks to completion; (2) a job that gets TERM
+with a learner and two actor tasks to completion, listing their metrics
+endpoints in the run's scrape targets; (2) a job that gets TERM
 mid-run checkpoints, is requeued and resumes to completion; (3) a 2x2
 experiment runs as a job array and its report counts every run."""
 
 import argparse
+import json
 import os
 import re
 import shutil
@@ -72,9 +74,10 @@ def check_rows(rows, steps, what):
           f"{what}: the last row is at {steps} steps ({rows[-1:]})")
 
 
-def submit(vantage, work, run_dir, train_args):
+def submit(vantage, work, run_dir, train_args, metrics=False):
     env = dict(os.environ, VANTAGE_BIN=vantage, VANTAGE_RUN_DIR=run_dir,
-               VANTAGE_TRAIN_ARGS=train_args)
+               VANTAGE_TRAIN_ARGS=train_args,
+               VANTAGE_METRICS="1" if metrics else "0")
     # --overcommit: three tasks on a node of two CPUs (the learner waits
     # while the actors step).
     out = run(["sbatch", "--parsable", "--overcommit", "--ntasks=3",
@@ -86,7 +89,21 @@ def submit(vantage, work, run_dir, train_args):
 
 def one_run(vantage, work):
     run_dir = os.path.join(work, "runs", "one")
-    job = submit(vantage, work, run_dir, "--steps=16384")
+    job = submit(vantage, work, run_dir, "--steps=40960", metrics=True)
+    # The scrape targets while it runs: the learner and both actors.
+    targets_path = os.path.join(run_dir, "prometheus_targets.json")
+    roles = []
+    deadline = time.time() + 120
+    while time.time() < deadline and not roles:
+        try:
+            with open(targets_path) as f:
+                roles = sorted(t["labels"]["role"] for t in json.load(f))
+        except (OSError, ValueError):
+            pass
+        time.sleep(0.2)
+    check(roles == ["actor", "actor", "learner"],
+          f"prometheus_targets.json lists the learner and two actors "
+          f"while the job runs ({roles})")
     fields = wait_for_job(job, 300)
     log = open(os.path.join(work, f"vantage-{job}.out")).read()
     check(fields.get("JobState") == "COMPLETED" and
@@ -97,7 +114,9 @@ def one_run(vantage, work):
           "the job started two actor tasks")
     check("RESULT train env=InvertedPendulum" in log,
           "the learner printed its RESULT line")
-    check_rows(progress(run_dir), 16384, "one run")
+    check_rows(progress(run_dir), 40960, "one run")
+    with open(targets_path) as f:
+        check(json.load(f) == [], "the finished job emptied its targets")
     mode = stat.S_IMODE(os.stat(os.path.join(run_dir, "slurm",
                                              "token")).st_mode)
     check(mode == 0o600, f"the job's auth token is mode 0600 ({oct(mode)})")
