@@ -173,9 +173,11 @@ int RunLearner(const std::vector<std::string>&) {
   const bool primary = server.replicas.rank == 0;
   ProgressRow last;
   last.mean_return = std::nan("");
+  bool updated = false;
   const absl::Status status =
       RunLearnerServer(server, StopRequested(), [&](const ProgressRow& row) {
         last = row;
+        updated = true;
         if (!primary) return;
         std::fprintf(stderr,
                      "learner: update %ld steps %ld return(last100) %.1f "
@@ -185,7 +187,15 @@ int RunLearner(const std::vector<std::string>&) {
                      row.steps_per_second);
       });
   if (!status.ok()) return Fail(kRuntimeError, status.message());
-  if (primary) PrintTrainResult(resolved->config, last);
+  if (!primary) return 0;
+  if (!updated && resolved->local.resume && !StopRequested()) {
+    // A requeued job or a restarted pod repeats its command after the end.
+    std::printf("%s is finished already (%ld steps); nothing to do\n",
+                resolved->local.run_dir.c_str(),
+                static_cast<long>(resolved->config.training().steps()));
+    return 0;
+  }
+  PrintTrainResult(resolved->config, last);
   return 0;
 }
 

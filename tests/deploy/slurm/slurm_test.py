@@ -117,6 +117,14 @@ def one_run(vantage, work):
     check_rows(progress(run_dir), 40960, "one run")
     with open(targets_path) as f:
         check(json.load(f) == [], "the finished job emptied its targets")
+    # The same job again on the finished run: it ends at once, untouched.
+    again = submit(vantage, work, run_dir, "--steps=40960")
+    fields = wait_for_job(again, 120)
+    log = open(os.path.join(work, f"vantage-{again}.out")).read()
+    check(fields.get("JobState") == "COMPLETED" and
+          "is finished already (40960 steps)" in log,
+          "a job on the finished run completes without training")
+    check(len(progress(run_dir)) == 10, "and leaves its progress as it was")
     mode = stat.S_IMODE(os.stat(os.path.join(run_dir, "slurm",
                                              "token")).st_mode)
     check(mode == 0o600, f"the job's auth token is mode 0600 ({oct(mode)})")
