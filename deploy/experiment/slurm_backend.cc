@@ -10,6 +10,7 @@
 #include <fstream>
 #include <thread>
 
+#include "absl/strings/match.h"
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_join.h"
@@ -67,7 +68,7 @@ absl::StatusOr<CommandResult> RunProgram(const std::vector<std::string>& args) {
 constexpr char kArrayScript[] = R"(#!/usr/bin/env bash
 # Written by `vantage experiment run --backend=slurm`: one cell per task.
 set -uo pipefail
-task="${SLURM_SUBMIT_DIR_TASKS}/${SLURM_ARRAY_TASK_ID}"
+task="${VANTAGE_TASK_DIR}/${SLURM_ARRAY_TASK_ID}"
 mapfile -t lines < "${task}"
 log="${lines[0]}"
 stopping=0
@@ -211,6 +212,14 @@ class SlurmBackend : public ExperimentBackend {
         !status.ok()) {
       return status;
     }
+    const std::string self = SelfPath();
+    if (absl::StrContains(self, ",") || absl::StrContains(task_dir, ",")) {
+      // sbatch --export separates its variables with commas.
+      return absl::InvalidArgumentError(absl::StrCat(
+          "a path with a comma cannot reach the tasks through sbatch "
+          "--export: ",
+          self, " or ", task_dir));
+    }
     std::vector<std::string> args = {
         "sbatch",
         "--parsable",
@@ -223,8 +232,8 @@ class SlurmBackend : public ExperimentBackend {
         "--signal=B:TERM@120",
         "--ntasks=1",
         absl::StrCat("--cpus-per-task=", cores),
-        absl::StrCat("--export=ALL,VANTAGE_BIN=", SelfPath(),
-                     ",SLURM_SUBMIT_DIR_TASKS=", task_dir)};
+        absl::StrCat("--export=ALL,VANTAGE_BIN=", self,
+                     ",VANTAGE_TASK_DIR=", task_dir)};
     args.insert(args.end(), options_.scheduler_args.begin(),
                 options_.scheduler_args.end());
     args.push_back(script);
