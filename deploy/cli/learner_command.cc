@@ -189,10 +189,7 @@ int RunLearner(const std::vector<std::string>&) {
   if (!status.ok()) return Fail(kRuntimeError, status.message());
   if (!primary) return 0;
   if (!updated && resolved->local.resume && !StopRequested()) {
-    // A requeued job or a restarted pod repeats its command after the end.
-    std::printf("%s is finished already (%ld steps); nothing to do\n",
-                resolved->local.run_dir.c_str(),
-                static_cast<long>(resolved->config.training().steps()));
+    PrintFinishedAlready(*resolved);
     return 0;
   }
   PrintTrainResult(resolved->config, last);

@@ -139,4 +139,10 @@ void PrintTrainResult(const pb::RunConfig& config, const ProgressRow& last) {
       last.elapsed_seconds, last.steps_per_second);
 }
 
+void PrintFinishedAlready(const ResolvedRun& run) {
+  std::printf("%s is finished already (%ld steps); nothing to do\n",
+              run.local.run_dir.c_str(),
+              static_cast<long>(run.config.training().steps()));
+}
+
 }  // namespace vantage

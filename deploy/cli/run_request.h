@@ -53,6 +53,10 @@ absl::StatusOr<ResolvedRun> ResolveRunRequest(const RunRequest& request);
 // `RESULT train env=.. algo=.. estimator=.. rho=.. steps=.. mean_return=..
 // elapsed_s=.. sps=..` on stdout, the line scripts and tests read.
 void PrintTrainResult(const pb::RunConfig& config, const ProgressRow& last);
+// `RUN_DIR is finished already (S steps); nothing to do` on stdout: what a
+// resumed run with no update left says instead (a requeued job or a
+// restarted pod repeats its command after the end).
+void PrintFinishedAlready(const ResolvedRun& run);
 
 }  // namespace vantage
 

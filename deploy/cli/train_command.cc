@@ -130,10 +130,7 @@ int RunLocal(const ResolvedRun& run) {
     return 0;
   }
   if (!updated && local.resume) {
-    // A requeued job or a restarted pod repeats its command after the end.
-    std::printf("%s is finished already (%ld steps); nothing to do\n",
-                local.run_dir.c_str(),
-                static_cast<long>(config.training().steps()));
+    PrintFinishedAlready(run);
     return 0;
   }
   PrintTrainResult(config, last);
