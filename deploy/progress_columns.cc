@@ -81,6 +81,20 @@ const std::vector<ProgressColumn>& ProgressColumns() {
        [](const ProgressRow& r) {
          return double(r.stats.rolled_back_updates);
        }},
+      {"exploration_loss", "exploration_model_loss", Metric::kGauge,
+       Format::kNumber,
+       "Mean loss of the exploration model's fit in the last update (EX2).",
+       [](const ProgressRow& r) { return r.stats.exploration.model_loss; }},
+      {"exploration_accuracy", "exploration_model_accuracy", Metric::kGauge,
+       Format::kNumber,
+       "Mean share of pairs the exploration model told apart in its last "
+       "fit (EX2's discriminator).",
+       [](const ProgressRow& r) { return r.stats.exploration.model_accuracy; }},
+      {"exploration_bonus", "exploration_mean_bonus", Metric::kGauge,
+       Format::kNumber,
+       "Mean exploration bonus of the last batch before centring and "
+       "weighting (EX2: -log p(s)).",
+       [](const ProgressRow& r) { return r.stats.exploration.mean_bonus; }},
       {"elapsed_s", "run_elapsed_seconds", Metric::kGauge,
        Format::kMilliseconds, "Wall time of the whole run, across resumes.",
        [](const ProgressRow& r) { return r.elapsed_seconds; }},

@@ -13,6 +13,7 @@
 #include "absl/strings/str_split.h"
 #include "common/advantage/advantage_config.h"
 #include "learner/algorithms/algorithm.h"
+#include "learner/exploration/ex2_config.h"
 #include "proto/flat_run_config.pb.h"
 
 namespace vantage {
@@ -22,8 +23,9 @@ absl::Status Invalid(absl::string_view flag, absl::string_view rule) {
   return absl::InvalidArgumentError(absl::StrCat("--", flag, " ", rule));
 }
 
-// An algorithm's rule names its field ("ppo.epochs must be >= 1"); the
-// message adds the field's flag (--ppo_epochs).
+// An algorithm's or exploration method's rule names its field
+// ("ppo.epochs must be >= 1"); the message adds the field's flag
+// (--ppo_epochs).
 absl::Status AlgorithmSettingError(absl::string_view rule) {
   const absl::string_view field = rule.substr(0, rule.find(' '));
   if (field.find('.') == absl::string_view::npos) {
@@ -188,6 +190,14 @@ absl::StatusOr<pb::RunConfig> ResolveRunConfig(const pb::RunConfig& given) {
   }
   SetAlgorithmSettings(algorithm, c);
   const AlgorithmRunDefaults run_defaults = RunDefaultsOf(algorithm);
+  // An exploration section naming no method means none.
+  const ExplorationConfig exploration = ExplorationConfigOf(c);
+  if (exploration.ex2.has_value()) {
+    if (absl::Status status = exploration.ex2->Validate(); !status.ok()) {
+      return AlgorithmSettingError(status.message());
+    }
+  }
+  SetExplorationSettings(exploration, c);
 
   const LocalTrainingConfig local;
   pb::TrainingSettings& t = *c.mutable_training();
@@ -331,6 +341,7 @@ LocalTrainingConfig ToLocalTrainingConfig(const pb::RunConfig& c) {
   advantage.lambda = a.gae_lambda();
   advantage.ensemble.assign(a.ensemble().begin(), a.ensemble().end());
   learner.algorithm = AlgorithmConfigOf(c);
+  learner.exploration = ExplorationConfigOf(c);
   return local;
 }
 

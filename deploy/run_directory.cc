@@ -1,5 +1,6 @@
 #include "deploy/run_directory.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -116,10 +117,31 @@ std::vector<ProgressLine> ReadProgressLines(const std::string& run_dir) {
 }
 
 absl::Status RunDirectory::TruncateProgress(int64_t updates) const {
-  std::string text = absl::StrCat(ProgressHeader(), "\n");
+  const std::string header = ProgressHeader();
+  std::string text = absl::StrCat(header, "\n");
+  // A file written by a vantage with other columns is carried over column
+  // by column (a column it lacked stays empty), so resumed rows line up.
+  std::ifstream file(progress_path());
+  std::string old_header;
+  std::getline(file, old_header);
+  const std::vector<std::string> old_names = absl::StrSplit(old_header, ',');
+  const std::vector<std::string> names = absl::StrSplit(header, ',');
   for (const ProgressLine& row : ReadProgressLines(path_)) {
     if (row.updates > updates) break;
-    absl::StrAppend(&text, row.text, "\n");
+    if (old_header == header) {
+      absl::StrAppend(&text, row.text, "\n");
+      continue;
+    }
+    const std::vector<std::string> values = absl::StrSplit(row.text, ',');
+    std::vector<std::string> fields;
+    for (const std::string& name : names) {
+      const auto at = std::find(old_names.begin(), old_names.end(), name);
+      fields.push_back(
+          at == old_names.end()
+              ? ""
+              : values[static_cast<size_t>(at - old_names.begin())]);
+    }
+    absl::StrAppend(&text, absl::StrJoin(fields, ","), "\n");
   }
   return WriteFileAtomically(progress_path(), text);
 }

@@ -16,6 +16,7 @@
 #include "absl/strings/str_cat.h"
 #include "common/advantage/advantage.h"
 #include "learner/archive_io.h"
+#include "learner/exploration/ex2_bonus.h"
 #include "learner/ingest/training_batch.h"
 #include "learner/parallel/replica_reductions.h"
 #include "learner/update_guard.h"
@@ -49,6 +50,11 @@ absl::Status LearnerConfig::Validate() const {
   }
   if (absl::Status status = advantage.Validate(); !status.ok()) return status;
   if (absl::Status status = algorithm.Validate(); !status.ok()) return status;
+  if (exploration.ex2.has_value()) {
+    if (absl::Status status = exploration.ex2->Validate(); !status.ok()) {
+      return status;
+    }
+  }
   if (algorithm.name == "a2c" &&
       horizon % algorithm.a2c.steps_per_minibatch != 0) {
     return absl::InvalidArgumentError(absl::StrCat(
@@ -84,13 +90,29 @@ LearnerCore::LearnerCore(const LearnerConfig& config,
       updater_(MakePolicyUpdater(config.algorithm, policy_, value_, replicas_)
                    .value()),
       stitcher_(config.horizon),
-      rng_(ReplicaSeed(config.seed, replicas_->rank())) {}
+      rng_(ReplicaSeed(config.seed, replicas_->rank())) {
+  if (config.exploration.ex2.has_value()) {
+    // Its own stream, so that the minibatches and masks stay those of the
+    // learner's generator.
+    exploration_ = std::make_unique<Ex2Bonus>(
+        *config.exploration.ex2, config.spec,
+        ReplicaSeed(config.seed, replicas_->rank()) ^ 0x4558324558320000ULL,
+        replicas_);
+  }
+}
+
+LearnerCore::~LearnerCore() = default;
 
 absl::Status LearnerCore::SynchroniseReplicas() {
   if (replicas_->world_size() == 1) return absl::OkStatus();
   at::NoGradGuard no_grad;
   std::vector<at::Tensor> parameters = policy_->parameters();
   for (const at::Tensor& p : value_->parameters()) parameters.push_back(p);
+  if (exploration_ != nullptr) {
+    for (const at::Tensor& p : exploration_->parameters()) {
+      parameters.push_back(p);
+    }
+  }
   const int64_t local_version = version_;
   std::vector<at::Tensor> state = {
       at::cat({at::tensor({normalizer_.count(), static_cast<double>(version_),
@@ -229,22 +251,31 @@ absl::StatusOr<UpdateStats> LearnerCore::Update(std::vector<Rollout> rollouts) {
   // (shipped with its weights), so that in sync mode the first epoch's
   // ratios start at 1; the statistics absorb the batch after the update.
   const double clip = config_.observation_clip;
-  absl::StatusOr<TrainingBatch> batch =
-      AssembleBatch(rollouts, [&](const at::Tensor& observations) {
-        at::NoGradGuard no_grad;
-        return value_->forward(normalizer_.Normalize(observations, clip));
-      });
-  if (!batch.ok()) return batch.status();
   UpdateGuard guard(*policy_, *value_, *updater_,
-                    config_.scale_rewards ? &reward_scaler_ : nullptr);
+                    config_.scale_rewards ? &reward_scaler_ : nullptr,
+                    exploration_.get());
   ReplicaGroup& replicas = *replicas_;
   const double world = replicas.world_size();
   // A collective that fails (a replica gone) throws from inside the
   // algorithm; nothing of the update may stay.
   try {
+    ExplorationStats exploration;
+    if (exploration_ != nullptr) {
+      exploration = exploration_->ShapeRewards(rollouts);
+    }
+    absl::StatusOr<TrainingBatch> batch =
+        AssembleBatch(rollouts, [&](const at::Tensor& observations) {
+          at::NoGradGuard no_grad;
+          return value_->forward(normalizer_.Normalize(observations, clip));
+        });
+    if (!batch.ok()) {
+      guard.Restore();
+      return batch.status();
+    }
     if (config_.scale_rewards) {
       if (absl::Status status = reward_scaler_.Observe(rollouts, replicas);
           !status.ok()) {
+        guard.Restore();
         return status;
       }
       batch->advantage_inputs.rewards =
@@ -252,7 +283,10 @@ absl::StatusOr<UpdateStats> LearnerCore::Update(std::vector<Rollout> rollouts) {
     }
     absl::StatusOr<Advantages> advantages =
         ComputeAdvantages(batch->advantage_inputs, config_.advantage, rng_);
-    if (!advantages.ok()) return advantages.status();
+    if (!advantages.ok()) {
+      guard.Restore();
+      return advantages.status();
+    }
 
     const UpdateBatch update =
         MakeUpdateBatch(*batch, *advantages, [&](const at::Tensor& raw) {
@@ -262,6 +296,7 @@ absl::StatusOr<UpdateStats> LearnerCore::Update(std::vector<Rollout> rollouts) {
     const double progress =
         static_cast<double>(env_steps_) / config_.total_env_steps;
     UpdateStats stats;
+    stats.exploration = exploration;
     const auto optimisation_start = std::chrono::steady_clock::now();
     stats.advantage_seconds =
         std::chrono::duration<double>(optimisation_start - update_start)
@@ -332,6 +367,7 @@ absl::StatusOr<UpdateStats> LearnerCore::Update(std::vector<Rollout> rollouts) {
           !status.ok()) {
         return status;
       }
+      if (exploration_ != nullptr) exploration_->Commit();
     }
     env_steps_ += static_cast<int64_t>(global_samples);
     episodes_ += static_cast<int64_t>(sums[1]);
@@ -402,6 +438,11 @@ void LearnerCore::Save(torch::serialize::OutputArchive& archive) const {
   reward_scaler_.Save(scaler);
   archive.write("updater", updater);
   archive.write("reward_scaler", scaler);
+  if (exploration_ != nullptr) {
+    torch::serialize::OutputArchive ex2;
+    exploration_->Save(ex2);
+    archive.write("ex2", ex2);
+  }
   WriteRunningMeanStd(archive, "normalizer", normalizer_);
   std::ostringstream rng;
   rng << rng_;
@@ -465,6 +506,19 @@ absl::StatusOr<std::unique_ptr<LearnerCore>> LearnerCore::Load(
         core.updater_->Load(updater), core.reward_scaler_.Load(scaler),
         ReadRunningMeanStd(archive, "normalizer", core.normalizer_)}) {
     if (!status.ok()) return status;
+  }
+  if (core.exploration_ != nullptr) {
+    torch::serialize::InputArchive ex2;
+    if (absl::Status status = CatchTorchErrors(
+            "checkpoint entry 'ex2' is missing (a run without EX2 cannot "
+            "continue with it)",
+            [&] { archive.read("ex2", ex2); });
+        !status.ok()) {
+      return status;
+    }
+    if (absl::Status status = core.exploration_->Load(ex2); !status.ok()) {
+      return status;
+    }
   }
   absl::StatusOr<std::string> rng = ReadBytes(archive, "rng");
   if (!rng.ok()) return rng.status();

@@ -18,11 +18,15 @@
 #include "common/rollout/segment.h"
 #include "common/rollout/segment_queue.h"
 #include "learner/algorithms/algorithm.h"
+#include "learner/exploration/ex2_config.h"
+#include "learner/exploration/exploration_stats.h"
 #include "learner/ingest/reward_scaler.h"
 #include "learner/ingest/rollout_stitcher.h"
 #include "learner/parallel/replica_group.h"
 
 namespace vantage {
+
+class Ex2Bonus;
 
 struct LearnerConfig {
   EnvSpec spec;
@@ -53,6 +57,8 @@ struct LearnerConfig {
   AdvantageConfig advantage;
   AlgorithmConfig algorithm;
   NetworkConfig network;
+  // A bonus added to the rewards before advantages (none by default).
+  ExplorationConfig exploration;
 
   absl::Status Validate() const;
 };
@@ -65,6 +71,7 @@ struct UpdateStats {
   // Of the last 100 episodes each replica saw; NaN before the first ends.
   double mean_return = 0.0;
   AlgorithmStats algorithm;
+  ExplorationStats exploration;  // rank 0's, in a data-parallel run
   double biased_fraction = 0.0;  // share of samples using the bias
   double mean_abs_bias = 0.0;    // mean |biased - GAE|
   double explained_variance = 0.0;
@@ -111,6 +118,8 @@ class LearnerCore {
       const LearnerConfig& config,
       std::shared_ptr<ReplicaGroup> replicas = SoloReplicaGroup());
 
+  ~LearnerCore();
+
   PolicyWeights CurrentWeights();
   // Blocks on `source` until a batch is complete, then updates. A replica
   // lost during the update leaves this learner as it was before it and
@@ -138,7 +147,8 @@ class LearnerCore {
   const LearnerConfig& config() const { return config_; }
 
   // Everything later updates depend on: both networks, the optimiser
-  // state, the observation normaliser, the reward scaler, the random
+  // state, the exploration model and its pool, the observation normaliser,
+  // the reward scaler, the random
   // generator, the version and counters, the recent returns and the
   // environment spec. Rollouts still being stitched are not included (a
   // resumed learner starts every stream afresh).
@@ -170,6 +180,9 @@ class LearnerCore {
   RunningMeanStd normalizer_;
   RewardScaler reward_scaler_;
   std::unique_ptr<PolicyUpdater> updater_;
+  // Created after the networks, from the same generator, so that a run
+  // without it initialises exactly as before it existed.
+  std::unique_ptr<Ex2Bonus> exploration_;
   RolloutStitcher stitcher_;
   std::vector<Rollout> pending_;
   std::mt19937_64 rng_;

@@ -9,6 +9,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "common/nn/networks.h"
+#include "learner/exploration/ex2_bonus.h"
 #include "learner/ingest/reward_scaler.h"
 
 namespace vantage {
@@ -33,11 +34,13 @@ std::string SaveToBytes(Saver save) {
 }  // namespace
 
 UpdateGuard::UpdateGuard(PolicyNetworkImpl& policy, ValueNetworkImpl& value,
-                         PolicyUpdater& updater, RewardScaler* reward_scaler)
+                         PolicyUpdater& updater, RewardScaler* reward_scaler,
+                         Ex2Bonus* exploration)
     : policy_(policy),
       value_(value),
       updater_(updater),
-      reward_scaler_(reward_scaler) {
+      reward_scaler_(reward_scaler),
+      exploration_(exploration) {
   for (const at::Tensor& p : AllParameters(policy_, value_)) {
     parameters_.push_back(p.detach().clone());
   }
@@ -47,6 +50,11 @@ UpdateGuard::UpdateGuard(PolicyNetworkImpl& policy, ValueNetworkImpl& value,
   if (reward_scaler_ != nullptr) {
     reward_scaler_state_ = SaveToBytes(
         [&](torch::serialize::OutputArchive& a) { reward_scaler_->Save(a); });
+  }
+  if (exploration_ != nullptr) {
+    exploration_state_ = SaveToBytes([&](torch::serialize::OutputArchive& a) {
+      exploration_->SaveModelState(a);
+    });
   }
 }
 
@@ -68,6 +76,14 @@ std::string UpdateGuard::Fault(const AlgorithmStats& stats,
   for (const auto& item : value_.named_parameters()) {
     if (!at::isfinite(item.value()).all().item<bool>()) {
       return absl::StrCat("non-finite value parameter ", item.key());
+    }
+  }
+  if (exploration_ != nullptr) {
+    for (const auto& item : exploration_->model().named_parameters()) {
+      if (!at::isfinite(item.value()).all().item<bool>()) {
+        return absl::StrCat("non-finite exploration model parameter ",
+                            item.key());
+      }
     }
   }
   return "";
@@ -94,6 +110,15 @@ void UpdateGuard::Restore() {
     scaler.load_from(scaler_bytes);
     const absl::Status scaler_loaded = reward_scaler_->Load(scaler);
     TORCH_CHECK(scaler_loaded.ok(), "rollback: ", scaler_loaded.ToString());
+  }
+  if (exploration_ != nullptr) {
+    torch::serialize::InputArchive exploration;
+    std::istringstream exploration_bytes(exploration_state_);
+    exploration.load_from(exploration_bytes);
+    const absl::Status exploration_loaded =
+        exploration_->LoadModelState(exploration);
+    TORCH_CHECK(exploration_loaded.ok(),
+                "rollback: ", exploration_loaded.ToString());
   }
 }
 

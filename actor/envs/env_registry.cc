@@ -14,6 +14,7 @@
 #include "actor/envs/mujoco/humanoid_env.h"
 #include "actor/envs/mujoco/pendulum_envs.h"
 #include "actor/envs/mujoco/point_maze_env.h"
+#include "actor/envs/mujoco/twod_maze_env.h"
 #include "common/env/time_limit.h"
 
 namespace vantage {
@@ -34,6 +35,8 @@ const std::map<std::string, Factory>& Factories() {
       {"InvertedPendulum", MakeInvertedPendulum},
       {"PointMaze", MakePointMaze},
       {"SparseHalfCheetah", MakeSparseHalfCheetah},
+      {"Ex2SparseHalfCheetah", MakeEx2SparseHalfCheetah},
+      {"TwoDMaze", MakeTwoDMaze},
       {"Walker2d", MakeWalker2d},
   };
   return *factories;

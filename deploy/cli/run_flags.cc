@@ -13,6 +13,7 @@
 #include "deploy/cli/command_line.h"
 #include "deploy/run_config.h"
 #include "learner/algorithms/algorithm.h"
+#include "learner/exploration/ex2_config.h"
 
 // Every default is ResolveRunConfig's (see RunFlagDefaults): a flag's own
 // default below is never read, since only given flags enter the config.
@@ -99,6 +100,31 @@ ABSL_FLAG(double, trpo_value_learning_rate, 0,
           "trpo: the value function's Adam learning rate");
 ABSL_FLAG(int, trpo_value_epochs, 0, "trpo: value function epochs per update");
 
+// The exploration bonus (learner/exploration/).
+ABSL_FLAG(std::string, exploration, "",
+          "none | ex2 (EX2's exemplar-model novelty bonus added to the "
+          "rewards on the learner; its settings are the --ex2_ flags)");
+ABSL_FLAG(std::vector<std::string>, ex2_hidden, {},
+          "ex2: hidden layer sizes of the encoders and discriminator");
+ABSL_FLAG(int64_t, ex2_feature_dim, 0, "ex2: latent size of each encoder");
+ABSL_FLAG(double, ex2_learning_rate, 0, "ex2: the model's Adam learning rate");
+ABSL_FLAG(double, ex2_kl_weight, 0,
+          "ex2: weight of the latents' KL divergence to N(0, I)");
+ABSL_FLAG(double, ex2_bonus_coeff, 0,
+          "ex2: weight of the bonus -log p(s) in the reward");
+ABSL_FLAG(int, ex2_train_iterations, 0,
+          "ex2: the model's Adam steps per policy update");
+ABSL_FLAG(int, ex2_first_train_iterations, 0,
+          "ex2: Adam steps of the model's first fit");
+ABSL_FLAG(int64_t, ex2_replay_min, 0,
+          "ex2: states seen before the model fits at all");
+ABSL_FLAG(int64_t, ex2_replay_size, 0,
+          "ex2: newest states kept in the pool of negatives");
+ABSL_FLAG(int, ex2_batch_size, 0,
+          "ex2: positive (and negative) pairs per Adam step");
+ABSL_FLAG(bool, ex2_use_actions, true,
+          "ex2: model (state, action) pairs rather than states");
+
 namespace vantage {
 namespace {
 
@@ -107,11 +133,13 @@ using google::protobuf::FieldDescriptor;
 using google::protobuf::Message;
 
 // One flag of a run-config field: `field` of the section `section`
-// (a RunConfig message field) or of RunConfig itself (section null).
+// (a RunConfig message field) or of RunConfig itself (section null), or of
+// the message `group` inside the section (an exploration method's).
 struct RunFlag {
   std::string name;
   const FieldDescriptor* section = nullptr;
   const FieldDescriptor* field = nullptr;
+  const FieldDescriptor* group = nullptr;
   bool algorithm() const {
     return section != nullptr && section->containing_oneof() != nullptr;
   }
@@ -131,6 +159,15 @@ const std::vector<RunFlag>& RunFlags() {
       const Descriptor* fields = section->message_type();
       for (int j = 0; j < fields->field_count(); ++j) {
         const FieldDescriptor* field = fields->field(j);
+        if (field->message_type() != nullptr) {
+          const Descriptor* group = field->message_type();
+          for (int k = 0; k < group->field_count(); ++k) {
+            all->push_back(
+                {absl::StrCat(field->name(), "_", group->field(k)->name()),
+                 section, group->field(k), field});
+          }
+          continue;
+        }
         all->push_back({algorithm
                             ? absl::StrCat(section->name(), "_", field->name())
                             : field->name(),
@@ -154,7 +191,10 @@ const Message* Holder(const pb::RunConfig& config, const RunFlag& flag) {
   if (flag.section == nullptr) return &config;
   const auto* reflection = config.GetReflection();
   if (!reflection->HasField(config, flag.section)) return nullptr;
-  return &reflection->GetMessage(config, flag.section);
+  const Message& section = reflection->GetMessage(config, flag.section);
+  if (flag.group == nullptr) return &section;
+  if (!section.GetReflection()->HasField(section, flag.group)) return nullptr;
+  return &section.GetReflection()->GetMessage(section, flag.group);
 }
 
 std::string FieldText(const Message& message, const FieldDescriptor& field) {
@@ -203,6 +243,9 @@ absl::Status SetField(const RunFlag& flag, const std::string& text,
       flag.section == nullptr
           ? &config
           : config.GetReflection()->MutableMessage(&config, flag.section);
+  if (flag.group != nullptr) {
+    message = message->GetReflection()->MutableMessage(message, flag.group);
+  }
   const auto* reflection = message->GetReflection();
   const FieldDescriptor* field = flag.field;
   auto bad = [&](absl::string_view what) {
@@ -255,9 +298,11 @@ absl::Status SetField(const RunFlag& flag, const std::string& text,
   }
 }
 
-pb::RunConfig Resolved(const std::string& algo, const std::string& mode) {
+pb::RunConfig Resolved(const std::string& algo, const std::string& mode,
+                       const std::string& exploration = "none") {
   pb::RunConfig given;
   if (!algo.empty()) (void)SelectAlgorithm(algo, given);
+  (void)SelectExploration(exploration, given);
   if (!mode.empty()) given.set_mode(mode);
   // The defaults resolve by construction; a failure is a programming error
   // that the help test catches as an empty default.
@@ -270,6 +315,7 @@ pb::RunConfig Resolved(const std::string& algo, const std::string& mode) {
 std::string RunConfigFieldText(const pb::RunConfig& config,
                                const std::string& flag) {
   if (flag == "algo") return AlgorithmNameOf(config);
+  if (flag == "exploration") return ExplorationNameOf(config);
   const RunFlag* run_flag = FindRunFlag(flag);
   if (run_flag == nullptr) return "";
   const Message* holder = Holder(config, *run_flag);
@@ -277,14 +323,19 @@ std::string RunConfigFieldText(const pb::RunConfig& config,
 }
 
 std::vector<std::string> RunSettingNames() {
-  std::vector<std::string> names = {"algo"};
+  std::vector<std::string> names = {"algo", "exploration"};
   for (const RunFlag& flag : RunFlags()) names.push_back(flag.name);
   return names;
 }
 
 std::vector<std::string> RunFlagNames(bool with_mode) {
   std::vector<std::string> names;
+  bool exploration_named = false;
   for (const RunFlag& flag : RunFlags()) {
+    if (flag.group != nullptr && !exploration_named) {
+      names.push_back("exploration");
+      exploration_named = true;
+    }
     if (flag.name == "mode") {
       if (with_mode) names.push_back(flag.name);
       names.push_back("algo");
@@ -307,7 +358,18 @@ std::map<std::string, std::string> RunFlagDefaults(bool with_mode) {
   }
   std::map<std::string, std::string> defaults;
   defaults["algo"] = AlgorithmNameOf(standard);
+  defaults["exploration"] = ExplorationNameOf(standard);
+  std::map<std::string, pb::RunConfig> by_exploration;
+  for (const std::string& method : ExplorationNames()) {
+    by_exploration[method] = Resolved("", "", method);
+  }
   for (const RunFlag& flag : RunFlags()) {
+    if (flag.group != nullptr) {
+      // Only its own method reads it.
+      defaults[flag.name] =
+          RunConfigFieldText(by_exploration[flag.group->name()], flag.name);
+      continue;
+    }
     if (flag.algorithm()) {
       // Only its own algorithm reads it.
       defaults[flag.name] =
@@ -349,9 +411,19 @@ absl::StatusOr<RunRequest> RunRequestFromSettings(
           absl::StrCat("--algo: ", status.message()));
     }
   }
+  for (const auto& [name, text] : settings) {
+    if (name != "exploration") continue;
+    request.exploration = text;
+    request.given_flags.push_back("exploration");
+    if (absl::Status status = SelectExploration(text, request.flags);
+        !status.ok()) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("--exploration: ", status.message()));
+    }
+  }
   const RunFlag* algorithm_flag = nullptr;
   for (const auto& [name, text] : settings) {
-    if (name == "algo") continue;
+    if (name == "algo" || name == "exploration") continue;
     const RunFlag* flag = FindRunFlag(name);
     if (flag == nullptr) {
       return absl::InvalidArgumentError(
@@ -374,6 +446,12 @@ absl::StatusOr<RunRequest> RunRequestFromSettings(
       }
       algorithm_flag = flag;
     }
+    if (flag->group != nullptr && !request.exploration.empty() &&
+        request.exploration != flag->group->name()) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("--", name, " is a setting of ", flag->group->name(),
+                       "; this run's --exploration is ", request.exploration));
+    }
     if (absl::Status status = SetField(*flag, text, request.flags);
         !status.ok()) {
       return status;
@@ -386,6 +464,9 @@ absl::StatusOr<RunRequest> RunRequestFromFlags() {
   std::vector<std::pair<std::string, std::string>> settings;
   if (FlagGiven("algo")) {
     settings.emplace_back("algo", absl::GetFlag(FLAGS_algo));
+  }
+  if (FlagGiven("exploration")) {
+    settings.emplace_back("exploration", absl::GetFlag(FLAGS_exploration));
   }
   for (const RunFlag& flag : RunFlags()) {
     if (!FlagGiven(flag.name)) continue;

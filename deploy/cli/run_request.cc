@@ -40,7 +40,11 @@ absl::StatusOr<pb::RunConfig> MergeFlags(const RunRequest& request) {
   if (flags.advantage().ensemble_size() > 0) {
     config.mutable_advantage()->clear_ensemble();
   }
+  if (flags.exploration().ex2().hidden_size() > 0) {
+    config.mutable_exploration()->mutable_ex2()->clear_hidden();
+  }
   config.MergeFrom(flags);
+  if (request.exploration == "none") config.clear_exploration();
   return config;
 }
 

@@ -25,6 +25,9 @@ struct RunRequest {
   // file's settings of the other one); else the flags' algorithm settings
   // must be the file's algorithm's.
   std::string algo;
+  // --exploration, if given: none drops a config file's exploration
+  // section; a method selects it (with the file's settings of it, if any).
+  std::string exploration;
   std::string config_file;  // --config: JSON RunConfig under the flags
   // A config already read, used instead of reading `config_file` (which
   // then only names it in messages).

@@ -39,7 +39,21 @@ LocalTrainingConfig SmallRun(const std::string& algorithm, uint64_t seed,
   config.total_env_steps = kUpdates * kEnvs * horizon;
   config.seed = seed;
   config.learner.horizon = horizon;
-  config.learner.algorithm.name = algorithm;
+  // "ex2": TRPO with an EX2 bonus small enough to fit on update 3, whose
+  // pool (1000 states) wraps around after four batches.
+  config.learner.algorithm.name = algorithm == "ex2" ? "trpo" : algorithm;
+  if (algorithm == "ex2") {
+    Ex2Config ex2;
+    ex2.hidden = {16};
+    ex2.feature_dim = 8;
+    ex2.replay_min = 300;
+    ex2.replay_size = 1000;
+    ex2.first_train_iterations = 30;
+    ex2.train_iterations = 10;
+    ex2.batch_size = 32;
+    ex2.bonus_coeff = 0.1;
+    config.learner.exploration.ex2 = ex2;
+  }
   config.learner.algorithm.ppo.minibatches = 8;
   config.learner.algorithm.ppo.epochs = 2;
   config.learner.algorithm.a2c.n = 4;
@@ -77,7 +91,8 @@ TEST(LocalTrainingTest, SameSeedSameProgressCsv) {
             "env_steps,updates,policy_version,episodes,mean_return,"
             "policy_loss,value_loss,entropy,approx_kl,clip_fraction,"
             "explained_variance,biased_fraction,mean_abs_bias,"
-            "rejected_segments,rolled_back_updates");
+            "rejected_segments,rolled_back_updates,exploration_loss,"
+            "exploration_accuracy,exploration_bonus");
   EXPECT_EQ(first, DeterministicProgress(b));
   EXPECT_NE(first, DeterministicProgress(c));
   // One row per update, steps counted exactly.
@@ -115,7 +130,51 @@ TEST_P(ResumeTest, ResumedRunEqualsUninterruptedRun) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Algorithms, ResumeTest,
-                         ::testing::Values("ppo", "a2c", "trpo"));
+                         ::testing::Values("ppo", "a2c", "trpo", "ex2"));
+
+// The rows without the three exploration columns (the last ones before the
+// wall clock, which DeterministicProgress drops).
+std::vector<std::string> WithoutExploration(
+    const std::vector<std::string>& rows) {
+  std::vector<std::string> kept;
+  for (const std::string& row : rows) {
+    std::vector<std::string> fields = absl::StrSplit(row, ',');
+    fields.resize(fields.size() - 3);
+    kept.push_back(absl::StrJoin(fields, ","));
+  }
+  return kept;
+}
+
+// The bonus enters only through the rewards, and the model draws from its
+// own generator: at bonus_coeff 0 a run trains exactly as without it, and
+// at 0.1 it trains otherwise.
+TEST(LocalTrainingTest, Ex2ChangesTrainingOnlyThroughTheRewards) {
+  at::set_num_threads(1);
+  const std::string plain = FreshDirectory("plain_trpo");
+  const std::string silent = FreshDirectory("silent_ex2");
+  const std::string shaped = FreshDirectory("shaped_ex2");
+  Train(SmallRun("trpo", 7, plain));
+  LocalTrainingConfig config = SmallRun("ex2", 7, silent);
+  config.learner.exploration.ex2->bonus_coeff = 0.0;
+  Train(config);
+  Train(SmallRun("ex2", 7, shaped));
+  const std::vector<std::string> silent_rows = DeterministicProgress(silent);
+  EXPECT_EQ(WithoutExploration(silent_rows),
+            WithoutExploration(DeterministicProgress(plain)));
+  EXPECT_NE(WithoutExploration(DeterministicProgress(shaped)),
+            WithoutExploration(DeterministicProgress(plain)));
+  // Updates 1-2: no model yet (bonus 0, no fit); 3: the first fit.
+  const auto field = [&](int row, int from_end) {
+    const std::vector<std::string> fields =
+        absl::StrSplit(silent_rows[row], ',');
+    return fields[fields.size() - from_end];
+  };
+  EXPECT_EQ(field(1, 1), "0");
+  EXPECT_EQ(field(1, 3), "");
+  EXPECT_NE(field(2, 1), "0");
+  EXPECT_NE(field(3, 3), "");
+  EXPECT_GT(std::stod(field(3, 2)), 0.0);
+}
 
 // A damaged newest checkpoint is reported and skipped: the run continues
 // from the one before it and still ends where the uninterrupted run did.

@@ -43,6 +43,19 @@ absl::StatusOr<std::unique_ptr<Environment>> MakeSparseHalfCheetah() {
   return Build(task, kHalfCheetahXml);
 }
 
+absl::StatusOr<std::unique_ptr<Environment>> MakeEx2SparseHalfCheetah() {
+  LocomotionTask task = HalfCheetahTask();
+  task.name = "Ex2SparseHalfCheetah";
+  task.frame_skip = 1;  // rllab's half_cheetah.xml sets none: dt 0.01 s
+  task.max_episode_steps = 500;
+  task.sparse_x_threshold = 5.0;
+  task.sparse_either_way = true;
+  task.subtree_com = true;  // 8 + 9 + 3 = 20
+  task.qpos_normal_noise = 0.01;
+  task.qvel_normal_noise = 0.1;
+  return Build(task, kHalfCheetahXml);
+}
+
 absl::StatusOr<std::unique_ptr<Environment>> MakeHopper() {
   LocomotionTask task;
   task.name = "Hopper";

@@ -18,6 +18,13 @@ absl::StatusOr<std::unique_ptr<Environment>> MakeAnt();
 // HalfCheetah dynamics with the sparse reward of the VIME and EX2 papers:
 // 1 per step while the torso is more than 5 m ahead of the start, else 0.
 absl::StatusOr<std::unique_ptr<Environment>> MakeSparseHalfCheetah();
+// The SparseHalfCheetah EX2's experiments ran (envs/half_cheetah_env.py of
+// jcoreyes/ex2 over rllab's HalfCheetahEnv): the same model stepped at
+// rllab's dt of 0.01 s (frame skip 1), 500 steps; reward 1 while the
+// torso's subtree centre of mass is more than 5 m from the start either
+// way, else 0; observation qpos[1:], qvel and that centre (20); reset
+// noise N(0, 0.01^2) on qpos and N(0, 0.1^2) on qvel.
+absl::StatusOr<std::unique_ptr<Environment>> MakeEx2SparseHalfCheetah();
 
 // Any MJCF file: observation (qpos, qvel), actions all actuators clipped to
 // their ctrlrange, the task read from the model's <custom> block (README,

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <random>
 #include <string>
 #include <utility>
 
@@ -21,6 +22,17 @@ class LocomotionEnv : public MujocoEnv {
 
  protected:
   void ResetState(std::mt19937_64& rng) override {
+    if (task_.qpos_normal_noise > 0 || task_.qvel_normal_noise > 0) {
+      std::normal_distribution<double> normal(0.0, 1.0);
+      mjData* d = mutable_data();
+      for (int i = 0; i < model()->nq; ++i) {
+        d->qpos[i] += task_.qpos_normal_noise * normal(rng);
+      }
+      for (int i = 0; i < model()->nv; ++i) {
+        d->qvel[i] += task_.qvel_normal_noise * normal(rng);
+      }
+      return;
+    }
     PerturbState(rng, task_.reset_noise, task_.normal_qvel_noise);
   }
 
@@ -31,8 +43,13 @@ class LocomotionEnv : public MujocoEnv {
   StepResult Evaluate(absl::Span<const double> action) override {
     StepResult result;
     const bool healthy = Healthy();
+    // Step leaves positions current (mj_kinematics), not the centres of
+    // mass.
+    if (task_.subtree_com) mj_comPos(model(), mutable_data());
     if (task_.sparse_x_threshold > -std::numeric_limits<double>::infinity()) {
-      result.reward = ForwardX() > task_.sparse_x_threshold ? 1.0 : 0.0;
+      const double x =
+          task_.sparse_either_way ? std::fabs(ForwardX()) : ForwardX();
+      result.reward = x > task_.sparse_x_threshold ? 1.0 : 0.0;
     } else {
       const double velocity = (ForwardX() - x_before_) / spec().control_dt;
       double effort = 0.0;
@@ -55,12 +72,18 @@ class LocomotionEnv : public MujocoEnv {
     for (int i = 0; i < m->nv; ++i) {
       *out++ = std::clamp(d->qvel[i], -task_.qvel_clip, task_.qvel_clip);
     }
+    if (task_.subtree_com) {
+      for (int k = 0; k < 3; ++k)
+        *out++ = d->subtree_com[3 * forward_body_ + k];
+    }
   }
 
  private:
   // Without a forward body there is no forward reward and no height rule.
   double ForwardX() const {
-    return forward_body_ < 0 ? 0.0 : data()->xpos[3 * forward_body_];
+    if (forward_body_ < 0) return 0.0;
+    return task_.subtree_com ? data()->subtree_com[3 * forward_body_]
+                             : data()->xpos[3 * forward_body_];
   }
 
   bool Healthy() const {
@@ -113,7 +136,12 @@ absl::StatusOr<std::unique_ptr<Environment>> MakeLocomotionEnv(
   if (!data.ok()) return data.status();
   EnvSpec spec;
   spec.name = task.name;
-  spec.observation_size = model->nq - task.observe_qpos_from + model->nv;
+  if (task.subtree_com && body < 0) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(task.name, ": subtree_com needs a forward body"));
+  }
+  spec.observation_size = model->nq - task.observe_qpos_from + model->nv +
+                          (task.subtree_com ? 3 : 0);
   spec.max_episode_steps = task.max_episode_steps;
   return std::unique_ptr<Environment>(new LocomotionEnv(
       task, std::move(spec), std::move(model), std::move(*data), body));

@@ -44,6 +44,15 @@ struct LocomotionTask {
   bool normal_qvel_noise = false;
   // > -inf: the sparse reward described above replaces the dense one.
   double sparse_x_threshold = -std::numeric_limits<double>::infinity();
+  // The sparse reward pays beyond the threshold either way (|x| > it).
+  bool sparse_either_way = false;
+  // x is the forward body's subtree centre of mass (rllab's get_body_com)
+  // rather than its origin, and the observation ends with that centre (3).
+  bool subtree_com = false;
+  // > 0: reset noise N(0, scale^2) on qpos and qvel (rllab's), instead of
+  // reset_noise.
+  double qpos_normal_noise = 0.0;
+  double qvel_normal_noise = 0.0;
 };
 
 absl::StatusOr<std::unique_ptr<Environment>> MakeLocomotionEnv(

@@ -418,4 +418,44 @@ const char kPointMazeXml[] = R"xml(
 </mujoco>
 )xml";
 
+// EX2's 2D maze: the geometry, contact and actuator numbers of its
+// twod_maze.xml; the motors take [-1, 1] at gear 0.5, which is the
+// reference's [-0.5, 0.5] behind rllab's action normalisation.
+const char kTwoDMazeXml[] = R"xml(
+<mujoco model="twod_maze">
+  <compiler inertiafromgeom="true" angle="radian" coordinate="local"/>
+  <option timestep="0.01" gravity="0 0 0" iterations="20" integrator="Euler"/>
+  <default>
+    <joint limited="false" damping="1"/>
+    <geom contype="2" conaffinity="1" condim="1" friction="0.5 0.1 0.1"
+          density="1000" margin="0.002"/>
+  </default>
+  <worldbody>
+    <body name="particle" pos="-0.15 -0.15 0">
+      <geom name="particle" type="sphere" size="0.03" contype="1"/>
+      <joint name="x" type="slide" pos="0 0 0" axis="1 0 0"/>
+      <joint name="y" type="slide" pos="0 0 0" axis="0 1 0"/>
+    </body>
+    <body name="target" pos="0.15 -0.15 0">
+      <geom name="target" type="sphere" size="0.03" conaffinity="2"
+            rgba="0 0.9 0.1 1"/>
+    </body>
+    <geom name="side_south" type="capsule" size="0.02"
+          fromto="-0.3 -0.3 0.01 0.3 -0.3 0.01"/>
+    <geom name="side_east" type="capsule" size="0.02"
+          fromto="0.3 -0.3 0.01 0.3 0.3 0.01"/>
+    <geom name="side_north" type="capsule" size="0.02"
+          fromto="-0.3 0.3 0.01 0.3 0.3 0.01"/>
+    <geom name="side_west" type="capsule" size="0.02"
+          fromto="-0.3 -0.3 0.01 -0.3 0.3 0.01"/>
+    <geom name="wall" type="capsule" size="0.02"
+          fromto="0 -0.3 0.01 0 0.05 0.01"/>
+  </worldbody>
+  <actuator>
+    <motor joint="x" gear="0.5" ctrllimited="true" ctrlrange="-1 1"/>
+    <motor joint="y" gear="0.5" ctrllimited="true" ctrlrange="-1 1"/>
+  </actuator>
+</mujoco>
+)xml";
+
 }  // namespace vantage

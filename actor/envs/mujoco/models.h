@@ -15,6 +15,7 @@ extern const char kWalker2dXml[];
 extern const char kAntXml[];
 extern const char kHumanoidXml[];
 extern const char kPointMazeXml[];
+extern const char kTwoDMazeXml[];
 
 }  // namespace vantage
 

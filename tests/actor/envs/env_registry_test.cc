@@ -1,5 +1,6 @@
 #include "actor/envs/env_registry.h"
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <map>
@@ -54,18 +55,29 @@ std::vector<std::vector<double>> Episode(Environment& env, uint64_t seed,
 
 TEST(EnvRegistryTest, SpecsMatchTheGymnasiumTasks) {
   const std::map<std::string, std::pair<int, int>> expected = {
-      {"HalfCheetah", {17, 6}},       {"Hopper", {11, 3}},
-      {"Walker2d", {17, 6}},          {"Ant", {27, 8}},
-      {"InvertedPendulum", {4, 1}},   {"InvertedDoublePendulum", {11, 1}},
-      {"SparseHalfCheetah", {17, 6}}, {"Humanoid", {376, 17}},
-      {"PointMaze", {4, 2}},          {"BulletHopper", {11, 3}},
-      {"BipedWalkFlat", {29, 11}},    {"BipedWalkIncline", {29, 11}}};
+      {"HalfCheetah", {17, 6}},
+      {"Hopper", {11, 3}},
+      {"Walker2d", {17, 6}},
+      {"Ant", {27, 8}},
+      {"InvertedPendulum", {4, 1}},
+      {"InvertedDoublePendulum", {11, 1}},
+      {"SparseHalfCheetah", {17, 6}},
+      {"Humanoid", {376, 17}},
+      {"PointMaze", {4, 2}},
+      {"TwoDMaze", {2, 2}},
+      {"Ex2SparseHalfCheetah", {20, 6}},
+      {"BulletHopper", {11, 3}},
+      {"BipedWalkFlat", {29, 11}},
+      {"BipedWalkIncline", {29, 11}}};
   for (const auto& [name, sizes] : expected) {
     const auto env = Make(name);
     ASSERT_NE(env, nullptr);
     EXPECT_EQ(env->spec().observation_size, sizes.first) << name;
     EXPECT_EQ(env->spec().action_size, sizes.second) << name;
-    EXPECT_EQ(env->spec().max_episode_steps, name == "PointMaze" ? 500 : 1000)
+    const std::map<std::string, int64_t> short_episodes = {
+        {"PointMaze", 500}, {"TwoDMaze", 200}, {"Ex2SparseHalfCheetah", 500}};
+    EXPECT_EQ(env->spec().max_episode_steps,
+              short_episodes.count(name) > 0 ? short_episodes.at(name) : 1000)
         << name;
   }
 }
@@ -186,6 +198,44 @@ TEST(EnvRegistryTest, PointMazeRewardsOnlyTheGoal) {
   }
   EXPECT_TRUE(result.terminated);
   EXPECT_EQ(total, 1.0);
+}
+
+// EX2's maze: -1 per step until the point is in the target's pocket on
+// the far side of the wall, where the reward rises towards 0 at the target.
+TEST(EnvRegistryTest, TwoDMazeRewardsThePocketBeyondTheWall) {
+  const auto env = Make("TwoDMaze");
+  std::vector<double> observation(2);
+  ASSERT_TRUE(env->Reset(3, absl::MakeSpan(observation)).ok());
+  EXPECT_NEAR(observation[0], -0.15, 0.011);
+  EXPECT_NEAR(observation[1], -0.15, 0.011);
+  // Straight at the target: the wall stops the point, every step pays -1.
+  StepResult result;
+  int steps = 0;
+  while (!result.truncated) {
+    result = *env->Step({1.0, 0.0}, absl::MakeSpan(observation));
+    EXPECT_EQ(result.reward, -1.0);
+    EXPECT_LT(observation[0], -0.04);
+    ++steps;
+  }
+  EXPECT_EQ(steps, 200);
+  // Over the top of the wall and down into the pocket.
+  ASSERT_TRUE(env->Reset(3, absl::MakeSpan(observation)).ok());
+  const double waypoints[3][2] = {{-0.15, 0.15}, {0.15, 0.15}, {0.15, -0.15}};
+  int target = 0;
+  double total = 0.0;
+  result = StepResult();
+  while (!result.truncated) {
+    const double dx = waypoints[target][0] - observation[0];
+    const double dy = waypoints[target][1] - observation[1];
+    if (target < 2 && std::hypot(dx, dy) < 0.03) ++target;
+    result = *env->Step(
+        {std::clamp(20 * dx, -1.0, 1.0), std::clamp(20 * dy, -1.0, 1.0)},
+        absl::MakeSpan(observation));
+    total += result.reward;
+  }
+  EXPECT_FALSE(result.terminated);
+  EXPECT_GT(result.reward, -0.1);  // within 2 cm (L1) of the target
+  EXPECT_GT(total, -150.0);        // a wall-hugger's is -200
 }
 
 TEST(EnvRegistryTest, SparseHalfCheetahIsSilentNearTheStart) {

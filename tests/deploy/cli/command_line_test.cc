@@ -151,10 +151,15 @@ TEST(CommandLineTest, AFlagfileIsTheCommandLine) {
 // update consumes envs x horizon steps).
 TEST(CommandLineTest, HelpDefaultsAreTheRunsConfigAndBehaviour) {
   const std::map<std::string, std::string> help = HelpDefaults("train");
-  for (const std::string algo : {"ppo", "a2c", "trpo"}) {
-    const std::string run = FreshDirectory("defaults_" + algo);
-    const Outcome outcome = RunVantage(
-        "train --mode=local --steps=1 --algo=" + algo + " --run_dir=" + run);
+  for (const std::string variant : {"ppo", "a2c", "trpo", "trpo+ex2"}) {
+    // "+ex2": with --exploration=ex2, whose settings only it holds.
+    const bool ex2 = absl::EndsWith(variant, "+ex2");
+    const std::string algo = variant.substr(0, variant.find('+'));
+    const std::string run =
+        FreshDirectory("defaults_" + algo + (ex2 ? "_ex2" : ""));
+    const Outcome outcome =
+        RunVantage("train --mode=local --steps=1 --algo=" + algo +
+                   (ex2 ? " --exploration=ex2" : "") + " --run_dir=" + run);
     ASSERT_EQ(outcome.exit_code, 0) << outcome.err;
     absl::StatusOr<pb::RunConfig> config =
         ReadRunConfigFile(run + "/config.json");
@@ -162,7 +167,11 @@ TEST(CommandLineTest, HelpDefaultsAreTheRunsConfigAndBehaviour) {
     for (const std::string& name : RunFlagNames(/*with_mode=*/true)) {
       if (name == "mode" || name == "algo" || name == "steps" ||
           name == "config" || name == "run_dir" || name == "resume" ||
-          name == "resume_if_exists") {
+          name == "resume_if_exists" || name == "exploration") {
+        continue;
+      }
+      if (absl::StartsWith(name, "ex2_") && !ex2) {
+        EXPECT_EQ(RunConfigFieldText(*config, name), "") << variant << name;
         continue;
       }
       // Another algorithm's settings are not in this run's config.

@@ -10,6 +10,7 @@
 #include <string>
 #include <utility>
 
+#include "deploy/cli/run_flags.h"
 #include "deploy/cli/train_command.h"
 #include "deploy/run_config.h"
 #include "deploy/run_directory.h"
@@ -48,6 +49,8 @@ TEST(RunRequestTest, BadSettingsNameTheirFlag) {
        "--max_policy_lag must be 0 with --sync"},
       {R"({"training": {"horizon": 100, "segment_length": 30}})",
        "--segment_length must divide --horizon"},
+      {R"({"exploration": {"ex2": {"kl_weight": -1}}})",
+       "ex2.kl_weight must be in [0, 1e6), got -1 (--ex2_kl_weight)"},
       {R"({"mode": "local", "distributed": {"actors": 2}})",
        "--mode=local runs one strictly on-policy process: drop the "
        "distributed settings"},
@@ -83,6 +86,60 @@ TEST(RunRequestTest, TheAlgorithmIsChosenOnce) {
   EXPECT_EQ(switched->config.training().seed(), 4);
   EXPECT_EQ(switched->config.training().horizon(), 2048);
   EXPECT_EQ(switched->local.learner.algorithm.ppo.epochs, 3);
+}
+
+// --exploration=ex2 selects EX2 with its defaults, the --ex2_ flags
+// select it too; --exploration=none drops a file's EX2.
+TEST(RunRequestTest, ExplorationIsSelectedByFlagOrFile) {
+  absl::StatusOr<RunRequest> request =
+      RunRequestFromSettings({{"exploration", "ex2"}});
+  ASSERT_TRUE(request.ok()) << request.status();
+  absl::StatusOr<ResolvedRun> ex2 = ResolveRunRequest(*request);
+  ASSERT_TRUE(ex2.ok()) << ex2.status();
+  EXPECT_EQ(ex2->config.exploration().ex2().kl_weight(), 0.1);
+  EXPECT_EQ(ex2->config.exploration().ex2().hidden_size(), 1);
+  ASSERT_TRUE(ex2->local.learner.exploration.ex2.has_value());
+  EXPECT_EQ(ex2->local.learner.exploration.ex2->train_iterations, 2000);
+
+  request = RunRequestFromSettings(
+      {{"ex2_kl_weight", "0.01"}, {"ex2_hidden", "16,16"}});
+  ASSERT_TRUE(request.ok()) << request.status();
+  absl::StatusOr<ResolvedRun> flags = ResolveRunRequest(*request);
+  ASSERT_TRUE(flags.ok()) << flags.status();
+  EXPECT_EQ(flags->local.learner.exploration.ex2->kl_weight, 0.01);
+  EXPECT_EQ(flags->local.learner.exploration.ex2->hidden,
+            (std::vector<int64_t>{16, 16}));
+
+  // Without it: no section in config.json, no bonus.
+  absl::StatusOr<ResolvedRun> plain = ResolveRunRequest(RunRequest());
+  ASSERT_TRUE(plain.ok());
+  EXPECT_FALSE(plain->config.has_exploration());
+  EXPECT_FALSE(plain->local.learner.exploration.enabled());
+
+  RunRequest from_file;
+  from_file.config_file = WriteTemp(
+      "ex2.json", R"({"exploration": {"ex2": {"bonus_coeff": 0.01}}})");
+  absl::StatusOr<ResolvedRun> file = ResolveRunRequest(from_file);
+  ASSERT_TRUE(file.ok()) << file.status();
+  EXPECT_EQ(file->local.learner.exploration.ex2->bonus_coeff, 0.01);
+  request = RunRequestFromSettings({{"exploration", "none"}});
+  ASSERT_TRUE(request.ok());
+  request->config_file = from_file.config_file;
+  absl::StatusOr<ResolvedRun> dropped = ResolveRunRequest(*request);
+  ASSERT_TRUE(dropped.ok()) << dropped.status();
+  EXPECT_FALSE(dropped->config.has_exploration());
+
+  EXPECT_THAT(
+      std::string(
+          RunRequestFromSettings({{"exploration", "vime"}}).status().message()),
+      HasSubstr("--exploration: unknown exploration method 'vime'; "
+                "available: none, ex2"));
+  EXPECT_THAT(std::string(RunRequestFromSettings({{"exploration", "none"},
+                                                  {"ex2_kl_weight", "0.1"}})
+                              .status()
+                              .message()),
+              HasSubstr("--ex2_kl_weight is a setting of ex2; this run's "
+                        "--exploration is none"));
 }
 
 TEST(RunRequestTest, BadFilesAreNamed) {

@@ -1,0 +1,177 @@
+#include "learner/exploration/ex2_bonus.h"
+
+#include <ATen/ATen.h>
+#include <ATen/CPUGeneratorImpl.h>
+#include <torch/optim/adam.h>
+#include <torch/serialize/archive.h>
+
+#include <utility>
+
+#include "absl/strings/str_cat.h"
+#include "learner/algorithms/gradient_step.h"
+#include "learner/archive_io.h"
+
+namespace vantage {
+namespace {
+
+int64_t InputWidth(const Ex2Config& config, const EnvSpec& spec) {
+  return spec.observation_size + (config.use_actions ? spec.action_size : 0);
+}
+
+// numpy's median: the mean of the two middle values of an even count.
+double Median(const at::Tensor& values) {
+  const at::Tensor sorted = std::get<0>(values.to(at::kDouble).sort());
+  const int64_t n = sorted.size(0);
+  const double upper = sorted[n / 2].item<double>();
+  return n % 2 == 1 ? upper : 0.5 * (upper + sorted[n / 2 - 1].item<double>());
+}
+
+}  // namespace
+
+Ex2Bonus::Ex2Bonus(const Ex2Config& config, const EnvSpec& spec, uint64_t seed,
+                   std::shared_ptr<ReplicaGroup> replicas)
+    : config_(config),
+      spec_(spec),
+      replicas_(std::move(replicas)),
+      model_(InputWidth(config, spec), config),
+      optimizer_(std::make_unique<torch::optim::Adam>(
+          model_->parameters(),
+          torch::optim::AdamOptions(config.learning_rate))),
+      generator_(at::make_generator<at::CPUGeneratorImpl>(seed)),
+      pool_(config.replay_size, InputWidth(config, spec)) {}
+
+Ex2Bonus::~Ex2Bonus() = default;
+
+std::vector<at::Tensor> Ex2Bonus::parameters() const {
+  return model_->parameters();
+}
+
+at::Tensor Ex2Bonus::Inputs(const std::vector<Rollout>& rollouts) const {
+  std::vector<at::Tensor> rows;
+  for (const Rollout& rollout : rollouts) {
+    const int64_t steps = rollout.rewards.size(0);
+    at::Tensor states = rollout.observations.slice(0, 0, steps);
+    if (!config_.use_actions) {
+      rows.push_back(states);
+      continue;
+    }
+    at::Tensor actions = rollout.actions;
+    if (spec_.discrete) {
+      actions =
+          at::one_hot(actions.reshape({-1}).to(at::kLong), spec_.action_size)
+              .to(at::kFloat);
+    }
+    rows.push_back(at::cat({states, actions.to(at::kFloat)}, 1));
+  }
+  return at::cat(rows).to(at::kFloat).contiguous();
+}
+
+ExplorationStats Ex2Bonus::ShapeRewards(std::vector<Rollout>& rollouts) {
+  ExplorationStats stats;
+  const at::Tensor inputs = Inputs(rollouts);
+  const int64_t m = inputs.size(0);
+  if (pool_.total_added() >= config_.replay_min && pool_.size() > 0) {
+    const int iterations =
+        fitted_ ? config_.train_iterations : config_.first_train_iterations;
+    const std::vector<at::Tensor> parameters = model_->parameters();
+    double loss_sum = 0.0, accuracy_sum = 0.0;
+    for (int i = 0; i < iterations; ++i) {
+      const at::Tensor positives = inputs.index_select(
+          0, at::randint(m, {config_.batch_size}, generator_,
+                         at::TensorOptions(at::kLong)));
+      const at::Tensor negatives = pool_.Sample(config_.batch_size, generator_);
+      const ExemplarLoss loss = ComputeExemplarLoss(
+          *model_, positives, negatives, config_.kl_weight, generator_);
+      GradientStep(*optimizer_, parameters, loss.loss,
+                   std::numeric_limits<double>::infinity(), *replicas_);
+      loss_sum += loss.loss.item<double>();
+      accuracy_sum += loss.accuracy;
+    }
+    fitted_ = true;
+    stats.fit_steps = iterations;
+    stats.model_loss = loss_sum / iterations;
+    stats.model_accuracy = accuracy_sum / iterations;
+  }
+  pending_ = inputs;
+  // The reference checks the pool's size after adding the batch: one batch
+  // earlier than the fit does.
+  at::Tensor bonus = at::zeros({m}, at::kFloat);
+  if (pool_.total_added() + m >= config_.replay_min) {
+    bonus = NoveltyBonus(*model_, inputs);
+  }
+  stats.mean_bonus = bonus.to(at::kDouble).mean().item<double>();
+  const at::Tensor shaped =
+      (config_.bonus_coeff * (bonus.to(at::kDouble) - Median(bonus)))
+          .to(at::kFloat);
+  int64_t offset = 0;
+  for (Rollout& rollout : rollouts) {
+    const int64_t steps = rollout.rewards.size(0);
+    rollout.rewards = rollout.rewards + shaped.slice(0, offset, offset + steps);
+    offset += steps;
+  }
+  return stats;
+}
+
+void Ex2Bonus::Commit() {
+  if (!pending_.defined()) return;
+  pool_.Add(pending_);
+  pending_ = at::Tensor();
+}
+
+void Ex2Bonus::SaveModelState(torch::serialize::OutputArchive& archive) const {
+  WriteModule(archive, "model", *model_);
+  SaveOptimizer(*optimizer_, "optimizer", archive);
+  archive.write("generator", generator_.get_state());
+  archive.write("fitted", at::tensor({static_cast<int64_t>(fitted_)}));
+}
+
+absl::Status Ex2Bonus::LoadModelState(torch::serialize::InputArchive& archive) {
+  at::Tensor generator_state, fitted;
+  for (absl::Status status : {ReadTensor(archive, "generator", generator_state),
+                              ReadTensor(archive, "fitted", fitted)}) {
+    if (!status.ok()) return status;
+  }
+  if (generator_state.scalar_type() != at::kByte ||
+      generator_state.sizes() != generator_.get_state().sizes() ||
+      fitted.scalar_type() != at::kLong || fitted.numel() != 1) {
+    return absl::InvalidArgumentError(
+        "ex2 entries 'generator' or 'fitted' are malformed");
+  }
+  // Checked before anything changes: the module's entries, then the
+  // optimiser's (which LoadOptimizer checks against the model).
+  if (absl::Status status = ReadModule(archive, "model", *model_);
+      !status.ok()) {
+    return status;
+  }
+  if (absl::Status status = LoadOptimizer(*optimizer_, "optimizer", archive);
+      !status.ok()) {
+    return status;
+  }
+  generator_.set_state(generator_state);
+  fitted_ = fitted.item<int64_t>() != 0;
+  pending_ = at::Tensor();
+  return absl::OkStatus();
+}
+
+void Ex2Bonus::Save(torch::serialize::OutputArchive& archive) const {
+  SaveModelState(archive);
+  torch::serialize::OutputArchive pool;
+  pool_.Save(pool);
+  archive.write("replay_pool", pool);
+}
+
+absl::Status Ex2Bonus::Load(torch::serialize::InputArchive& archive) {
+  torch::serialize::InputArchive pool;
+  if (absl::Status status =
+          CatchTorchErrors("ex2 entry 'replay_pool' is missing",
+                           [&] { archive.read("replay_pool", pool); });
+      !status.ok()) {
+    return status;
+  }
+  if (absl::Status status = pool_.Load(pool); !status.ok()) {
+    return absl::InvalidArgumentError(absl::StrCat("ex2: ", status.message()));
+  }
+  return LoadModelState(archive);
+}
+
+}  // namespace vantage

@@ -1,0 +1,86 @@
+#ifndef VANTAGE_LEARNER_EXPLORATION_EX2_BONUS_H_
+#define VANTAGE_LEARNER_EXPLORATION_EX2_BONUS_H_
+
+// EX2's exploration bonus on the learner, in the order of its reference
+// code (parallel_trpo/batch_polopt.py, models/exemplar.py): once the pool
+// has seen replay_min states, each batch first fits the exemplar model
+// (positives (x, x) drawn from the batch, negatives (x, x') with x' from
+// the pool), then the batch joins the pool, then every step's reward gains
+// bonus_coeff x (b - median b) with b = -log p(x) from the fitted model.
+// The critic and the advantage estimators see the shaped rewards; the
+// episode returns the actors report stay the environment's own.
+
+#include <ATen/core/Generator.h>
+#include <ATen/core/Tensor.h>
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "absl/status/status.h"
+#include "common/env/environment.h"
+#include "learner/exploration/ex2_config.h"
+#include "learner/exploration/exemplar_model.h"
+#include "learner/exploration/exploration_stats.h"
+#include "learner/exploration/replay_pool.h"
+#include "learner/ingest/rollout_stitcher.h"
+#include "learner/parallel/replica_group.h"
+
+namespace torch::optim {
+class Adam;
+}  // namespace torch::optim
+namespace torch::serialize {
+class InputArchive;
+class OutputArchive;
+}  // namespace torch::serialize
+
+namespace vantage {
+
+class Ex2Bonus {
+ public:
+  // The model's initial weights come from LibTorch's global generator; its
+  // sampling from its own, seeded by `seed`. With `replicas`, gradients
+  // are averaged over them (every replica must start from the same
+  // weights, which the learner broadcasts).
+  Ex2Bonus(const Ex2Config& config, const EnvSpec& spec, uint64_t seed,
+           std::shared_ptr<ReplicaGroup> replicas);
+  ~Ex2Bonus();
+
+  // Fits the model and adds the bonus to the rollouts' rewards (see
+  // above). The rollouts' states join the pool only at Commit, so that an
+  // update that is rolled back leaves the pool as it was.
+  ExplorationStats ShapeRewards(std::vector<Rollout>& rollouts);
+  void Commit();
+
+  std::vector<at::Tensor> parameters() const;
+  ExemplarModelImpl& model() { return *model_; }
+  const ReplayPool& pool() const { return pool_; }
+
+  // What ShapeRewards changes but the pool: the model, its optimiser, the
+  // generator and whether it has fitted before (for rolling back).
+  void SaveModelState(torch::serialize::OutputArchive& archive) const;
+  absl::Status LoadModelState(torch::serialize::InputArchive& archive);
+  // All of it, pool included (checkpoints). On error the object is half
+  // loaded: the learner being loaded is discarded.
+  void Save(torch::serialize::OutputArchive& archive) const;
+  absl::Status Load(torch::serialize::InputArchive& archive);
+
+  // The model's inputs for the rollouts' steps: [sum T, width], states
+  // with the actions (one-hot if discrete) when use_actions.
+  at::Tensor Inputs(const std::vector<Rollout>& rollouts) const;
+
+ private:
+  Ex2Config config_;
+  EnvSpec spec_;
+  std::shared_ptr<ReplicaGroup> replicas_;
+  ExemplarModel model_{nullptr};
+  std::unique_ptr<torch::optim::Adam> optimizer_;
+  at::Generator generator_;
+  ReplayPool pool_;
+  bool fitted_ = false;
+  at::Tensor pending_;  // inputs of the batch shaped last, until Commit
+};
+
+}  // namespace vantage
+
+#endif  // VANTAGE_LEARNER_EXPLORATION_EX2_BONUS_H_

@@ -1,0 +1,24 @@
+#ifndef VANTAGE_LEARNER_EXPLORATION_EXPLORATION_STATS_H_
+#define VANTAGE_LEARNER_EXPLORATION_EXPLORATION_STATS_H_
+
+#include <cstdint>
+#include <limits>
+
+namespace vantage {
+
+// What an exploration bonus did in one update (this replica's batch in a
+// data-parallel run). All NaN in a run without one.
+struct ExplorationStats {
+  // Means over this update's Adam steps of the density model; NaN if it
+  // did not fit this update.
+  double model_loss = std::numeric_limits<double>::quiet_NaN();
+  double model_accuracy = std::numeric_limits<double>::quiet_NaN();
+  // Mean bonus over the batch before centring and weighting (0 until the
+  // model is in use).
+  double mean_bonus = std::numeric_limits<double>::quiet_NaN();
+  int64_t fit_steps = 0;
+};
+
+}  // namespace vantage
+
+#endif  // VANTAGE_LEARNER_EXPLORATION_EXPLORATION_STATS_H_

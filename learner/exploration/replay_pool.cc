@@ -1,0 +1,88 @@
+#include "learner/exploration/replay_pool.h"
+
+#include <ATen/ATen.h>
+#include <torch/serialize/archive.h>
+
+#include <algorithm>
+
+#include "absl/strings/str_cat.h"
+#include "learner/archive_io.h"
+
+namespace vantage {
+
+ReplayPool::ReplayPool(int64_t capacity, int64_t width)
+    : capacity_(capacity),
+      width_(width),
+      rows_(at::zeros({capacity, width}, at::kFloat)) {}
+
+void ReplayPool::Add(const at::Tensor& rows) {
+  const int64_t m = rows.size(0);
+  total_added_ += m;
+  const at::Tensor kept = m > capacity_ ? rows.slice(0, m - capacity_) : rows;
+  int64_t done = 0;
+  while (done < kept.size(0)) {
+    const int64_t n = std::min(kept.size(0) - done, capacity_ - next_);
+    rows_.slice(0, next_, next_ + n).copy_(kept.slice(0, done, done + n));
+    done += n;
+    next_ = (next_ + n) % capacity_;
+    size_ = std::min(capacity_, size_ + n);
+  }
+}
+
+at::Tensor ReplayPool::Sample(int64_t n, const at::Generator& generator) const {
+  const at::Tensor index =
+      at::randint(size_, {n}, generator, at::TensorOptions(at::kLong));
+  return rows_.index_select(0, index);
+}
+
+void ReplayPool::Save(torch::serialize::OutputArchive& archive) const {
+  archive.write("rows", rows_.slice(0, 0, size_));
+  archive.write(
+      "counts",
+      at::tensor({capacity_, width_, next_, size_, total_added_}, at::kLong));
+}
+
+absl::Status ReplayPool::Load(torch::serialize::InputArchive& archive) {
+  at::Tensor rows, counts;
+  for (absl::Status status : {ReadTensor(archive, "rows", rows),
+                              ReadTensor(archive, "counts", counts)}) {
+    if (!status.ok()) return status;
+  }
+  if (counts.scalar_type() != at::kLong || counts.dim() != 1 ||
+      counts.numel() != 5) {
+    return absl::InvalidArgumentError(
+        "replay pool entry 'counts' is malformed");
+  }
+  const int64_t capacity = counts[0].item<int64_t>();
+  const int64_t width = counts[1].item<int64_t>();
+  const int64_t next = counts[2].item<int64_t>();
+  const int64_t size = counts[3].item<int64_t>();
+  const int64_t total = counts[4].item<int64_t>();
+  if (capacity != capacity_ || width != width_) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("replay pool holds ", capacity, " rows of ", width,
+                     " values; this run's holds ", capacity_, " of ", width_));
+  }
+  if (size < 0 || size > capacity || next < 0 || next >= capacity ||
+      (size < capacity && next != size) || total < size) {
+    return absl::InvalidArgumentError(
+        "replay pool entry 'counts' is inconsistent");
+  }
+  if (rows.scalar_type() != at::kFloat || rows.dim() != 2 ||
+      rows.size(0) != size || rows.size(1) != width) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "replay pool entry 'rows' is not [", size, ", ", width, "] float32"));
+  }
+  if (!at::isfinite(rows).all().item<bool>()) {
+    return absl::InvalidArgumentError(
+        "replay pool entry 'rows' holds non-finite values");
+  }
+  rows_.zero_();
+  rows_.slice(0, 0, size).copy_(rows);
+  next_ = next;
+  size_ = size;
+  total_added_ = total;
+  return absl::OkStatus();
+}
+
+}  // namespace vantage

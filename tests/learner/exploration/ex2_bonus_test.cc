@@ -1,0 +1,330 @@
+#include "learner/exploration/ex2_bonus.h"
+
+#include <ATen/ATen.h>
+#include <ATen/CPUGeneratorImpl.h>
+#include <torch/serialize/archive.h>
+
+#include <cmath>
+#include <sstream>
+#include <vector>
+
+#include "gmock/gmock.h"
+#include "gtest/gtest.h"
+#include "learner/exploration/exemplar_model.h"
+#include "learner/exploration/replay_pool.h"
+
+namespace vantage {
+namespace {
+
+using ::testing::HasSubstr;
+
+EnvSpec PlaneSpec() {
+  EnvSpec spec;
+  spec.name = "Plane";
+  spec.observation_size = 2;
+  spec.action_size = 1;
+  return spec;
+}
+
+// One rollout whose T states are `states` [T, 2], with zero rewards.
+Rollout RolloutOf(const at::Tensor& states) {
+  const int64_t t = states.size(0);
+  Rollout rollout;
+  rollout.observations = at::cat({states, states.slice(0, t - 1)});
+  rollout.actions = at::zeros({t, 1});
+  rollout.rewards = at::zeros({t});
+  rollout.terminated = at::zeros({t}, at::kBool);
+  rollout.truncated = at::zeros({t}, at::kBool);
+  return rollout;
+}
+
+// `n` copies of the rows of `states` [k, 2], the i-th with probability
+// `weights[i]`.
+at::Tensor Draw(int64_t n, const at::Tensor& states,
+                const std::vector<double>& weights, at::Generator& generator) {
+  const at::Tensor index = at::multinomial(at::tensor(weights, at::kDouble), n,
+                                           /*replacement=*/true, generator);
+  return states.index_select(0, index);
+}
+
+Ex2Config SmallConfig() {
+  Ex2Config config;
+  config.hidden = {32};
+  config.feature_dim = 16;
+  config.learning_rate = 1e-3;
+  config.kl_weight = 0.1;
+  config.bonus_coeff = 1.0;
+  config.train_iterations = 300;
+  config.first_train_iterations = 1500;
+  config.replay_min = 1000;
+  config.replay_size = 5000;
+  config.batch_size = 128;
+  config.use_actions = false;
+  return config;
+}
+
+void SetAllParameters(torch::nn::Module& module, double value) {
+  at::NoGradGuard no_grad;
+  for (at::Tensor& p : module.parameters()) p.fill_(value);
+}
+
+TEST(ReplayPoolTest, KeepsTheNewestRowsAndCountsEveryRow) {
+  ReplayPool pool(/*capacity=*/5, /*width=*/1);
+  pool.Add(at::arange(3, at::kFloat).reshape({3, 1}));
+  EXPECT_EQ(pool.size(), 3);
+  pool.Add(at::arange(3, 7, at::kFloat).reshape({4, 1}));
+  EXPECT_EQ(pool.size(), 5);
+  EXPECT_EQ(pool.total_added(), 7);
+  at::Generator generator = at::make_generator<at::CPUGeneratorImpl>(1);
+  const at::Tensor sample = pool.Sample(2000, generator);
+  // Rows 0 and 1 were pushed out; 2..6 are all drawn.
+  EXPECT_EQ(sample.min().item<float>(), 2.0f);
+  EXPECT_EQ(sample.max().item<float>(), 6.0f);
+  EXPECT_EQ(std::get<0>(at::_unique(sample)).numel(), 5);
+  // More rows than it holds at once: only the last ones stay.
+  pool.Add(at::arange(10, 22, at::kFloat).reshape({12, 1}));
+  EXPECT_EQ(pool.Sample(2000, generator).min().item<float>(), 17.0f);
+  EXPECT_EQ(pool.total_added(), 19);
+}
+
+TEST(ReplayPoolTest, SavedPoolLoadsBackAndBadOnesAreRefused) {
+  ReplayPool pool(4, 2);
+  pool.Add(at::arange(12, at::kFloat).reshape({6, 2}));
+  torch::serialize::OutputArchive out;
+  pool.Save(out);
+  std::ostringstream bytes;
+  out.save_to(bytes);
+  const auto load = [&](ReplayPool& into) {
+    torch::serialize::InputArchive in;
+    std::istringstream stream(bytes.str());
+    in.load_from(stream);
+    return into.Load(in);
+  };
+  ReplayPool copy(4, 2);
+  ASSERT_TRUE(load(copy).ok());
+  EXPECT_EQ(copy.total_added(), 6);
+  at::Generator a = at::make_generator<at::CPUGeneratorImpl>(3);
+  at::Generator b = at::make_generator<at::CPUGeneratorImpl>(3);
+  EXPECT_TRUE(copy.Sample(50, a).equal(pool.Sample(50, b)));
+  // Another width: refused, naming both shapes.
+  ReplayPool wider(4, 3);
+  const absl::Status status = load(wider);
+  EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(std::string(status.message()), HasSubstr("4 rows of 2"));
+  // Non-finite rows are refused.
+  ReplayPool poisoned(4, 2);
+  poisoned.Add(at::full({2, 2}, std::nanf("")));
+  torch::serialize::OutputArchive bad;
+  poisoned.Save(bad);
+  std::ostringstream bad_bytes;
+  bad.save_to(bad_bytes);
+  torch::serialize::InputArchive in;
+  std::istringstream stream(bad_bytes.str());
+  in.load_from(stream);
+  EXPECT_THAT(std::string(copy.Load(in).message()), HasSubstr("non-finite"));
+}
+
+// With every weight 0 the latents are N(0, I) draws and D = 1/2 whatever
+// the noise: the loss is log 2. A mean head biased to c adds, per latent
+// dimension of both encoders, KL = c^2 / 2.
+TEST(ExemplarModelTest, LossAndBonusMatchClosedForms) {
+  Ex2Config config = SmallConfig();
+  config.hidden = {8, 8};
+  config.feature_dim = 3;
+  ExemplarModel model(2, config);
+  SetAllParameters(*model, 0.0);
+  at::Generator noise = at::make_generator<at::CPUGeneratorImpl>(5);
+  const at::Tensor x = at::randn({10, 2});
+  ExemplarLoss loss = ComputeExemplarLoss(*model, x, x.flip(0), 0.5, noise);
+  EXPECT_NEAR(loss.loss.item<double>(), std::log(2.0), 1e-6);
+  const double c = 0.7;
+  {
+    at::NoGradGuard no_grad;
+    for (auto& item : model->named_parameters()) {
+      if (item.key().find("mean.layers.2.bias") != std::string::npos) {
+        item.value().fill_(c);
+      }
+    }
+  }
+  loss = ComputeExemplarLoss(*model, x, x.flip(0), 0.5, noise);
+  EXPECT_NEAR(loss.loss.item<double>(),
+              std::log(2.0) + 0.5 * 2 * config.feature_dim * c * c / 2, 1e-5);
+  // D(x, x) = sigmoid(b) from the discriminator's output bias b, so the
+  // bonus log(D / (1 - D)) is b itself, clipped where D is.
+  for (double b : {-3.0, 0.0, 2.5, 40.0}) {
+    {
+      at::NoGradGuard no_grad;
+      for (auto& item : model->named_parameters()) {
+        if (item.key() == "discriminator.layers.2.bias") item.value().fill_(b);
+      }
+    }
+    const double expected = std::min(b, std::log((1 - 1e-5) / 1e-5));
+    EXPECT_NEAR(NoveltyBonus(*model, x).mean().item<double>(), expected, 3e-3)
+        << b;
+  }
+}
+
+// The point of the model. Fitted on batches of two states, one nine times
+// as frequent as the other, D(x, x) approaches P(x) / (P(x) + P(x)^2)
+// (about 0.53 and 0.91): the rare state earns the larger bonus. When a
+// batch brings a third state the pool has never held, D(x, x) of it
+// approaches 1: the largest bonus of all. A weak KL weight, so that the
+// few nats the two-state task offers are worth encoding.
+TEST(Ex2BonusTest, RareStatesEarnMoreThanFrequentOnesAndNewOnesMost) {
+  at::manual_seed(0);
+  Ex2Config config = SmallConfig();
+  config.kl_weight = 1e-3;
+  config.train_iterations = 1000;
+  Ex2Bonus ex2(config, PlaneSpec(), 11, SoloReplicaGroup());
+  at::Generator generator = at::make_generator<at::CPUGeneratorImpl>(2);
+  const at::Tensor states =
+      at::tensor({0.0f, 0.0f, 1.0f, 1.0f, -1.0f, 1.5f}).reshape({3, 2});
+  const auto bonus = [&](int i) {
+    return NoveltyBonus(ex2.model(), states.slice(0, i, i + 1)).item<double>();
+  };
+  // Pool sizes before each: 0, 600, 1200 (the first fit).
+  for (int batch = 0; batch < 3; ++batch) {
+    std::vector<Rollout> rollouts = {
+        RolloutOf(Draw(600, states, {0.9, 0.1, 0.0}, generator))};
+    const ExplorationStats stats = ex2.ShapeRewards(rollouts);
+    ex2.Commit();
+    if (batch == 2) {
+      EXPECT_EQ(stats.fit_steps, 1500);
+      EXPECT_GT(stats.model_accuracy, 0.55);
+    }
+  }
+  EXPECT_NEAR(bonus(0), std::log(0.53 / 0.47), 0.3);
+  EXPECT_NEAR(bonus(1), std::log(0.91 / 0.09), 0.6);
+  std::vector<Rollout> rollouts = {
+      RolloutOf(Draw(600, states, {0.8, 0.1, 0.1}, generator))};
+  ex2.ShapeRewards(rollouts);
+  EXPECT_LT(bonus(0) + 1.0, bonus(1));
+  EXPECT_LT(bonus(1) + 1.0, bonus(2));
+  // The rewards carry it: the new state's steps gain the most.
+  const at::Tensor rewards = rollouts[0].rewards;
+  const at::Tensor is_new =
+      rollouts[0].observations.slice(0, 0, 600).select(1, 0).lt(-0.5);
+  EXPECT_GT(rewards.masked_select(is_new).min().item<double>(),
+            rewards.masked_select(is_new.logical_not()).max().item<double>());
+}
+
+// EX2's order: a batch fits only once the pool has seen replay_min states
+// before it, but its bonus counts the batch itself; the first fit is the
+// long one; rewards gain bonus_coeff x (b - median b).
+TEST(Ex2BonusTest, FitsAndShapesOnEx2sSchedule) {
+  at::manual_seed(0);
+  Ex2Config config = SmallConfig();
+  config.replay_min = 1000;
+  config.bonus_coeff = 0.25;
+  config.first_train_iterations = 40;
+  config.train_iterations = 10;
+  Ex2Bonus ex2(config, PlaneSpec(), 3, SoloReplicaGroup());
+  at::Generator generator = at::make_generator<at::CPUGeneratorImpl>(4);
+  std::vector<int64_t> fits;
+  std::vector<double> bonuses;
+  for (int batch = 0; batch < 4; ++batch) {
+    std::vector<Rollout> rollouts = {RolloutOf(at::randn({300, 2}, generator)),
+                                     RolloutOf(at::randn({300, 2}, generator))};
+    const ExplorationStats stats = ex2.ShapeRewards(rollouts);
+    fits.push_back(stats.fit_steps);
+    bonuses.push_back(stats.mean_bonus);
+    const at::Tensor added =
+        at::cat({rollouts[0].rewards, rollouts[1].rewards});
+    if (batch == 0) {
+      EXPECT_TRUE(added.equal(at::zeros({600}))) << "no bonus before the pool";
+      EXPECT_TRUE(std::isnan(stats.model_loss));
+    } else {
+      // Centred on the median: as many steps above it as below.
+      EXPECT_EQ((added > 0).sum().item<int64_t>(),
+                (added < 0).sum().item<int64_t>());
+      // The bonus of the model as fitted on this batch (numpy's median of
+      // an even count: the mean of the middle two).
+      const at::Tensor raw = NoveltyBonus(ex2.model(), ex2.Inputs(rollouts));
+      const at::Tensor sorted = std::get<0>(raw.sort());
+      const double median =
+          0.5 * (sorted[299].item<double>() + sorted[300].item<double>());
+      EXPECT_TRUE(at::allclose(added, 0.25 * (raw - median), 1e-5, 1e-6));
+    }
+    ex2.Commit();
+    EXPECT_EQ(ex2.pool().total_added(), 600 * (batch + 1));
+  }
+  // Pool sizes before each batch: 0, 600, 1200, 1800.
+  EXPECT_THAT(fits, ::testing::ElementsAre(0, 0, 40, 10));
+  EXPECT_EQ(bonuses[0], 0.0);
+  EXPECT_NE(bonuses[1], 0.0);  // the untrained model's, as in the reference
+}
+
+TEST(Ex2BonusTest, SameSeedSameBonusesAndASavedModelContinuesExactly) {
+  const auto batches = [] {
+    std::vector<std::vector<Rollout>> all;
+    at::Generator generator = at::make_generator<at::CPUGeneratorImpl>(9);
+    for (int i = 0; i < 5; ++i) {
+      all.push_back({RolloutOf(at::randn({400, 2}, generator))});
+    }
+    return all;
+  };
+  Ex2Config config = SmallConfig();
+  config.replay_min = 500;
+  config.replay_size = 900;  // wraps around
+  config.first_train_iterations = 30;
+  config.train_iterations = 20;
+  at::manual_seed(1);
+  Ex2Bonus whole(config, PlaneSpec(), 8, SoloReplicaGroup());
+  std::vector<at::Tensor> expected;
+  for (std::vector<Rollout>& rollouts : batches()) {
+    whole.ShapeRewards(rollouts);
+    whole.Commit();
+    expected.push_back(rollouts[0].rewards);
+  }
+  at::manual_seed(1);
+  Ex2Bonus first(config, PlaneSpec(), 8, SoloReplicaGroup());
+  std::vector<std::vector<Rollout>> inputs = batches();
+  for (int i = 0; i < 3; ++i) {
+    first.ShapeRewards(inputs[i]);
+    first.Commit();
+    EXPECT_TRUE(inputs[i][0].rewards.equal(expected[i])) << i;
+  }
+  torch::serialize::OutputArchive out;
+  first.Save(out);
+  std::ostringstream bytes;
+  out.save_to(bytes);
+  at::manual_seed(99);  // other initial weights, all overwritten
+  Ex2Bonus resumed(config, PlaneSpec(), 1234, SoloReplicaGroup());
+  torch::serialize::InputArchive in;
+  std::istringstream stream(bytes.str());
+  in.load_from(stream);
+  ASSERT_TRUE(resumed.Load(in).ok());
+  for (int i = 3; i < 5; ++i) {
+    resumed.ShapeRewards(inputs[i]);
+    resumed.Commit();
+    EXPECT_TRUE(inputs[i][0].rewards.equal(expected[i])) << i;
+  }
+  // A model of other inputs (actions too) does not load it.
+  config.use_actions = true;
+  Ex2Bonus other(config, PlaneSpec(), 8, SoloReplicaGroup());
+  torch::serialize::InputArchive again;
+  std::istringstream stream2(bytes.str());
+  again.load_from(stream2);
+  const absl::Status status = other.Load(again);
+  EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(std::string(status.message()), HasSubstr("replay pool"));
+}
+
+TEST(Ex2ConfigTest, RulesNameTheirField) {
+  Ex2Config config;
+  EXPECT_TRUE(config.Validate().ok());
+  config.kl_weight = -1;
+  EXPECT_THAT(std::string(config.Validate().message()),
+              HasSubstr("ex2.kl_weight"));
+  config = Ex2Config();
+  config.hidden = {};
+  EXPECT_THAT(std::string(config.Validate().message()),
+              HasSubstr("ex2.hidden"));
+  config = Ex2Config();
+  config.replay_size = int64_t{1} << 40;
+  EXPECT_THAT(std::string(config.Validate().message()),
+              HasSubstr("ex2.replay_size"));
+}
+
+}  // namespace
+}  // namespace vantage
