@@ -142,6 +142,8 @@ class LearnerCore {
   const std::deque<double>& recent_returns() const { return recent_returns_; }
   // Mean of recent_returns(); NaN before the first episode ends.
   double MeanRecentReturn() const;
+  // The exploration bonus, or null in a run without one.
+  const Ex2Bonus* exploration() const { return exploration_.get(); }
   int64_t policy_version() const { return version_; }
   int64_t env_steps() const { return env_steps_; }
   const LearnerConfig& config() const { return config_; }

@@ -235,7 +235,7 @@ INSTANTIATE_TEST_SUITE_P(AllEnvs, EnvReplayTest,
                          });
 
 TEST(EnvStateTest, EveryRegisteredEnvIsCovered) {
-  EXPECT_EQ(RegisteredEnvironments().size(), 12u);
+  EXPECT_EQ(RegisteredEnvironments().size(), 14u);
 }
 
 // The state is the whole mjData buffer: check that in MuJoCo 2.2.2 every
@@ -270,7 +270,7 @@ TEST(EnvStateTest, EveryMjDataArrayLivesInTheBuffer) {
     (void)nv;
     (void)njmax;
   }
-  EXPECT_EQ(mujoco_envs, 9);
+  EXPECT_EQ(mujoco_envs, 11);
 }
 
 // Saving exactly when an episode has ended (the time limit refuses to step

@@ -34,17 +34,18 @@ using ::testing::HasSubstr;
 
 constexpr char kRun[] = "--steps=3072 --horizon=256 --envs=2 --seed=5";
 
-// The equivalence: a --sync run with one actor trains on exactly
-// the data of local mode and repeats its progress.csv (wall clock aside).
-TEST(DistributedTest, SyncWithOneActorReproducesLocalMode) {
-  const std::string local = FreshDirectory("local");
-  const std::string remote = FreshDirectory("remote");
-  ASSERT_EQ(RunVantage(std::string("train --mode=local ") + kRun +
-                       " --run_dir=" + local)
-                .exit_code,
-            0);
-  const Learner learner =
-      StartLearner(std::string(kRun) + " --run_dir=" + remote);
+// A --sync run with one actor trains on exactly the data of local mode and
+// repeats its progress.csv (wall clock aside); with EX2 too, whose model
+// fits on the learner from update 2 on.
+void ExpectSyncWithOneActorReproducesLocalMode(const std::string& extra) {
+  const bool ex2 = !extra.empty();
+  const std::string local = FreshDirectory(ex2 ? "local_ex2" : "local");
+  const std::string remote = FreshDirectory(ex2 ? "remote_ex2" : "remote");
+  const std::string run = std::string(kRun) + extra;
+  ASSERT_EQ(
+      RunVantage("train --mode=local " + run + " --run_dir=" + local).exit_code,
+      0);
+  const Learner learner = StartLearner(run + " --run_dir=" + remote);
   const int actor =
       StartVantage("actor --learner=127.0.0.1:" + learner.port +
                        " --env=InvertedPendulum --envs=2 --seed=5",
@@ -56,6 +57,23 @@ TEST(DistributedTest, SyncWithOneActorReproducesLocalMode) {
   const std::vector<std::string> expected = DeterministicProgress(local);
   ASSERT_EQ(expected.size(), 1u + 6);
   EXPECT_EQ(DeterministicProgress(remote), expected);
+  if (ex2) {
+    // The last row's exploration_loss (third from the end once the wall
+    // clock is dropped) is that of a fit.
+    const std::vector<std::string> fields =
+        absl::StrSplit(expected.back(), ',');
+    EXPECT_FALSE(fields[fields.size() - 3].empty()) << expected.back();
+  }
+}
+
+TEST(DistributedTest, SyncWithOneActorReproducesLocalMode) {
+  ExpectSyncWithOneActorReproducesLocalMode("");
+}
+
+TEST(DistributedTest, SyncWithOneActorReproducesLocalModeWithEx2) {
+  ExpectSyncWithOneActorReproducesLocalMode(
+      " --exploration=ex2 --ex2_replay_min=500 --ex2_first_train_iterations=50 "
+      "--ex2_train_iterations=20 --ex2_bonus_coeff=0.1");
 }
 
 // Two actors of two envs each fill the learner's four-stream batches: no

@@ -10,6 +10,7 @@
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
 #include "learner/checkpoint.h"
+#include "learner/exploration/ex2_bonus.h"
 #include "tests/fakes/learner_batches.h"
 
 namespace vantage {
@@ -107,6 +108,49 @@ TEST(RollbackLimitTest, AGradientNormExplosionIsUndone) {
     EXPECT_TRUE(
         learner->CurrentWeights().parameters[0].equal(before.parameters[0]));
   }
+}
+
+// An update rolled back undoes the EX2 model's fit on its batch and keeps
+// the batch out of the pool; the next honest batch fits from there.
+TEST(RollbackTest, AnEx2FitOnAPoisonedBatchIsUndoneToo) {
+  auto actor = MakeTestActor();
+  LearnerConfig config = UngatedConfig(actor->spec(), "trpo");
+  Ex2Config ex2;
+  ex2.replay_min = 1;
+  ex2.first_train_iterations = 20;
+  ex2.train_iterations = 10;
+  config.exploration.ex2 = ex2;
+  auto learner = *LearnerCore::Create(config);
+  // The first batch only fills the pool; the second fits.
+  for (int i = 0; i < 2; ++i) {
+    const UpdateStats honest =
+        UpdateWith(*learner, ActOneBatch(*actor, *learner));
+    EXPECT_FALSE(honest.rolled_back) << honest.rollback_reason;
+  }
+  const auto model_parameters = [&] {
+    std::vector<at::Tensor> copies;
+    for (const at::Tensor& p : learner->exploration()->parameters()) {
+      copies.push_back(p.detach().clone());
+    }
+    return copies;
+  };
+  const std::vector<at::Tensor> before = model_parameters();
+  const int64_t pooled = learner->exploration()->pool().total_added();
+  EXPECT_EQ(pooled, 2 * kTestEnvs * kTestHorizon);
+  std::vector<Segment> poisoned = ActOneBatch(*actor, *learner);
+  for (Segment& segment : poisoned) segment.rewards.fill_(3e38f);
+  const UpdateStats stats = UpdateWith(*learner, poisoned);
+  EXPECT_TRUE(stats.rolled_back);
+  EXPECT_EQ(stats.exploration.fit_steps, 10);  // it did fit, then was undone
+  const std::vector<at::Tensor> after = model_parameters();
+  for (size_t i = 0; i < before.size(); ++i) {
+    EXPECT_TRUE(after[i].equal(before[i])) << i;
+  }
+  EXPECT_EQ(learner->exploration()->pool().total_added(), pooled);
+  const UpdateStats next = UpdateWith(*learner, ActOneBatch(*actor, *learner));
+  EXPECT_FALSE(next.rolled_back) << next.rollback_reason;
+  EXPECT_EQ(learner->exploration()->pool().total_added(),
+            pooled + kTestEnvs * kTestHorizon);
 }
 
 TEST(RollbackLimitTest, AnHonestRunNeverRollsBack) {
