@@ -35,8 +35,18 @@ absl::Status AlgorithmSettingError(absl::string_view rule) {
       rule, " (--", absl::StrReplaceAll(field, {{".", "_"}}), ")"));
 }
 
-// An actor sends segments of at most this many steps (or one horizon).
+// An actor sends segments of at most this many steps by default: the
+// largest divisor of the horizon up to it, so that a segment never spans
+// two rollouts (which local and --sync runs need).
 constexpr int64_t kSegmentSteps = 128;
+
+int64_t DefaultSegmentLength(int64_t horizon) {
+  for (int64_t length = std::min(kSegmentSteps, horizon); length > 1;
+       --length) {
+    if (horizon % length == 0) return length;
+  }
+  return 1;
+}
 
 absl::Status ResolveDistributed(pb::RunConfig& c) {
   pb::TrainingSettings& t = *c.mutable_training();
@@ -225,7 +235,7 @@ absl::StatusOr<pb::RunConfig> ResolveRunConfig(const pb::RunConfig& given) {
   }
   if (!t.has_scale_rewards()) t.set_scale_rewards(local.learner.scale_rewards);
   if (!t.has_segment_length()) {
-    t.set_segment_length(std::min(kSegmentSteps, t.horizon()));
+    t.set_segment_length(DefaultSegmentLength(t.horizon()));
   }
   if (t.segment_length() < 1 || t.segment_length() > t.horizon()) {
     return Invalid("segment_length", "must be in [1, --horizon]");
@@ -257,6 +267,11 @@ absl::StatusOr<pb::RunConfig> ResolveRunConfig(const pb::RunConfig& given) {
           "--max_policy_lag, --learners, --learner_threads)");
     }
     if (!t.has_envs()) t.set_envs(local.num_envs);
+    if (t.horizon() % t.segment_length() != 0) {
+      return Invalid("segment_length",
+                     "must divide --horizon in a local run (its actor sends "
+                     "each rollout as whole segments)");
+    }
   }
 
   pb::RecordingSettings& r = *c.mutable_recording();

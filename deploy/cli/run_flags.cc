@@ -31,7 +31,9 @@ ABSL_FLAG(std::vector<std::string>, hidden, {},
 ABSL_FLAG(bool, scale_rewards, false,
           "divide rewards by the running std of discounted returns");
 ABSL_FLAG(int64_t, segment_length, 0,
-          "steps per segment an actor sends (divides --horizon with --sync)");
+          "steps per segment an actor sends (divides --horizon in local and "
+          "--sync runs; by default the largest divisor of --horizon up to "
+          "128)");
 ABSL_FLAG(std::string, estimator, "",
           "the biased statistic: gae (none) | max | min | maxabs | order:D");
 ABSL_FLAG(double, rho, 0, "probability of the biased estimate per sample");
