@@ -79,7 +79,10 @@ class PrometheusTest(unittest.TestCase):
     cls.train_log = open(os.path.join(cls.tmp, "train.log"), "w")
     cls.train = subprocess.Popen(
         [VANTAGE, "train", "--actors=2", "--horizon=512", "--steps=100000000",
-         "--metrics=0", "--checkpoint_every=1000", "--run_dir=" + cls.run_dir],
+         "--metrics=0", "--checkpoint_every=1000", "--run_dir=" + cls.run_dir,
+         # EX2 fits from the second update on, for its panels.
+         "--exploration=ex2", "--ex2_replay_min=1024",
+         "--ex2_first_train_iterations=50", "--ex2_train_iterations=20"],
         stdout=cls.train_log, stderr=subprocess.STDOUT, start_new_session=True)
     cls.listen = f"127.0.0.1:{free_port()}"
     cls.state = os.path.join(cls.tmp, "prometheus")
