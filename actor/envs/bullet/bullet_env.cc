@@ -142,7 +142,9 @@ absl::StatusOr<Frame> BulletEnv::Render(int width, int height) {
     capsule.far_side = absl::StartsWith(model_.links[i].name, "left");
     scene.capsules.push_back(capsule);
     const PlanarLink& link = model_.links[i];
-    top = std::max(top, std::max(link.from_z, link.to_z) + link.radius);
+    top = std::max(top, link.is_box()
+                            ? link.box_centre_z + link.box_height / 2
+                            : std::max(link.from_z, link.to_z) + link.radius);
   }
   scene.view_height = 1.8 * top;
   const PlanarCapsule& root = scene.capsules[0];

@@ -12,6 +12,8 @@ constexpr double kPi = 3.14159265358979323846;
 // The slides carry no real body; Bullet wants a positive mass and inertia.
 constexpr double kSlideMass = 1e-3;
 constexpr double kSlideInertia = 1e-5;
+// The collision margin of a box, inside its faces.
+constexpr double kBoxMargin = 2e-3;
 // Manifold points closer than this count as touching.
 constexpr double kTouchDistance = 2e-3;
 // Link colliders only meet the ground, never each other.
@@ -47,6 +49,43 @@ CapsuleInertia Capsule(double length, double radius, double density) {
   return inertia;
 }
 
+// A link's mass, its inertia about its centre (x, y, z world axes at the
+// zero pose) and its centre there.
+struct LinkInertia {
+  double mass;
+  btVector3 inertia;
+  btVector3 centre;
+};
+
+LinkInertia InertiaOf(const PlanarLink& link, double density) {
+  LinkInertia result;
+  if (link.is_box()) {
+    const double w2 = link.box_width * link.box_width;
+    const double d2 = link.box_depth * link.box_depth;
+    const double h2 = link.box_height * link.box_height;
+    result.mass = link.mass > 0.0 ? link.mass
+                                  : density * link.box_width * link.box_depth *
+                                        link.box_height;
+    result.inertia = btVector3(result.mass * (d2 + h2) / 12.0,
+                               result.mass * (w2 + h2) / 12.0,
+                               result.mass * (w2 + d2) / 12.0);
+    result.centre = btVector3(link.box_centre_x, 0, link.box_centre_z);
+    return result;
+  }
+  const CapsuleInertia capsule =
+      Capsule(SegmentLength(link), link.radius, density);
+  // An explicit mass scales the capsule's density.
+  const double scale = link.mass > 0.0 ? link.mass / capsule.mass : 1.0;
+  result.mass = capsule.mass * scale;
+  const double axial = capsule.axial * scale;
+  const double across = capsule.perpendicular * scale;
+  result.inertia = AlongX(link) ? btVector3(axial, across, across)
+                                : btVector3(across, across, axial);
+  result.centre = btVector3((link.from_x + link.to_x) / 2.0, 0,
+                            (link.from_z + link.to_z) / 2.0);
+  return result;
+}
+
 }  // namespace
 
 absl::Status ValidatePlanarModel(const PlanarModel& model) {
@@ -69,11 +108,18 @@ absl::Status ValidatePlanarModel(const PlanarModel& model) {
                : link.parent < 0 || link.parent >= static_cast<int>(i)) {
       return bad("needs the root's parent -1, else an earlier link");
     }
-    if (link.from_x != link.to_x && link.from_z != link.to_z) {
-      return bad("is not parallel to x or z");
+    if (!(link.mass >= 0.0) || !(link.friction >= 0.0)) {
+      return bad("needs mass >= 0 and friction >= 0");
     }
-    if (!(link.radius > 0.0) || !(link.friction >= 0.0)) {
-      return bad("needs radius > 0 and friction >= 0");
+    if (link.is_box()) {
+      if (!(link.box_depth > 0.0) || !(link.box_height > 0.0)) {
+        return bad("needs a box depth and height > 0");
+      }
+    } else {
+      if (link.from_x != link.to_x && link.from_z != link.to_z) {
+        return bad("is not parallel to x or z");
+      }
+      if (!(link.radius > 0.0)) return bad("needs radius > 0");
     }
     if (i == 0) continue;
     if (link.axis != 1.0 && link.axis != -1.0) return bad("needs axis +-1");
@@ -83,12 +129,11 @@ absl::Status ValidatePlanarModel(const PlanarModel& model) {
     }
     // The damping torque is explicit: it must not overshoot within one
     // step, i.e. damping * dt well below the link's inertia about its hinge.
-    const CapsuleInertia capsule =
-        Capsule(SegmentLength(link), link.radius, model.density);
-    const double cx = (link.from_x + link.to_x) / 2.0 - link.joint_x;
-    const double cz = (link.from_z + link.to_z) / 2.0 - link.joint_z;
-    const double about_hinge = capsule.perpendicular + link.armature +
-                               capsule.mass * (cx * cx + cz * cz);
+    const LinkInertia body = InertiaOf(link, model.density);
+    const double cx = body.centre.x() - link.joint_x;
+    const double cz = body.centre.z() - link.joint_z;
+    const double about_hinge =
+        body.inertia.y() + link.armature + body.mass * (cx * cx + cz * cz);
     if (link.damping * model.timestep > 0.5 * about_hinge) {
       return bad(absl::StrCat(
           "damping ", link.damping, " is too high for an explicit step of ",
@@ -149,23 +194,17 @@ BulletWorld::BulletWorld(const PlanarModel& model)
   chains_.resize(links);
   for (int i = 0; i < links; ++i) {
     const PlanarLink& link = model.links[i];
-    const double length = SegmentLength(link);
-    const CapsuleInertia capsule = Capsule(length, link.radius, model.density);
-    const btVector3 centre((link.from_x + link.to_x) / 2.0, 0,
-                           (link.from_z + link.to_z) / 2.0);
+    const LinkInertia body = InertiaOf(link, model.density);
+    const btVector3 centre = body.centre;
     centres.push_back(centre);
-    btVector3 inertia = AlongX(link)
-                            ? btVector3(capsule.axial, capsule.perpendicular,
-                                        capsule.perpendicular)
-                            : btVector3(capsule.perpendicular,
-                                        capsule.perpendicular, capsule.axial);
+    const btVector3 inertia = body.inertia;
     if (i == 0) {
-      body_->setupRevolute(LinkIndex(0), capsule.mass, inertia, 1, identity,
+      body_->setupRevolute(LinkIndex(0), body.mass, inertia, 1, identity,
                            btVector3(0, 1, 0), zero,
                            centre - btVector3(0, 0, model.root_z), true);
     } else {
       const btVector3 joint(link.joint_x, 0, link.joint_z);
-      body_->setupRevolute(LinkIndex(i), capsule.mass, inertia,
+      body_->setupRevolute(LinkIndex(i), body.mass, inertia,
                            LinkIndex(link.parent), identity,
                            btVector3(0, link.axis, 0),
                            joint - centres[link.parent], centre - joint, true);
@@ -182,10 +221,18 @@ BulletWorld::BulletWorld(const PlanarModel& model)
             identity, btVector3(0, link.axis, 0), zero, zero, true);
       }
     }
-    if (AlongX(link)) {
-      shapes_.push_back(std::make_unique<btCapsuleShapeX>(link.radius, length));
+    if (link.is_box()) {
+      shapes_.push_back(std::make_unique<btBoxShape>(btVector3(
+          link.box_width / 2, link.box_depth / 2, link.box_height / 2)));
+      // Bullet's default margin (4 cm) lies inside the box and exceeds a
+      // thin one's half height (a 5 cm foot).
+      shapes_.back()->setMargin(kBoxMargin);
+    } else if (AlongX(link)) {
+      shapes_.push_back(
+          std::make_unique<btCapsuleShapeX>(link.radius, SegmentLength(link)));
     } else {
-      shapes_.push_back(std::make_unique<btCapsuleShapeZ>(link.radius, length));
+      shapes_.push_back(
+          std::make_unique<btCapsuleShapeZ>(link.radius, SegmentLength(link)));
     }
   }
   body_->finalizeMultiDof();
@@ -309,11 +356,23 @@ double BulletWorld::LinkMass(int link) const {
 
 CapsulePose BulletWorld::LinkCapsule(int link) const {
   const btMultiBodyLinkCollider* collider = colliders_[link].get();
+  const btTransform& pose = collider->getWorldTransform();
+  if (collider->getCollisionShape()->getShapeType() == BOX_SHAPE_PROXYTYPE) {
+    const auto* box =
+        static_cast<const btBoxShape*>(collider->getCollisionShape());
+    const btVector3 extents = box->getHalfExtentsWithMargin();
+    const bool wide = extents.x() >= extents.z();
+    const double radius = wide ? extents.z() : extents.x();
+    btVector3 half(0, 0, 0);
+    half[wide ? 0 : 2] = (wide ? extents.x() : extents.z()) - radius;
+    const btVector3 from = pose * -half;
+    const btVector3 to = pose * half;
+    return {from.x(), from.z(), to.x(), to.z(), radius};
+  }
   const auto* shape =
       static_cast<const btCapsuleShape*>(collider->getCollisionShape());
   btVector3 half(0, 0, 0);
   half[shape->getUpAxis()] = shape->getHalfHeight();
-  const btTransform& pose = collider->getWorldTransform();
   const btVector3 from = pose * -half;
   const btVector3 to = pose * half;
   CapsulePose capsule;

@@ -1,7 +1,8 @@
 #ifndef VANTAGE_ACTOR_ENVS_BULLET_BULLET_WORLD_H_
 #define VANTAGE_ACTOR_ENVS_BULLET_BULLET_WORLD_H_
 
-// A planar articulated body of capsules on a (possibly tilted) ground plane,
+// A planar articulated body of capsules and boxes on a (possibly tilted)
+// ground plane,
 // simulated with Bullet's Featherstone multibody. Everything Bullet
 // allocates is owned here and released in the order Bullet needs.
 //
@@ -57,6 +58,19 @@ struct PlanarLink {
   double upper = 0.0;
   double damping = 0.0;
   double armature = 0.0;
+  // A box instead of a capsule when box_width > 0: its full sizes along x
+  // (width), y (depth) and z (height) at the zero pose and its centre there;
+  // from_/to_ and radius are then unused.
+  double box_width = 0.0;
+  double box_depth = 0.0;
+  double box_height = 0.0;
+  double box_centre_x = 0.0;
+  double box_centre_z = 0.0;
+  // > 0: the link's mass (kg) rather than the model's density times its
+  // volume.
+  double mass = 0.0;
+
+  bool is_box() const { return box_width > 0.0; }
 };
 
 struct PlanarModel {
@@ -119,7 +133,8 @@ class BulletWorld {
   double LinkMass(int link) const;
   int num_links() const { return static_cast<int>(colliders_.size()); }
   // Read from the link's collider, as the last physics step or SetState
-  // left it.
+  // left it. A box is drawn as the capsule of its footprint: its long
+  // side's centre line, rounded to half its short side.
   CapsulePose LinkCapsule(int link) const;
 
  private:

@@ -175,6 +175,42 @@ TEST(BulletWorldTest, InclinedGroundIsTilted) {
   }
 }
 
+// A box of given mass: its mass and inertia are the box's, it comes to
+// rest with its bottom face on the ground, and it is drawn as the capsule
+// of its footprint.
+TEST(BulletWorldTest, ABoxLinkRestsOnItsFace) {
+  PlanarModel model;
+  model.root_z = 0.2;
+  model.timestep = 1.0 / 3000;
+  PlanarLink block;
+  block.name = "block";
+  block.box_width = 0.4;
+  block.box_depth = 0.1;
+  block.box_height = 0.05;
+  block.box_centre_z = 0.1;  // bottom 0.075 above the ground
+  block.mass = 2.0;
+  model.links = {block};
+  ASSERT_TRUE(ValidatePlanarModel(model).ok());
+  BulletWorld world(model);
+  EXPECT_DOUBLE_EQ(world.LinkMass(0), 2.0);
+  for (int t = 0; t < 3000; ++t) world.Step({}, 1);
+  // The box centre sits 0.1 below the root point (0.2 and 0.1 at the zero
+  // pose): at rest, half the box's height above the ground.
+  EXPECT_NEAR(world.q(1) - 0.1, 0.025, 2e-3);
+  EXPECT_NEAR(world.q(2), 0.0, 1e-3);
+  EXPECT_NEAR(world.qd(1), 0.0, 1e-3);
+  EXPECT_TRUE(world.TouchesGround(0));
+  const CapsulePose drawn = world.LinkCapsule(0);
+  EXPECT_NEAR(drawn.radius, 0.025, 1e-9);
+  EXPECT_NEAR(drawn.to_x - drawn.from_x, 0.4 - 0.05, 1e-6);
+  EXPECT_NEAR(drawn.from_z, world.q(1) - 0.1, 1e-6);
+  // Thin boxes need a depth and height.
+  block.box_height = 0.0;
+  model.links = {block};
+  EXPECT_THAT(std::string(ValidatePlanarModel(model).message()),
+              HasSubstr("box depth and height"));
+}
+
 TEST(BulletWorldTest, ModelsAreValidated) {
   EXPECT_TRUE(ValidatePlanarModel(Leg()).ok());
   PlanarModel tilted = Leg();
