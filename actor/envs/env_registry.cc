@@ -10,6 +10,7 @@
 #include "absl/strings/strip.h"
 #include "actor/envs/bullet/biped_walk.h"
 #include "actor/envs/bullet/bullet_hopper.h"
+#include "actor/envs/bullet/terrain_biped.h"
 #include "actor/envs/mujoco/gym_tasks.h"
 #include "actor/envs/mujoco/humanoid_env.h"
 #include "actor/envs/mujoco/pendulum_envs.h"
@@ -35,6 +36,7 @@ const std::map<std::string, Factory>& Factories() {
       {"InvertedPendulum", MakeInvertedPendulum},
       {"PointMaze", MakePointMaze},
       {"SparseHalfCheetah", MakeSparseHalfCheetah},
+      {"TerrainBipedFlat", MakeTerrainBipedFlat},
       {"Ex2SparseHalfCheetah", MakeEx2SparseHalfCheetah},
       {"TwoDMaze", MakeTwoDMaze},
       {"Walker2d", MakeWalker2d},

@@ -39,6 +39,19 @@ BulletEnv::BulletEnv(EnvSpec spec, PlanarModel model, std::vector<double> gears,
   torques_.resize(gears_.size());
 }
 
+void BulletEnv::Torques(const BulletWorld&, absl::Span<const double> clipped,
+                        std::vector<double>& torques) const {
+  for (size_t j = 0; j < gears_.size(); ++j) {
+    torques[j] = gears_[j] * clipped[j];
+  }
+}
+
+void BulletEnv::SetActionBounds(std::vector<double> low,
+                                std::vector<double> high) {
+  spec_.action_low = std::move(low);
+  spec_.action_high = std::move(high);
+}
+
 std::vector<double> BulletEnv::ZeroPose() const {
   std::vector<double> q(model_.links.size() + 2, 0.0);
   q[1] = model_.root_z;
@@ -71,11 +84,12 @@ absl::Status BulletEnv::Reset(uint64_t seed, absl::Span<double> observation) {
 
 absl::Status BulletEnv::Advance(absl::Span<const double> clipped,
                                 StepResult* result) {
-  for (size_t j = 0; j < gears_.size(); ++j) {
-    torques_[j] = gears_[j] * clipped[j];
-  }
   BeforeStep(*world_);
-  world_->Step(torques_, frame_skip_);
+  const int substeps = std::max(1, TorqueSubsteps());
+  for (int done = 0; done < frame_skip_; done += substeps) {
+    Torques(*world_, clipped, torques_);
+    world_->Step(torques_, std::min(substeps, frame_skip_ - done));
+  }
   if (!world_->IsFinite()) {
     return absl::InternalError(absl::StrCat(
         spec_.name,

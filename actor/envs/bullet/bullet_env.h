@@ -73,6 +73,15 @@ class BulletEnv : public Environment {
   // Whatever else decides the task's rules (thresholds set by a config),
   // so that a state is only restored into an identical task.
   virtual std::string TaskSignature() const { return {}; }
+  // The hinge torques for the next TorqueSubsteps() physics steps of a
+  // frame; by default the clipped action times the gears, held for the
+  // whole frame. A controller (PD) recomputes them more often.
+  virtual int TorqueSubsteps() const { return frame_skip_; }
+  virtual void Torques(const BulletWorld& world,
+                       absl::Span<const double> clipped,
+                       std::vector<double>& torques) const;
+  // Replaces the [-1, 1] action bounds (one entry per hinge).
+  void SetActionBounds(std::vector<double> low, std::vector<double> high);
 
  private:
   void Begin(uint64_t seed);

@@ -149,6 +149,35 @@ std::array<BoxPlacement, kTerrainBipedBodies> PlaceBodies(
   return placements;
 }
 
+std::array<BoxMotion, kTerrainBipedBodies> MoveBodies(
+    const TerrainBipedPose& pose, const TerrainBipedPose& rates) {
+  const auto& joints = TerrainBipedJointDefs();
+  const auto& bodies = TerrainBipedBodyDefs();
+  const Frames frames = JointFrames(pose);
+  // Each joint frame's velocity and angular velocity, root first; in the
+  // plane, omega x r = omega * (-r_y, r_x).
+  std::array<BoxMotion, kTerrainBipedBodies> joint_motion;
+  joint_motion[kRoot] = {rates.root_x, rates.root_y, rates.root_angle};
+  for (int j = 1; j < kTerrainBipedBodies; ++j) {
+    const int p = joints[j].parent;
+    const double rx = frames.x[j] - frames.x[p];
+    const double ry = frames.y[j] - frames.y[p];
+    const BoxMotion& parent = joint_motion[p];
+    joint_motion[j] = {parent.vx - parent.omega * ry,
+                       parent.vy + parent.omega * rx,
+                       parent.omega + rates.joints[j - 1]};
+  }
+  std::array<BoxMotion, kTerrainBipedBodies> motions;
+  for (int b = 0; b < kTerrainBipedBodies; ++b) {
+    const auto r =
+        Rotate(frames.angle[b], bodies[b].centre_x, bodies[b].centre_y);
+    const BoxMotion& joint = joint_motion[b];
+    motions[b] = {joint.vx - joint.omega * r[1], joint.vy + joint.omega * r[0],
+                  joint.omega};
+  }
+  return motions;
+}
+
 double LowestCorner(int body, const BoxPlacement& placement) {
   const TerrainBipedBody& box = TerrainBipedBodyDefs()[body];
   double lowest = placement.y;
@@ -188,6 +217,23 @@ TerrainBipedPose WalkPose(double time) {
     pose.joints[j] = a.joints[j] + blend * (b.joints[j] - a.joints[j]);
   }
   return pose;
+}
+
+TerrainBipedPose WalkPoseRate(double time) {
+  constexpr double kHalf = 1.0 / 120.0;
+  const double from = std::max(0.0, time - kHalf);
+  const double to = from + 2 * kHalf;
+  const TerrainBipedPose a = WalkPose(from);
+  const TerrainBipedPose b = WalkPose(to);
+  const double scale = 1.0 / (to - from);
+  TerrainBipedPose rate;
+  rate.root_x = (b.root_x - a.root_x) * scale;
+  rate.root_y = (b.root_y - a.root_y) * scale;
+  rate.root_angle = (b.root_angle - a.root_angle) * scale;
+  for (int j = 0; j < kTerrainBipedJoints; ++j) {
+    rate.joints[j] = (b.joints[j] - a.joints[j]) * scale;
+  }
+  return rate;
 }
 
 }  // namespace vantage

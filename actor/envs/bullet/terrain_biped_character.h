@@ -67,6 +67,16 @@ struct BoxPlacement {
 };
 std::array<BoxPlacement, kTerrainBipedBodies> PlaceBodies(
     const TerrainBipedPose& pose);
+
+// A body's centre velocity and angular velocity when the pose changes at
+// `rates` (each field the time derivative of the pose's).
+struct BoxMotion {
+  double vx = 0.0;
+  double vy = 0.0;
+  double omega = 0.0;
+};
+std::array<BoxMotion, kTerrainBipedBodies> MoveBodies(
+    const TerrainBipedPose& pose, const TerrainBipedPose& rates);
 // The lowest corner of body `body`'s box, placed as `placement`.
 double LowestCorner(int body, const BoxPlacement& placement);
 // Where joint `joint` (1..11) is.
@@ -80,6 +90,8 @@ double WalkCycleAdvance();
 // The pose at `time` seconds (any time >= 0: each later cycle advances the
 // root by WalkCycleAdvance()), keyframes interpolated linearly.
 TerrainBipedPose WalkPose(double time);
+// Its rate of change at `time`: the central difference over 1/60 s.
+TerrainBipedPose WalkPoseRate(double time);
 
 }  // namespace vantage
 

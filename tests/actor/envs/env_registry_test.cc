@@ -75,7 +75,10 @@ TEST(EnvRegistryTest, SpecsMatchTheGymnasiumTasks) {
     EXPECT_EQ(env->spec().observation_size, sizes.first) << name;
     EXPECT_EQ(env->spec().action_size, sizes.second) << name;
     const std::map<std::string, int64_t> short_episodes = {
-        {"PointMaze", 500}, {"TwoDMaze", 200}, {"Ex2SparseHalfCheetah", 500}};
+        {"PointMaze", 500},
+        {"TwoDMaze", 200},
+        {"Ex2SparseHalfCheetah", 500},
+        {"TerrainBipedFlat", 256}};
     EXPECT_EQ(env->spec().max_episode_steps,
               short_episodes.count(name) > 0 ? short_episodes.at(name) : 1000)
         << name;
