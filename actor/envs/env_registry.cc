@@ -37,6 +37,7 @@ const std::map<std::string, Factory>& Factories() {
       {"PointMaze", MakePointMaze},
       {"SparseHalfCheetah", MakeSparseHalfCheetah},
       {"TerrainBipedFlat", MakeTerrainBipedFlat},
+      {"TerrainBipedIncline", MakeTerrainBipedIncline},
       {"Ex2SparseHalfCheetah", MakeEx2SparseHalfCheetah},
       {"TwoDMaze", MakeTwoDMaze},
       {"Walker2d", MakeWalker2d},

@@ -2,6 +2,7 @@
 
 #include <cairo.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -88,28 +89,50 @@ absl::StatusOr<Frame> DrawPlanarScene(const PlanarScene& scene, int width,
   cairo_set_source(cr, sky.get());
   cairo_paint(cr);
 
-  // The ground below its line, down past the frame's bottom edge.
+  // The ground below its line (the slope's, or the profile), down past the
+  // frame's bottom edge.
   const double tangent = std::tan(scene.slope);
-  const double bottom =
-      scene.centre_z - half_height - 1.0 - std::abs(tangent) * 2.0 * half_width;
-  cairo_move_to(cr, left - 1.0, (left - 1.0) * tangent);
-  cairo_line_to(cr, right + 1.0, (right + 1.0) * tangent);
-  cairo_line_to(cr, right + 1.0, bottom);
-  cairo_line_to(cr, left - 1.0, bottom);
+  std::vector<std::array<double, 2>> line = scene.ground;
+  if (line.empty()) {
+    line = {{left - 1.0, (left - 1.0) * tangent},
+            {right + 1.0, (right + 1.0) * tangent}};
+  }
+  const auto height_at = [&](double x) {
+    for (size_t i = 1; i < line.size(); ++i) {
+      if (x <= line[i][0] || i + 1 == line.size()) {
+        const double span = line[i][0] - line[i - 1][0];
+        const double blend =
+            span > 0 ? std::clamp((x - line[i - 1][0]) / span, 0.0, 1.0) : 0.0;
+        return line[i - 1][1] + blend * (line[i][1] - line[i - 1][1]);
+      }
+    }
+    return line.front()[1];
+  };
+  double lowest = line.front()[1];
+  for (const auto& point : line) lowest = std::min(lowest, point[1]);
+  const double bottom = std::min(scene.centre_z - half_height, lowest) - 1.0;
+  const auto trace = [&] {
+    cairo_move_to(cr, line.front()[0], line.front()[1]);
+    for (size_t i = 1; i < line.size(); ++i) {
+      cairo_line_to(cr, line[i][0], line[i][1]);
+    }
+  };
+  trace();
+  cairo_line_to(cr, line.back()[0], bottom);
+  cairo_line_to(cr, line.front()[0], bottom);
   cairo_close_path(cr);
   SetColour(cr, kGround);
   cairo_fill(cr);
   const double pixel = 1.0 / scale;
   cairo_set_line_cap(cr, CAIRO_LINE_CAP_BUTT);
-  cairo_move_to(cr, left - 1.0, (left - 1.0) * tangent);
-  cairo_line_to(cr, right + 1.0, (right + 1.0) * tangent);
+  trace();
   cairo_set_line_width(cr, 3.0 * pixel);
   SetColour(cr, kGroundLine);
   cairo_stroke(cr);
   // A tick every metre, longer every fifth, into the ground.
   for (double x = std::floor(left); x <= right + 1.0; x += 1.0) {
     const bool long_tick = std::fmod(std::abs(x), 5.0) < 0.5;
-    const double z = x * tangent;
+    const double z = height_at(x);
     cairo_move_to(cr, x, z);
     cairo_line_to(cr, x, z - (long_tick ? 0.25 : 0.1));
     cairo_set_line_width(cr, 2.0 * pixel);

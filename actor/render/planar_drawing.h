@@ -5,6 +5,7 @@
 // tasks), drawn in 2-D with Cairo. Knows nothing of Bullet: the caller
 // describes the scene in the sagittal (x, z) plane, in metres.
 
+#include <array>
 #include <vector>
 
 #include "absl/status/statusor.h"
@@ -27,8 +28,11 @@ struct PlanarCapsule {
 struct PlanarScene {
   std::vector<PlanarCapsule> capsules;
   // The ground passes through the origin and rises by tan(slope) per metre
-  // of x (radians).
+  // of x (radians)...
   double slope = 0.0;
+  // ... unless this profile is given: (x, z) points from left to right,
+  // joined by straight segments, spanning the frame.
+  std::vector<std::array<double, 2>> ground;
   // The world point at the frame's centre, and how many metres the frame's
   // height spans.
   double centre_x = 0.0;

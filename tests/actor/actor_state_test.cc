@@ -235,7 +235,7 @@ INSTANTIATE_TEST_SUITE_P(AllEnvs, EnvReplayTest,
                          });
 
 TEST(EnvStateTest, EveryRegisteredEnvIsCovered) {
-  EXPECT_EQ(RegisteredEnvironments().size(), 15u);
+  EXPECT_EQ(RegisteredEnvironments().size(), 16u);
 }
 
 // The state is the whole mjData buffer: check that in MuJoCo 2.2.2 every

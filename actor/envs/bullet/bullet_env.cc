@@ -59,8 +59,10 @@ std::vector<double> BulletEnv::ZeroPose() const {
 }
 
 void BulletEnv::Begin(uint64_t seed) {
-  world_ = std::make_unique<BulletWorld>(model_);
   std::mt19937_64 rng(seed);
+  PlanarModel model = model_;
+  ShapeGround(rng, model);
+  world_ = std::make_unique<BulletWorld>(model);
   std::vector<double> q = ZeroPose();
   std::vector<double> qd(q.size(), 0.0);
   ResetState(rng, q, qd);
@@ -142,7 +144,6 @@ absl::StatusOr<Frame> BulletEnv::Render(int width, int height) {
         absl::StrCat(spec_.name, ": nothing to render before a Reset"));
   }
   PlanarScene scene;
-  scene.slope = model_.slope;
   // The whole standing body fits in the frame, with room to jump.
   double top = 0.0;
   for (int i = 0; i < world_->num_links(); ++i) {
@@ -163,6 +164,12 @@ absl::StatusOr<Frame> BulletEnv::Render(int width, int height) {
   scene.view_height = 1.8 * top;
   const PlanarCapsule& root = scene.capsules[0];
   scene.centre_x = 0.5 * (root.from_x + root.to_x);
+  // The ground as the world has it, a point every 5 cm across the frame
+  // (generously: the frame's width depends on its aspect).
+  for (double x = scene.centre_x - 2.0 * scene.view_height;
+       x <= scene.centre_x + 2.0 * scene.view_height; x += 0.05) {
+    scene.ground.push_back({x, world_->GroundHeight(x)});
+  }
   // The ground stays at the same height in the frame (a tenth above its
   // bottom edge) however the body bobs.
   scene.centre_z =

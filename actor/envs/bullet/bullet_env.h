@@ -58,6 +58,9 @@ class BulletEnv : public Environment {
   BulletEnv(EnvSpec spec, PlanarModel model, std::vector<double> gears,
             int frame_skip);
 
+  // The episode's ground, drawn before the world is built (by default the
+  // model's own, drawing nothing from `rng`).
+  virtual void ShapeGround(std::mt19937_64& rng, PlanarModel& model) {}
   // Perturbs the initial positions and velocities (num_dofs each), which
   // start at ZeroPose() and 0.
   virtual void ResetState(std::mt19937_64& rng, std::vector<double>& q,

@@ -12,8 +12,12 @@ constexpr double kPi = 3.14159265358979323846;
 // The slides carry no real body; Bullet wants a positive mass and inertia.
 constexpr double kSlideMass = 1e-3;
 constexpr double kSlideInertia = 1e-5;
-// The collision margin of a box, inside its faces.
+// The collision margin of a box, inside its faces, and of a ground profile.
 constexpr double kBoxMargin = 2e-3;
+// A ground profile spans y in [-kGroundHalfWidth, kGroundHalfWidth] and
+// stays level for kRunOut metres past its ends.
+constexpr double kGroundHalfWidth = 1.0;
+constexpr double kRunOut = 100.0;
 // Manifold points closer than this count as touching.
 constexpr double kTouchDistance = 2e-3;
 // Link colliders only meet the ground, never each other.
@@ -98,6 +102,19 @@ absl::Status ValidatePlanarModel(const PlanarModel& model) {
         "planar model: timestep and density must be > 0, solver_iterations "
         ">= 1 and |slope| < 45 degrees");
   }
+  if (!model.ground_heights.empty()) {
+    if (model.ground_heights.size() < 2 || !(model.ground_spacing > 0.0)) {
+      return absl::InvalidArgumentError(
+          "planar model: a ground profile needs 2 or more heights and a "
+          "spacing > 0");
+    }
+    for (double h : model.ground_heights) {
+      if (!std::isfinite(h)) {
+        return absl::InvalidArgumentError(
+            "planar model: the ground profile has a non-finite height");
+      }
+    }
+  }
   for (size_t i = 0; i < model.links.size(); ++i) {
     const PlanarLink& link = model.links[i];
     const auto bad = [&](absl::string_view why) {
@@ -144,7 +161,11 @@ absl::Status ValidatePlanarModel(const PlanarModel& model) {
 }
 
 BulletWorld::BulletWorld(const PlanarModel& model)
-    : slope_tangent_(std::tan(model.slope)), timestep_(model.timestep) {
+    : slope_tangent_(std::tan(model.slope)),
+      ground_heights_(model.ground_heights),
+      ground_start_x_(model.ground_start_x),
+      ground_spacing_(model.ground_spacing),
+      timestep_(model.timestep) {
   const int links = static_cast<int>(model.links.size());
   num_dofs_ = 2 + links;
   int rotors = 0;
@@ -170,8 +191,36 @@ BulletWorld::BulletWorld(const PlanarModel& model)
   world_->setGravity(btVector3(0, 0, -model.gravity));
   world_->getSolverInfo().m_numIterations = model.solver_iterations;
 
-  const btVector3 normal(-std::sin(model.slope), 0, std::cos(model.slope));
-  ground_shape_ = std::make_unique<btStaticPlaneShape>(normal, 0);
+  if (ground_heights_.empty()) {
+    const btVector3 normal(-std::sin(model.slope), 0, std::cos(model.slope));
+    ground_shape_ = std::make_unique<btStaticPlaneShape>(normal, 0);
+  } else {
+    // The profile as a strip of triangles across y, wide enough for any
+    // body of the plane, with a level run-out of kRunOut at both ends.
+    ground_mesh_ = std::make_unique<btTriangleMesh>();
+    const int n = static_cast<int>(ground_heights_.size());
+    const auto x_at = [&](int i) {
+      return ground_start_x_ + i * ground_spacing_;
+    };
+    const auto add = [&](double x0, double h0, double x1, double h1) {
+      const btVector3 a(x0, -kGroundHalfWidth, h0),
+          b(x1, -kGroundHalfWidth, h1);
+      const btVector3 c(x1, kGroundHalfWidth, h1), d(x0, kGroundHalfWidth, h0);
+      ground_mesh_->addTriangle(a, b, c);
+      ground_mesh_->addTriangle(a, c, d);
+    };
+    add(x_at(0) - kRunOut, ground_heights_.front(), x_at(0),
+        ground_heights_.front());
+    for (int i = 0; i + 1 < n; ++i) {
+      add(x_at(i), ground_heights_[i], x_at(i + 1), ground_heights_[i + 1]);
+    }
+    add(x_at(n - 1), ground_heights_.back(), x_at(n - 1) + kRunOut,
+        ground_heights_.back());
+    auto shape =
+        std::make_unique<btBvhTriangleMeshShape>(ground_mesh_.get(), true);
+    shape->setMargin(kBoxMargin);
+    ground_shape_ = std::move(shape);
+  }
   btRigidBody::btRigidBodyConstructionInfo ground_info(0, nullptr,
                                                        ground_shape_.get());
   ground_info.m_friction = 1.0;
@@ -317,6 +366,18 @@ void BulletWorld::Step(absl::Span<const double> torques, int substeps) {
     // maxSubSteps 0: exactly one step of timestep_, no interpolation.
     world_->stepSimulation(timestep_, 0, timestep_);
   }
+}
+
+double BulletWorld::GroundHeight(double x) const {
+  if (ground_heights_.empty()) return x * slope_tangent_;
+  const double at = (x - ground_start_x_) / ground_spacing_;
+  const int last = static_cast<int>(ground_heights_.size()) - 1;
+  if (!(at > 0.0)) return ground_heights_.front();
+  if (at >= last) return ground_heights_.back();
+  const int i = static_cast<int>(at);
+  const double blend = at - i;
+  return ground_heights_[i] +
+         blend * (ground_heights_[i + 1] - ground_heights_[i]);
 }
 
 double BulletWorld::LinkPitch(int link) const {

@@ -82,6 +82,12 @@ struct PlanarModel {
   // The ground plane passes through the origin and rises by tan(slope) per
   // metre of x (radians; 0 is flat).
   double slope = 0.0;
+  // If not empty, the ground is this height profile instead of the plane:
+  // heights (m) at x = ground_start_x + i * ground_spacing, joined by
+  // straight segments and extended level past both ends.
+  std::vector<double> ground_heights;
+  double ground_start_x = 0.0;
+  double ground_spacing = 0.0;
   double gravity = 9.81;
   // Physics timestep (seconds) and sequential-impulse iterations.
   double timestep = 0.002;
@@ -127,7 +133,7 @@ class BulletWorld {
   // Whether link `link` touched the ground in the last physics step.
   bool TouchesGround(int link) const;
   // Height of the ground plane at `x`.
-  double GroundHeight(double x) const { return x * slope_tangent_; }
+  double GroundHeight(double x) const;
   // Positions and velocities are all finite.
   bool IsFinite() const;
   double LinkMass(int link) const;
@@ -144,6 +150,9 @@ class BulletWorld {
 
   int num_dofs_ = 0;
   double slope_tangent_ = 0.0;
+  std::vector<double> ground_heights_;
+  double ground_start_x_ = 0.0;
+  double ground_spacing_ = 0.0;
   double timestep_ = 0.0;
   std::vector<double> damping_;           // per hinge
   std::vector<std::vector<int>> chains_;  // per link: hinges root..link
@@ -157,6 +166,7 @@ class BulletWorld {
   std::unique_ptr<btCollisionDispatcher> dispatcher_;
   std::unique_ptr<btBroadphaseInterface> broadphase_;
   std::unique_ptr<btMultiBodyConstraintSolver> solver_;
+  std::unique_ptr<btTriangleMesh> ground_mesh_;  // a profile's, or null
   std::unique_ptr<btCollisionShape> ground_shape_;
   std::unique_ptr<btRigidBody> ground_;
   std::vector<std::unique_ptr<btCollisionShape>> shapes_;

@@ -117,7 +117,8 @@ absl::Status TerrainBipedConfig::Validate() const {
 double TerrainBipedImitationReward(const TerrainBipedPose& pose,
                                    const TerrainBipedPose& rate,
                                    const TerrainBipedPose& reference,
-                                   const TerrainBipedPose& reference_rate) {
+                                   const TerrainBipedPose& reference_rate,
+                                   absl::FunctionRef<double(double)> ground) {
   const auto& joints = TerrainBipedJointDefs();
   double total_weight = 0.0;
   for (const TerrainBipedJoint& joint : joints) {
@@ -144,10 +145,11 @@ double TerrainBipedImitationReward(const TerrainBipedPose& pose,
     const auto at = JointPosition(pose, joint);
     const auto reference_at = JointPosition(reference, joint);
     end_error += square((at[0] - com.x) - (reference_at[0] - reference_com.x)) +
-                 square(at[1] - reference_at[1]);
+                 square(at[1] - ground(at[0]) - reference_at[1]);
   }
   end_error /= kEndEffectors.size();
-  const double root_error = square(pose.root_y - reference.root_y);
+  const double root_error =
+      square(pose.root_y - ground(pose.root_x) - reference.root_y);
   const double com_error = 0.1 * (square(com.vx - reference_com.vx) +
                                   square(com.vy - reference_com.vy));
   return 0.5 * std::exp(-2.0 * pose_error) +
@@ -214,6 +216,35 @@ TerrainBipedPose TerrainBipedEnv::PoseRate(const BulletWorld& world) const {
   return rate;
 }
 
+void TerrainBipedEnv::ShapeGround(std::mt19937_64& rng, PlanarModel& model) {
+  if (!config_.incline) return;
+  // sim/TerrainGen2D.cpp (OverlaySlopes) with inclines.txt's
+  // SlopeDeltaRange 0.1, SlopeDeltaMin 0.15 and SlopeDeltaMax 0.2: at every
+  // vertex the slope moves by U(0, range), downwards with a probability
+  // that pulls it into [min, max].
+  constexpr double kSpacing = 0.025;  // gVertSpacing
+  constexpr double kRange = 0.1, kMin = 0.15, kMax = 0.2;
+  constexpr double kFrom = -2.0, kTo = 30.0, kPadEnd = 1.0;
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  model.ground_start_x = kFrom;
+  model.ground_spacing = kSpacing;
+  model.ground_heights.clear();
+  double slope = 0.0;
+  double height = 0.0;
+  const int vertices = static_cast<int>(std::lround((kTo - kFrom) / kSpacing));
+  for (int i = 0; i <= vertices; ++i) {
+    if (kFrom + i * kSpacing > kPadEnd) {
+      const double delta = kRange * unit(rng);
+      const double sign_draw = 2.0 * unit(rng) - 1.0;
+      const bool down =
+          sign_draw < (slope - 0.5 * (kMin + kMax)) / (0.5 * (kMax - kMin));
+      slope += down ? -delta : delta;
+      height += slope * kSpacing;
+    }
+    model.ground_heights.push_back(height);
+  }
+}
+
 void TerrainBipedEnv::ResetState(std::mt19937_64& rng, std::vector<double>& q,
                                  std::vector<double>& qd) {
   // The simulator cycles through 20 evenly spaced clip phases, episode by
@@ -265,10 +296,11 @@ StepResult TerrainBipedEnv::Evaluate(const BulletWorld& world,
            (TerrainBipedBodyDefs()[b].fall_contact && world.TouchesGround(b));
   }
   const double time = clip_time();
-  result.reward =
-      fell ? 0.0
-           : TerrainBipedImitationReward(Pose(world), PoseRate(world),
-                                         WalkPose(time), WalkPoseRate(time));
+  result.reward = fell ? 0.0
+                       : TerrainBipedImitationReward(
+                             Pose(world), PoseRate(world), WalkPose(time),
+                             WalkPoseRate(time),
+                             [&](double x) { return world.GroundHeight(x); });
   bool stuck = false;
   if (stuck_steps_ > 0 && steps_ % stuck_steps_ == 0) {
     stuck = std::abs(world.q(0) - root_x_at_check_) < config_.stuck_distance;
@@ -287,7 +319,7 @@ void TerrainBipedEnv::Observe(const BulletWorld& world,
   const auto placed = PlaceBodies(pose);
   const auto moving = MoveBodies(pose, PoseRate(world));
   double* out = observation;
-  *out++ = pose.root_y;  // the ground is y = 0
+  *out++ = pose.root_y - world.GroundHeight(pose.root_x);
   for (const BoxPlacement& body : placed) {
     *out++ = body.x - pose.root_x;
     *out++ = body.y - pose.root_y;
@@ -305,12 +337,23 @@ void TerrainBipedEnv::Observe(const BulletWorld& world,
 
 std::string TerrainBipedEnv::TaskSignature() const {
   return absl::StrCat(config_.name, ";", config_.max_episode_steps, ";",
-                      config_.stuck_distance, ";", config_.stuck_seconds);
+                      config_.stuck_distance, ";", config_.stuck_seconds, ";",
+                      config_.incline);
 }
 
 absl::StatusOr<std::unique_ptr<Environment>> MakeTerrainBipedFlat() {
   absl::StatusOr<std::unique_ptr<TerrainBipedEnv>> env =
       TerrainBipedEnv::Create(TerrainBipedConfig());
+  if (!env.ok()) return env.status();
+  return std::unique_ptr<Environment>(std::move(*env));
+}
+
+absl::StatusOr<std::unique_ptr<Environment>> MakeTerrainBipedIncline() {
+  TerrainBipedConfig config;
+  config.name = "TerrainBipedIncline";
+  config.incline = true;
+  absl::StatusOr<std::unique_ptr<TerrainBipedEnv>> env =
+      TerrainBipedEnv::Create(config);
   if (!env.ok()) return env.status();
   return std::unique_ptr<Environment>(std::move(*env));
 }

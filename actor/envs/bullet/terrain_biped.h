@@ -2,7 +2,8 @@
 #define VANTAGE_ACTOR_ENVS_BULLET_TERRAIN_BIPED_H_
 
 // The Terrain RL simulator's planar biped walking task
-// (UBCMOCCA/TerrainRLSim, PD_Biped2D_Flat-v0), rebuilt on Bullet as far as
+// (UBCMOCCA/TerrainRLSim, PD_Biped2D_Flat-v0 and PD_Biped2D_Incline-v0),
+// rebuilt on Bullet as far as
 // its facts allow (docs/environments.md compares each item with its source
 // file): the 12-box biped2D_full character, 11 PD targets per step at
 // 30 Hz, a pose-only observation and the walking clip's imitation reward.
@@ -12,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "absl/functional/function_ref.h"
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
 #include "actor/envs/bullet/bullet_env.h"
@@ -28,6 +30,10 @@ struct TerrainBipedConfig {
   // tasks leave off; the paper ends episodes that are stuck). 0: off.
   double stuck_distance = 0.5;
   double stuck_seconds = 5.0;
+  // The simulator's inclines (data/terrain/inclines.txt): level up to
+  // x = 1 m, then a slope that wanders about a grade of 0.175 (a new one
+  // every episode); false: flat ground.
+  bool incline = false;
 
   absl::Status Validate() const;
 };
@@ -62,6 +68,7 @@ class TerrainBipedEnv : public BulletEnv {
  private:
   TerrainBipedEnv(const TerrainBipedConfig& config, PlanarModel model);
 
+  void ShapeGround(std::mt19937_64& rng, PlanarModel& model) override;
   void ResetState(std::mt19937_64& rng, std::vector<double>& q,
                   std::vector<double>& qd) override;
   void BeginEpisode(const BulletWorld& world) override;
@@ -88,12 +95,15 @@ class TerrainBipedEnv : public BulletEnv {
 // for a simulated pose against the clip's at the same time: 0.5 pose +
 // 0.05 velocity + 0.15 end effectors + 0.1 root height + 0.2 centre-of-mass
 // velocity, each exp(-k x error). Exposed for its test.
-double TerrainBipedImitationReward(const TerrainBipedPose& pose,
-                                   const TerrainBipedPose& rate,
-                                   const TerrainBipedPose& reference,
-                                   const TerrainBipedPose& reference_rate);
+// Heights of the simulated pose count from `ground` (the height at an x);
+// the clip's from 0.
+double TerrainBipedImitationReward(
+    const TerrainBipedPose& pose, const TerrainBipedPose& rate,
+    const TerrainBipedPose& reference, const TerrainBipedPose& reference_rate,
+    absl::FunctionRef<double(double)> ground = [](double) { return 0.0; });
 
 absl::StatusOr<std::unique_ptr<Environment>> MakeTerrainBipedFlat();
+absl::StatusOr<std::unique_ptr<Environment>> MakeTerrainBipedIncline();
 
 }  // namespace vantage
 

@@ -68,7 +68,9 @@ TEST(EnvRegistryTest, SpecsMatchTheGymnasiumTasks) {
       {"Ex2SparseHalfCheetah", {20, 6}},
       {"BulletHopper", {11, 3}},
       {"BipedWalkFlat", {29, 11}},
-      {"BipedWalkIncline", {29, 11}}};
+      {"BipedWalkIncline", {29, 11}},
+      {"TerrainBipedFlat", {54, 11}},
+      {"TerrainBipedIncline", {54, 11}}};
   for (const auto& [name, sizes] : expected) {
     const auto env = Make(name);
     ASSERT_NE(env, nullptr);
@@ -78,7 +80,8 @@ TEST(EnvRegistryTest, SpecsMatchTheGymnasiumTasks) {
         {"PointMaze", 500},
         {"TwoDMaze", 200},
         {"Ex2SparseHalfCheetah", 500},
-        {"TerrainBipedFlat", 256}};
+        {"TerrainBipedFlat", 256},
+        {"TerrainBipedIncline", 256}};
     EXPECT_EQ(env->spec().max_episode_steps,
               short_episodes.count(name) > 0 ? short_episodes.at(name) : 1000)
         << name;

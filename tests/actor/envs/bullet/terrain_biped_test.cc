@@ -1,5 +1,6 @@
 #include "actor/envs/bullet/terrain_biped.h"
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <vector>
@@ -138,6 +139,41 @@ TEST(TerrainBipedTest, PlayingTheClipWalksUntilItFalls) {
     EXPECT_LT(random.reward / random.steps, 0.4) << seed;
     EXPECT_EQ(random.ending, TerrainBipedEnding::kFell) << seed;
   }
+}
+
+// The simulator's incline: level to x = 1 m, then a slope wandering about
+// a grade of 0.175, new every episode and the same for the same seed.
+TEST(TerrainBipedTest, TheInclineRisesAtAboutAGradeOf0point175) {
+  TerrainBipedConfig config;
+  config.name = "TerrainBipedIncline";
+  config.incline = true;
+  auto env = Make(config);
+  std::vector<double> observation(TerrainBipedEnv::kObservationSize);
+  std::vector<double> at_ten;
+  for (uint64_t seed : {1, 2, 1}) {
+    ASSERT_TRUE(env->Reset(seed, absl::MakeSpan(observation)).ok());
+    const BulletWorld& world = *env->world();
+    EXPECT_EQ(world.GroundHeight(-1.0), 0.0);
+    EXPECT_EQ(world.GroundHeight(0.9), 0.0);
+    const double grade =
+        (world.GroundHeight(20.5) - world.GroundHeight(1.5)) / 19.0;
+    EXPECT_GT(grade, 0.15) << seed;
+    EXPECT_LT(grade, 0.2) << seed;
+    at_ten.push_back(world.GroundHeight(10.0));
+    // The observation's first value is the height above the ground.
+    EXPECT_NEAR(observation[0], world.q(1) - world.GroundHeight(world.q(0)),
+                1e-12);
+  }
+  EXPECT_NE(at_ten[0], at_ten[1]);
+  EXPECT_EQ(at_ten[0], at_ten[2]);
+  // Playing the clip, the character walks onto the slope before it falls.
+  double furthest = 0.0;
+  for (uint64_t seed = 0; seed < 5; ++seed) {
+    const Episode episode = RunEpisode(*env, seed, ClipTargets);
+    EXPECT_GT(episode.steps, 5) << seed;
+    furthest = std::max(furthest, episode.distance);
+  }
+  EXPECT_GT(furthest, 1.0);
 }
 
 TEST(TerrainBipedTest, AStuckCharacterEndsTheEpisode) {
