@@ -13,12 +13,22 @@ namespace vantage {
 ReplayPool::ReplayPool(int64_t capacity, int64_t width)
     : capacity_(capacity),
       width_(width),
-      rows_(at::zeros({capacity, width}, at::kFloat)) {}
+      rows_(at::zeros({0, width}, at::kFloat)) {}
+
+void ReplayPool::Reserve(int64_t rows) {
+  if (rows <= rows_.size(0)) return;
+  // Grown as it fills (doubling), so that a large capacity costs memory
+  // only once the states are there.
+  const int64_t grown = std::min(capacity_, std::max(rows, 2 * rows_.size(0)));
+  rows_ =
+      at::cat({rows_, at::zeros({grown - rows_.size(0), width_}, at::kFloat)});
+}
 
 void ReplayPool::Add(const at::Tensor& rows) {
   const int64_t m = rows.size(0);
   total_added_ += m;
   const at::Tensor kept = m > capacity_ ? rows.slice(0, m - capacity_) : rows;
+  Reserve(std::min(capacity_, size_ + kept.size(0)));
   int64_t done = 0;
   while (done < kept.size(0)) {
     const int64_t n = std::min(kept.size(0) - done, capacity_ - next_);
@@ -77,8 +87,7 @@ absl::Status ReplayPool::Load(torch::serialize::InputArchive& archive) {
     return absl::InvalidArgumentError(
         "replay pool entry 'rows' holds non-finite values");
   }
-  rows_.zero_();
-  rows_.slice(0, 0, size).copy_(rows);
+  rows_ = rows.clone();
   next_ = next;
   size_ = size;
   total_added_ = total;

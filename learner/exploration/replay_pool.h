@@ -38,9 +38,14 @@ class ReplayPool {
   absl::Status Load(torch::serialize::InputArchive& archive);
 
  private:
+  // Room for at least `rows` rows (at most capacity_).
+  void Reserve(int64_t rows);
+
   int64_t capacity_;
   int64_t width_;
-  at::Tensor rows_;   // [capacity, width], the first size_ rows filled
+  // [allocated, width]: grown as states arrive, up to capacity_ rows; the
+  // first size_ rows are filled.
+  at::Tensor rows_;
   int64_t next_ = 0;  // where the next row goes
   int64_t size_ = 0;
   int64_t total_added_ = 0;

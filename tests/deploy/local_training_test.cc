@@ -10,6 +10,8 @@
 
 #include "absl/strings/str_join.h"
 #include "absl/strings/str_split.h"
+#include "deploy/progress_columns.h"
+#include "deploy/run_directory.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
 #include "learner/checkpoint.h"
@@ -98,6 +100,39 @@ TEST(LocalTrainingTest, SameSeedSameProgressCsv) {
   // One row per update, steps counted exactly.
   EXPECT_THAT(first[1], ::testing::StartsWith("256,1,1,"));
   EXPECT_THAT(first[kUpdates], ::testing::StartsWith("1536,6,6,"));
+}
+
+// A progress.csv written by a vantage with fewer columns is carried over
+// column by column when a resumed run cuts it back: rows keep their values
+// under the same names and the new columns stay empty.
+TEST(LocalTrainingTest, ResumingMigratesAnOlderProgressFile) {
+  const std::string dir = FreshDirectory("old_columns");
+  absl::StatusOr<RunDirectory> run = RunDirectory::Create(dir, "{}");
+  ASSERT_TRUE(run.ok()) << run.status();
+  {
+    std::ofstream old(dir + "/progress.csv");
+    old << "env_steps,updates,mean_return,sps\n"
+        << "256,1,12.5,900\n"
+        << "512,2,13.5,950\n";
+  }
+  ASSERT_TRUE(run->TruncateProgress(1).ok());
+  std::ifstream file(dir + "/progress.csv");
+  std::string header, row, rest;
+  std::getline(file, header);
+  std::getline(file, row);
+  EXPECT_EQ(header, ProgressHeader());
+  EXPECT_FALSE(std::getline(file, rest));  // update 2 is cut
+  const std::vector<std::string> names = absl::StrSplit(header, ',');
+  const std::vector<std::string> values = absl::StrSplit(row, ',');
+  ASSERT_EQ(values.size(), names.size());
+  for (size_t i = 0; i < names.size(); ++i) {
+    const std::string expected = names[i] == "env_steps"     ? "256"
+                                 : names[i] == "updates"     ? "1"
+                                 : names[i] == "mean_return" ? "12.5"
+                                 : names[i] == "sps"         ? "900"
+                                                             : "";
+    EXPECT_EQ(values[i], expected) << names[i];
+  }
 }
 
 TEST(LocalTrainingTest, RefusesADirectoryThatHoldsARun) {
