@@ -438,11 +438,7 @@ void LearnerCore::Save(torch::serialize::OutputArchive& archive) const {
   reward_scaler_.Save(scaler);
   archive.write("updater", updater);
   archive.write("reward_scaler", scaler);
-  if (exploration_ != nullptr) {
-    torch::serialize::OutputArchive ex2;
-    exploration_->Save(ex2);
-    archive.write("ex2", ex2);
-  }
+  if (exploration_ != nullptr) exploration_->Save(archive, "ex2");
   WriteRunningMeanStd(archive, "normalizer", normalizer_);
   std::ostringstream rng;
   rng << rng_;
@@ -508,16 +504,12 @@ absl::StatusOr<std::unique_ptr<LearnerCore>> LearnerCore::Load(
     if (!status.ok()) return status;
   }
   if (core.exploration_ != nullptr) {
-    torch::serialize::InputArchive ex2;
-    if (absl::Status status = CatchTorchErrors(
-            "checkpoint entry 'ex2' is missing (a run without EX2 cannot "
-            "continue with it)",
-            [&] { archive.read("ex2", ex2); });
+    if (absl::Status status = core.exploration_->Load(archive, "ex2");
         !status.ok()) {
-      return status;
-    }
-    if (absl::Status status = core.exploration_->Load(ex2); !status.ok()) {
-      return status;
+      return absl::InvalidArgumentError(
+          absl::StrCat(status.message(),
+                       " (the run's EX2 state; a checkpoint of a run "
+                       "without EX2 cannot continue with it)"));
     }
   }
   absl::StatusOr<std::string> rng = ReadBytes(archive, "rng");

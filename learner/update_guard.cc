@@ -53,7 +53,7 @@ UpdateGuard::UpdateGuard(PolicyNetworkImpl& policy, ValueNetworkImpl& value,
   }
   if (exploration_ != nullptr) {
     exploration_state_ = SaveToBytes([&](torch::serialize::OutputArchive& a) {
-      exploration_->SaveModelState(a);
+      exploration_->SaveModelState(a, "ex2");
     });
   }
 }
@@ -116,7 +116,7 @@ void UpdateGuard::Restore() {
     std::istringstream exploration_bytes(exploration_state_);
     exploration.load_from(exploration_bytes);
     const absl::Status exploration_loaded =
-        exploration_->LoadModelState(exploration);
+        exploration_->LoadModelState(exploration, "ex2");
     TORCH_CHECK(exploration_loaded.ok(),
                 "rollback: ", exploration_loaded.ToString());
   }

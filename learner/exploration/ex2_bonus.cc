@@ -118,60 +118,70 @@ void Ex2Bonus::Commit() {
   pending_ = at::Tensor();
 }
 
-void Ex2Bonus::SaveModelState(torch::serialize::OutputArchive& archive) const {
-  WriteModule(archive, "model", *model_);
-  SaveOptimizer(*optimizer_, "optimizer", archive);
-  archive.write("generator", generator_.get_state());
-  archive.write("fitted", at::tensor({static_cast<int64_t>(fitted_)}));
+void Ex2Bonus::SaveModelState(torch::serialize::OutputArchive& archive,
+                              const std::string& prefix) const {
+  WriteModule(archive, prefix + ".model", *model_);
+  SaveOptimizer(*optimizer_, prefix + ".optimizer", archive);
+  archive.write(prefix + ".generator", generator_.get_state());
+  archive.write(prefix + ".fitted",
+                at::tensor({static_cast<int64_t>(fitted_)}));
 }
 
-absl::Status Ex2Bonus::LoadModelState(torch::serialize::InputArchive& archive) {
+absl::Status Ex2Bonus::LoadModelState(torch::serialize::InputArchive& archive,
+                                      const std::string& prefix) {
   at::Tensor generator_state, fitted;
-  for (absl::Status status : {ReadTensor(archive, "generator", generator_state),
-                              ReadTensor(archive, "fitted", fitted)}) {
+  for (absl::Status status :
+       {ReadTensor(archive, prefix + ".generator", generator_state),
+        ReadTensor(archive, prefix + ".fitted", fitted)}) {
     if (!status.ok()) return status;
   }
   if (generator_state.scalar_type() != at::kByte ||
       generator_state.sizes() != generator_.get_state().sizes() ||
       fitted.scalar_type() != at::kLong || fitted.numel() != 1) {
     return absl::InvalidArgumentError(
-        "ex2 entries 'generator' or 'fitted' are malformed");
+        absl::StrCat("checkpoint entries '", prefix, ".generator' or '", prefix,
+                     ".fitted' are malformed"));
+  }
+  // A generator state of the right size can still be invalid (LibTorch
+  // checks its fields): tried on a scratch generator first.
+  at::Generator restored = at::make_generator<at::CPUGeneratorImpl>(0);
+  if (absl::Status status =
+          CatchTorchErrors(absl::StrCat("checkpoint entry '", prefix,
+                                        ".generator' is not a generator state"),
+                           [&] { restored.set_state(generator_state); });
+      !status.ok()) {
+    return status;
   }
   // Checked before anything changes: the module's entries, then the
   // optimiser's (which LoadOptimizer checks against the model).
-  if (absl::Status status = ReadModule(archive, "model", *model_);
+  if (absl::Status status = ReadModule(archive, prefix + ".model", *model_);
       !status.ok()) {
     return status;
   }
-  if (absl::Status status = LoadOptimizer(*optimizer_, "optimizer", archive);
+  if (absl::Status status =
+          LoadOptimizer(*optimizer_, prefix + ".optimizer", archive);
       !status.ok()) {
     return status;
   }
-  generator_.set_state(generator_state);
+  generator_ = restored;
   fitted_ = fitted.item<int64_t>() != 0;
   pending_ = at::Tensor();
   return absl::OkStatus();
 }
 
-void Ex2Bonus::Save(torch::serialize::OutputArchive& archive) const {
-  SaveModelState(archive);
-  torch::serialize::OutputArchive pool;
-  pool_.Save(pool);
-  archive.write("replay_pool", pool);
+void Ex2Bonus::Save(torch::serialize::OutputArchive& archive,
+                    const std::string& prefix) const {
+  SaveModelState(archive, prefix);
+  pool_.Save(archive, prefix + ".pool");
 }
 
-absl::Status Ex2Bonus::Load(torch::serialize::InputArchive& archive) {
-  torch::serialize::InputArchive pool;
-  if (absl::Status status =
-          CatchTorchErrors("ex2 entry 'replay_pool' is missing",
-                           [&] { archive.read("replay_pool", pool); });
+absl::Status Ex2Bonus::Load(torch::serialize::InputArchive& archive,
+                            const std::string& prefix) {
+  if (absl::Status status = pool_.Load(archive, prefix + ".pool");
       !status.ok()) {
     return status;
   }
-  if (absl::Status status = pool_.Load(pool); !status.ok()) {
-    return absl::InvalidArgumentError(absl::StrCat("ex2: ", status.message()));
-  }
-  return LoadModelState(archive);
+  return LoadModelState(archive, prefix);
 }
 
 }  // namespace vantage

@@ -15,6 +15,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "absl/status/status.h"
@@ -58,12 +59,19 @@ class Ex2Bonus {
 
   // What ShapeRewards changes but the pool: the model, its optimiser, the
   // generator and whether it has fitted before (for rolling back).
-  void SaveModelState(torch::serialize::OutputArchive& archive) const;
-  absl::Status LoadModelState(torch::serialize::InputArchive& archive);
+  // Entries named `prefix`.model.*, .optimizer, .generator and .fitted.
+  void SaveModelState(torch::serialize::OutputArchive& archive,
+                      const std::string& prefix) const;
+  absl::Status LoadModelState(torch::serialize::InputArchive& archive,
+                              const std::string& prefix);
   // All of it, pool included (checkpoints). On error the object is half
   // loaded: the learner being loaded is discarded.
-  void Save(torch::serialize::OutputArchive& archive) const;
-  absl::Status Load(torch::serialize::InputArchive& archive);
+  // With the pool as `prefix`.pool.*: flat entries beside the learner's
+  // own, so that checkpoint checks and fuzzing reach every one.
+  void Save(torch::serialize::OutputArchive& archive,
+            const std::string& prefix) const;
+  absl::Status Load(torch::serialize::InputArchive& archive,
+                    const std::string& prefix);
 
   // The model's inputs for the rollouts' steps: [sum T, width], states
   // with the actions (one-hot if discrete) when use_actions.

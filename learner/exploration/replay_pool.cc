@@ -45,17 +45,20 @@ at::Tensor ReplayPool::Sample(int64_t n, const at::Generator& generator) const {
   return rows_.index_select(0, index);
 }
 
-void ReplayPool::Save(torch::serialize::OutputArchive& archive) const {
-  archive.write("rows", rows_.slice(0, 0, size_));
+void ReplayPool::Save(torch::serialize::OutputArchive& archive,
+                      const std::string& prefix) const {
+  archive.write(prefix + ".rows", rows_.slice(0, 0, size_));
   archive.write(
-      "counts",
+      prefix + ".counts",
       at::tensor({capacity_, width_, next_, size_, total_added_}, at::kLong));
 }
 
-absl::Status ReplayPool::Load(torch::serialize::InputArchive& archive) {
+absl::Status ReplayPool::Load(torch::serialize::InputArchive& archive,
+                              const std::string& prefix) {
   at::Tensor rows, counts;
-  for (absl::Status status : {ReadTensor(archive, "rows", rows),
-                              ReadTensor(archive, "counts", counts)}) {
+  for (absl::Status status :
+       {ReadTensor(archive, prefix + ".rows", rows),
+        ReadTensor(archive, prefix + ".counts", counts)}) {
     if (!status.ok()) return status;
   }
   if (counts.scalar_type() != at::kLong || counts.dim() != 1 ||
@@ -73,8 +76,10 @@ absl::Status ReplayPool::Load(torch::serialize::InputArchive& archive) {
         absl::StrCat("replay pool holds ", capacity, " rows of ", width,
                      " values; this run's holds ", capacity_, " of ", width_));
   }
+  // A count near the int64 limit would overflow as states are added.
   if (size < 0 || size > capacity || next < 0 || next >= capacity ||
-      (size < capacity && next != size) || total < size) {
+      (size < capacity && next != size) || total < size ||
+      total > (int64_t{1} << 62)) {
     return absl::InvalidArgumentError(
         "replay pool entry 'counts' is inconsistent");
   }

@@ -5,6 +5,7 @@
 #include <ATen/core/Tensor.h>
 
 #include <cstdint>
+#include <string>
 
 #include "absl/status/status.h"
 
@@ -32,10 +33,13 @@ class ReplayPool {
   // Rows ever added (what EX2's minimum size counts).
   int64_t total_added() const { return total_added_; }
 
-  void Save(torch::serialize::OutputArchive& archive) const;
+  // As the entries `prefix`.rows and `prefix`.counts.
+  void Save(torch::serialize::OutputArchive& archive,
+            const std::string& prefix) const;
   // A pool of another width or capacity, or malformed or non-finite rows,
   // is an InvalidArgument error naming the entry; the pool is unchanged.
-  absl::Status Load(torch::serialize::InputArchive& archive);
+  absl::Status Load(torch::serialize::InputArchive& archive,
+                    const std::string& prefix);
 
  private:
   // Room for at least `rows` rows (at most capacity_).

@@ -1,9 +1,10 @@
 // What a checkpoint's pickles decide, without LibTorch's unpickler in the
-// way (see checkpoint_fuzzer.cc): a real learner's checkpoint (FuzzLearner
-// Config, PPO, after one update) with some of its top-level tensor entries
-// replaced by tensors the input describes, written by LibTorch's own
-// archive writer and read back by ReadFuzzCheckpoint; a learner that loads
-// must pass CheckLoadedLearner.
+// way (see checkpoint_fuzzer.cc): a real learner's checkpoint (PPO with an
+// EX2 bonus, FuzzEx2LearnerConfig, after two updates, so that the EX2
+// model has fitted and its pool holds states) with some of its top-level
+// tensor entries (EX2's among them) replaced by tensors the input
+// describes, written by LibTorch's own archive writer and read back by
+// ReadFuzzEx2Checkpoint; a learner that loads must pass CheckLoadedLearner.
 //
 // The input is a list of edits, each
 //   key (1 byte: an index into the entries, modulo their count),
@@ -68,11 +69,12 @@ struct Reference {
 const Reference& GetReference() {
   static const Reference* reference = [] {
     auto* made = new Reference;
-    const LearnerConfig config = FuzzLearnerConfig("ppo");
+    const LearnerConfig config = FuzzEx2LearnerConfig();
     absl::StatusOr<std::unique_ptr<LearnerCore>> learner =
         LearnerCore::Create(config);
     if (!learner.ok()) FuzzFail("no reference learner", learner.status());
     made->learner = *std::move(learner);
+    CheckLoadedLearner(*made->learner);
     CheckLoadedLearner(*made->learner);
     torch::serialize::OutputArchive written;
     made->learner->Save(written);
@@ -145,7 +147,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     if (!file) return 0;
   }
   absl::StatusOr<std::unique_ptr<LearnerCore>> learner =
-      ReadFuzzCheckpoint(path);
+      ReadFuzzEx2Checkpoint(path);
   if (learner.ok()) CheckLoadedLearner(**learner);
   std::remove(path.c_str());
   return 0;

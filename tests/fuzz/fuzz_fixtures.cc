@@ -54,6 +54,20 @@ LearnerConfig FuzzLearnerConfig(const std::string& algorithm) {
   return config;
 }
 
+LearnerConfig FuzzEx2LearnerConfig() {
+  LearnerConfig config = FuzzLearnerConfig("ppo");
+  Ex2Config ex2;
+  ex2.hidden = {4};
+  ex2.feature_dim = 2;
+  ex2.replay_min = 1;
+  ex2.replay_size = 64;
+  ex2.first_train_iterations = 3;
+  ex2.train_iterations = 2;
+  ex2.batch_size = 8;
+  config.exploration.ex2 = ex2;
+  return config;
+}
+
 Segment FuzzSegment(const EnvSpec& spec, int64_t steps, int64_t env_slot,
                     int64_t policy_version, uint64_t seed) {
   at::Generator generator = at::detail::createCPUGenerator(seed);
@@ -93,6 +107,12 @@ absl::StatusOr<std::unique_ptr<LearnerCore>> ReadFuzzCheckpoint(
     }
   }
   return learner;
+}
+
+absl::StatusOr<std::unique_ptr<LearnerCore>> ReadFuzzEx2Checkpoint(
+    const std::string& path) {
+  (void)ReadCheckpointExtras(path);
+  return ReadCheckpoint(path, FuzzEx2LearnerConfig());
 }
 
 void CheckLoadedLearner(LearnerCore& learner) {

@@ -30,6 +30,10 @@ EnvSpec FuzzDiscreteSpec();
 // batch, reward scaling on.
 LearnerConfig FuzzLearnerConfig(const std::string& algorithm);
 
+// FuzzLearnerConfig("ppo") with an EX2 bonus small enough to fit from the
+// second update on, whose pool wraps around within a few.
+LearnerConfig FuzzEx2LearnerConfig();
+
 // A segment ValidateSegment accepts for `spec` (`steps` >= 3): an episode
 // that terminates after step 0, one that a time limit truncates after step
 // 2, and one still running; the values are drawn from `seed`.
@@ -39,6 +43,9 @@ Segment FuzzSegment(const EnvSpec& spec, int64_t steps, int64_t env_slot,
 // ReadCheckpointExtras, then ReadCheckpoint with FuzzLearnerConfig("ppo"),
 // or "a2c" or "trpo" when the checkpoint says it was trained with those.
 absl::StatusOr<std::unique_ptr<LearnerCore>> ReadFuzzCheckpoint(
+    const std::string& path);
+// ReadCheckpointExtras, then ReadCheckpoint with FuzzEx2LearnerConfig().
+absl::StatusOr<std::unique_ptr<LearnerCore>> ReadFuzzEx2Checkpoint(
     const std::string& path);
 
 // What a learner read from a checkpoint must allow: its weights are finite

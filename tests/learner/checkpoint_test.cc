@@ -138,6 +138,15 @@ TEST_F(CheckpointErrorTest, OtherNetworkSizesAreRefused) {
   EXPECT_THAT(std::string(status.message()), HasSubstr("networks"));
 }
 
+TEST_F(CheckpointErrorTest, AnEx2RunDoesNotContinueARunWithoutIt) {
+  LearnerConfig other = config_;
+  other.exploration.ex2 = Ex2Config();
+  const absl::Status status = ReadCheckpoint(path_, other).status();
+  EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(std::string(status.message()), HasSubstr("'ex2.pool.rows'"));
+  EXPECT_THAT(std::string(status.message()), HasSubstr("without EX2"));
+}
+
 TEST_F(CheckpointErrorTest, AnotherAlgorithmIsRefused) {
   LearnerConfig other = config_;
   other.algorithm.name = "trpo";

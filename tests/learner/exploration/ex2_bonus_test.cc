@@ -91,14 +91,14 @@ TEST(ReplayPoolTest, SavedPoolLoadsBackAndBadOnesAreRefused) {
   ReplayPool pool(4, 2);
   pool.Add(at::arange(12, at::kFloat).reshape({6, 2}));
   torch::serialize::OutputArchive out;
-  pool.Save(out);
+  pool.Save(out, "pool");
   std::ostringstream bytes;
   out.save_to(bytes);
   const auto load = [&](ReplayPool& into) {
     torch::serialize::InputArchive in;
     std::istringstream stream(bytes.str());
     in.load_from(stream);
-    return into.Load(in);
+    return into.Load(in, "pool");
   };
   ReplayPool copy(4, 2);
   ASSERT_TRUE(load(copy).ok());
@@ -115,13 +115,14 @@ TEST(ReplayPoolTest, SavedPoolLoadsBackAndBadOnesAreRefused) {
   ReplayPool poisoned(4, 2);
   poisoned.Add(at::full({2, 2}, std::nanf("")));
   torch::serialize::OutputArchive bad;
-  poisoned.Save(bad);
+  poisoned.Save(bad, "pool");
   std::ostringstream bad_bytes;
   bad.save_to(bad_bytes);
   torch::serialize::InputArchive in;
   std::istringstream stream(bad_bytes.str());
   in.load_from(stream);
-  EXPECT_THAT(std::string(copy.Load(in).message()), HasSubstr("non-finite"));
+  EXPECT_THAT(std::string(copy.Load(in, "pool").message()),
+              HasSubstr("non-finite"));
 }
 
 // With every weight 0 the latents are N(0, I) draws and D = 1/2 whatever
@@ -285,7 +286,7 @@ TEST(Ex2BonusTest, SameSeedSameBonusesAndASavedModelContinuesExactly) {
     EXPECT_TRUE(inputs[i][0].rewards.equal(expected[i])) << i;
   }
   torch::serialize::OutputArchive out;
-  first.Save(out);
+  first.Save(out, "ex2");
   std::ostringstream bytes;
   out.save_to(bytes);
   at::manual_seed(99);  // other initial weights, all overwritten
@@ -293,7 +294,7 @@ TEST(Ex2BonusTest, SameSeedSameBonusesAndASavedModelContinuesExactly) {
   torch::serialize::InputArchive in;
   std::istringstream stream(bytes.str());
   in.load_from(stream);
-  ASSERT_TRUE(resumed.Load(in).ok());
+  ASSERT_TRUE(resumed.Load(in, "ex2").ok());
   for (int i = 3; i < 5; ++i) {
     resumed.ShapeRewards(inputs[i]);
     resumed.Commit();
@@ -305,7 +306,7 @@ TEST(Ex2BonusTest, SameSeedSameBonusesAndASavedModelContinuesExactly) {
   torch::serialize::InputArchive again;
   std::istringstream stream2(bytes.str());
   again.load_from(stream2);
-  const absl::Status status = other.Load(again);
+  const absl::Status status = other.Load(again, "ex2");
   EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument);
   EXPECT_THAT(std::string(status.message()), HasSubstr("replay pool"));
 }
