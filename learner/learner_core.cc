@@ -343,7 +343,9 @@ absl::StatusOr<UpdateStats> LearnerCore::Update(std::vector<Rollout> rollouts) {
     // The same decision on every replica: the statistics are global and
     // the parameters identical.
     stats.rollback_reason =
-        guard.Fault(stats.algorithm, config_.rollback_gradient_norm);
+        exploration.fault.empty()
+            ? guard.Fault(stats.algorithm, config_.rollback_gradient_norm)
+            : exploration.fault;
     const double global_samples = sums[0];
     if (!stats.rollback_reason.empty()) {
       guard.Restore();

@@ -5,6 +5,7 @@
 #include <torch/optim/adam.h>
 #include <torch/serialize/archive.h>
 
+#include <cmath>
 #include <utility>
 
 #include "absl/strings/str_cat.h"
@@ -100,6 +101,14 @@ ExplorationStats Ex2Bonus::ShapeRewards(std::vector<Rollout>& rollouts) {
     bonus = NoveltyBonus(*model_, inputs);
   }
   stats.mean_bonus = bonus.to(at::kDouble).mean().item<double>();
+  if (!std::isfinite(stats.mean_bonus)) {
+    // The rewards stay as they are and the learner undoes the update.
+    stats.fault = absl::StrCat(
+        "non-finite exploration bonus (the EX2 model's mean loss this "
+        "update: ",
+        stats.model_loss, ")");
+    return stats;
+  }
   const at::Tensor shaped =
       (config_.bonus_coeff * (bonus.to(at::kDouble) - Median(bonus)))
           .to(at::kFloat);

@@ -3,6 +3,7 @@
 
 #include <cstdint>
 #include <limits>
+#include <string>
 
 namespace vantage {
 
@@ -17,6 +18,9 @@ struct ExplorationStats {
   // model is in use).
   double mean_bonus = std::numeric_limits<double>::quiet_NaN();
   int64_t fit_steps = 0;
+  // Why this update must be undone (a non-finite bonus: the model
+  // diverged); empty if nothing is wrong.
+  std::string fault;
 };
 
 }  // namespace vantage

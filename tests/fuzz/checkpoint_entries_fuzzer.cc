@@ -74,8 +74,20 @@ const Reference& GetReference() {
         LearnerCore::Create(config);
     if (!learner.ok()) FuzzFail("no reference learner", learner.status());
     made->learner = *std::move(learner);
-    CheckLoadedLearner(*made->learner);
-    CheckLoadedLearner(*made->learner);
+    // Two updates, the second continuing the first's streams.
+    for (int64_t round = 0; round < 2; ++round) {
+      SegmentQueue queue(config.rollouts_per_batch);
+      for (int64_t slot = 0; slot < config.rollouts_per_batch; ++slot) {
+        Segment segment =
+            FuzzSegment(config.spec, config.horizon, slot,
+                        made->learner->policy_version(), 10 * round + slot);
+        segment.sequence = round;
+        (void)queue.Send(std::move(segment));
+      }
+      queue.Close();
+      absl::StatusOr<UpdateStats> stats = made->learner->RunUpdate(queue);
+      if (!stats.ok()) FuzzFail("the reference cannot update", stats.status());
+    }
     torch::serialize::OutputArchive written;
     made->learner->Save(written);
     std::ostringstream bytes;

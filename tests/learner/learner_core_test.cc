@@ -1,9 +1,11 @@
 #include "learner/learner_core.h"
 
 #include <ATen/ATen.h>
+#include <torch/serialize/archive.h>
 
 #include <cmath>
 #include <limits>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -151,6 +153,53 @@ TEST(RollbackTest, AnEx2FitOnAPoisonedBatchIsUndoneToo) {
   EXPECT_FALSE(next.rolled_back) << next.rollback_reason;
   EXPECT_EQ(learner->exploration()->pool().total_added(),
             pooled + kTestEnvs * kTestHorizon);
+}
+
+// An EX2 model whose weights make its bonus non-finite (a checkpoint with a
+// huge but finite weight, found by the entries fuzzer) undoes the update
+// instead of failing it, even with reward scaling, which would refuse the
+// non-finite rewards.
+TEST(RollbackTest, AnEx2ModelThatDivergesIsUndone) {
+  auto actor = MakeTestActor();
+  LearnerConfig config = UngatedConfig(actor->spec(), "trpo");
+  config.scale_rewards = true;
+  Ex2Config ex2;
+  ex2.replay_min = 1;
+  ex2.first_train_iterations = 5;
+  ex2.train_iterations = 5;
+  config.exploration.ex2 = ex2;
+  auto learner = *LearnerCore::Create(config);
+  for (int i = 0; i < 2; ++i) {
+    UpdateWith(*learner, ActOneBatch(*actor, *learner));
+  }
+  torch::serialize::OutputArchive out;
+  learner->Save(out);
+  at::Tensor weight;
+  {
+    std::ostringstream bytes;
+    out.save_to(bytes);
+    torch::serialize::InputArchive in;
+    std::istringstream stream(bytes.str());
+    in.load_from(stream);
+    in.read("ex2.model.exemplar_encoder.mean.layers.1.weight", weight);
+  }
+  weight = weight.clone();
+  weight.view(-1)[0] = 2e29f;
+  out.write("ex2.model.exemplar_encoder.mean.layers.1.weight", weight);
+  std::ostringstream bytes;
+  out.save_to(bytes);
+  torch::serialize::InputArchive in;
+  std::istringstream stream(bytes.str());
+  in.load_from(stream);
+  absl::StatusOr<std::unique_ptr<LearnerCore>> loaded =
+      LearnerCore::Load(config, in);
+  ASSERT_TRUE(loaded.ok()) << loaded.status();
+  const int64_t pooled = (*loaded)->exploration()->pool().total_added();
+  const UpdateStats stats = UpdateWith(**loaded, ActOneBatch(*actor, **loaded));
+  EXPECT_TRUE(stats.rolled_back);
+  EXPECT_THAT(stats.rollback_reason, HasSubstr("non-finite exploration bonus"));
+  EXPECT_EQ((*loaded)->exploration()->pool().total_added(), pooled);
+  EXPECT_TRUE(AllFinite((*loaded)->CurrentWeights()));
 }
 
 TEST(RollbackLimitTest, AnHonestRunNeverRollsBack) {
