@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <mutex>
 #include <numeric>
 #include <sstream>
 #include <utility>
@@ -64,14 +65,28 @@ absl::Status LearnerConfig::Validate() const {
   return absl::OkStatus();
 }
 
+namespace {
+
+std::mutex& InitialisationMutex() {
+  static std::mutex mutex;
+  return mutex;
+}
+
+}  // namespace
+
 absl::StatusOr<std::unique_ptr<LearnerCore>> LearnerCore::Create(
     const LearnerConfig& config, std::shared_ptr<ReplicaGroup> replicas) {
   if (absl::Status status = config.Validate(); !status.ok()) return status;
   if (replicas == nullptr) replicas = SoloReplicaGroup();
-  // Network initialisation draws from LibTorch's global generator.
-  at::manual_seed(config.seed);
-  std::unique_ptr<LearnerCore> core(
-      new LearnerCore(config, std::move(replicas)));
+  std::unique_ptr<LearnerCore> core;
+  {
+    // Network initialisation draws from LibTorch's global generator; held,
+    // so that learners built at once in one process (replicas in threads)
+    // each draw the seed's values rather than an interleaving.
+    std::lock_guard<std::mutex> lock(InitialisationMutex());
+    at::manual_seed(config.seed);
+    core.reset(new LearnerCore(config, std::move(replicas)));
+  }
   if (absl::Status status = core->SynchroniseReplicas(); !status.ok()) {
     return status;
   }
@@ -461,9 +476,12 @@ absl::StatusOr<std::unique_ptr<LearnerCore>> LearnerCore::Load(
   if (absl::Status status = config.Validate(); !status.ok()) return status;
   if (replicas == nullptr) replicas = SoloReplicaGroup();
   // Synchronised after the state is read, not at creation.
-  at::manual_seed(config.seed);
-  absl::StatusOr<std::unique_ptr<LearnerCore>> created =
-      std::unique_ptr<LearnerCore>(new LearnerCore(config, replicas));
+  absl::StatusOr<std::unique_ptr<LearnerCore>> created;
+  {
+    std::lock_guard<std::mutex> lock(InitialisationMutex());
+    at::manual_seed(config.seed);
+    created = std::unique_ptr<LearnerCore>(new LearnerCore(config, replicas));
+  }
   if (!created.ok()) return created.status();
   LearnerCore& core = **created;
   absl::StatusOr<std::string> name = ReadBytes(archive, "spec.name");
