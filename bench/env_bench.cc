@@ -29,14 +29,14 @@ int RunEnvBenchmark(const std::string& env_name) {
   std::unique_ptr<RawPhysics> physics = MakeRawPhysics(**made);
   if (physics == nullptr) {
     std::fprintf(stderr,
-                 "vantage bench env: %s has no MuJoCo or Bullet model to "
-                 "compare with\n",
+                 "vantage bench env: %s has no MuJoCo or Bullet model or "
+                 "MinAtar game to compare with\n",
                  env_name.c_str());
     return 2;
   }
   Environment& env = **made;
   const EnvSpec spec = env.spec();
-  const std::vector<double> action(spec.action_size, kBenchAction);
+  const std::vector<double> action = BenchAction(spec);
 
   absl::StatusOr<int64_t> episode_length = FixedActionEpisodeLength(env);
   if (!episode_length.ok()) return 1;
@@ -58,8 +58,10 @@ int RunEnvBenchmark(const std::string& env_name) {
   absl::StatusOr<std::unique_ptr<VectorEnv>> vector =
       VectorEnv::Create(env_name, kVectorEnvs, 0);
   if (!vector.ok() || !(*vector)->Reset().ok()) return 1;
-  const std::vector<double> actions(kVectorEnvs * spec.action_size,
-                                    kBenchAction);
+  std::vector<double> actions;
+  for (int i = 0; i < kVectorEnvs; ++i) {
+    actions.insert(actions.end(), action.begin(), action.end());
+  }
   benchmark::RegisterBenchmark("vec16", [&](benchmark::State& state) {
     for (auto _ : state) benchmark::DoNotOptimize((*vector)->Step(actions));
   })->Apply(UseFastestOfRepetitions);

@@ -3,10 +3,13 @@
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
+#include <random>
+#include <utility>
 #include <vector>
 
 #include "actor/envs/bullet/bullet_env.h"
 #include "actor/envs/bullet/bullet_world.h"
+#include "actor/envs/minatar/minatar_env.h"
 #include "actor/envs/mujoco/mujoco_env.h"
 #include "bench/fastest.h"
 #include "common/env/time_limit.h"
@@ -71,7 +74,37 @@ class BulletPhysics : public RawPhysics {
   int frame_skip_;
 };
 
+// A MinAtar game's rules with its grid written every step, as the
+// environment observes it; each restart seeds a new game.
+class MinAtarRules : public RawPhysics {
+ public:
+  explicit MinAtarRules(std::unique_ptr<MinAtarGame> game)
+      : game_(std::move(game)), grid_(game_->channels() * kMinAtarCells) {}
+
+  int frame_skip() const override { return 1; }
+  void Restart() override {
+    random_.seed(episode_++);
+    game_->Reset(random_);
+  }
+  void Step() override {
+    game_->Act(MinAtarAction::kNoop, random_);
+    game_->Observe(absl::MakeSpan(grid_));
+    benchmark::DoNotOptimize(grid_.data());
+  }
+
+ private:
+  std::unique_ptr<MinAtarGame> game_;
+  std::vector<uint8_t> grid_;
+  std::mt19937_64 random_;
+  uint64_t episode_ = 0;
+};
+
 }  // namespace
+
+std::vector<double> BenchAction(const EnvSpec& spec) {
+  if (spec.discrete) return {0.0};
+  return std::vector<double>(spec.action_size, kBenchAction);
+}
 
 std::unique_ptr<RawPhysics> MakeRawPhysics(const Environment& env) {
   const auto* limited = dynamic_cast<const TimeLimit*>(&env);
@@ -82,12 +115,15 @@ std::unique_ptr<RawPhysics> MakeRawPhysics(const Environment& env) {
   if (const auto* bullet = dynamic_cast<const BulletEnv*>(&inner)) {
     return std::make_unique<BulletPhysics>(*bullet);
   }
+  if (std::unique_ptr<MinAtarGame> game = MakeBareGame(inner)) {
+    return std::make_unique<MinAtarRules>(std::move(game));
+  }
   return nullptr;
 }
 
 absl::StatusOr<int64_t> FixedActionEpisodeLength(Environment& env) {
   const EnvSpec& spec = env.spec();
-  const std::vector<double> action(spec.action_size, kBenchAction);
+  const std::vector<double> action = BenchAction(spec);
   std::vector<double> observation(spec.observation_size);
   uint64_t episode = 0;
   if (absl::Status status = env.Reset(episode, absl::MakeSpan(observation));

@@ -2,11 +2,13 @@
 #define VANTAGE_BENCH_RAW_PHYSICS_H_
 
 // The baseline of the environment and actor benchmarks: the bare physics
-// engine under an environment, with nothing of the task around it.
+// engine under an environment (for the MinAtar games: the bare rules), with
+// nothing of the task around it.
 
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "absl/status/statusor.h"
 #include "common/env/environment.h"
@@ -15,6 +17,10 @@ namespace vantage {
 
 // A fixed, in-bounds action for every actuator: the same work each step.
 inline constexpr double kBenchAction = 0.2;
+
+// The action benchmarks repeat: kBenchAction on every actuator, or the
+// first action (a game's noop) of a discrete environment.
+std::vector<double> BenchAction(const EnvSpec& spec);
 
 class RawPhysics {
  public:
@@ -28,7 +34,8 @@ class RawPhysics {
 
 // The bare physics of `env`'s model (inside its time limit): MuJoCo's
 // mj_step or the env's Bullet world, kBenchAction on every actuator, frame
-// skip included. nullptr if the environment has no engine this knows.
+// skip included; for a MinAtar game its rules and grid, playing noop.
+// nullptr if the environment has no engine this knows.
 std::unique_ptr<RawPhysics> MakeRawPhysics(const Environment& env);
 
 // How many steps `env`'s episodes last under kBenchAction (a baseline

@@ -11,6 +11,7 @@
 #include "actor/envs/bullet/biped_walk.h"
 #include "actor/envs/bullet/bullet_hopper.h"
 #include "actor/envs/bullet/terrain_biped.h"
+#include "actor/envs/minatar/minatar_env.h"
 #include "actor/envs/mujoco/gym_tasks.h"
 #include "actor/envs/mujoco/humanoid_env.h"
 #include "actor/envs/mujoco/pendulum_envs.h"
@@ -34,6 +35,11 @@ const std::map<std::string, Factory>& Factories() {
       {"Humanoid", MakeHumanoid},
       {"InvertedDoublePendulum", MakeInvertedDoublePendulum},
       {"InvertedPendulum", MakeInvertedPendulum},
+      {"MinAtarAsterix", MakeMinAtarAsterix},
+      {"MinAtarBreakout", MakeMinAtarBreakout},
+      {"MinAtarFreeway", MakeMinAtarFreeway},
+      {"MinAtarSeaquest", MakeMinAtarSeaquest},
+      {"MinAtarSpaceInvaders", MakeMinAtarSpaceInvaders},
       {"PointMaze", MakePointMaze},
       {"SparseHalfCheetah", MakeSparseHalfCheetah},
       {"TerrainBipedFlat", MakeTerrainBipedFlat},

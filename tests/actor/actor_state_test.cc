@@ -83,6 +83,12 @@ std::vector<double> RandomActions(const EnvSpec& spec, int count,
                                   std::mt19937_64& rng) {
   std::vector<double> actions;
   for (int n = 0; n < count; ++n) {
+    if (spec.discrete) {
+      actions.push_back(
+          static_cast<double>(std::uniform_int_distribution<int64_t>(
+              0, spec.action_size - 1)(rng)));
+      continue;
+    }
     for (int64_t i = 0; i < spec.action_size; ++i) {
       const bool bounded = std::isfinite(spec.action_low[i]) &&
                            std::isfinite(spec.action_high[i]);
@@ -235,7 +241,7 @@ INSTANTIATE_TEST_SUITE_P(AllEnvs, EnvReplayTest,
                          });
 
 TEST(EnvStateTest, EveryRegisteredEnvIsCovered) {
-  EXPECT_EQ(RegisteredEnvironments().size(), 16u);
+  EXPECT_EQ(RegisteredEnvironments().size(), 21u);
 }
 
 // The state is the whole mjData buffer: check that in MuJoCo 2.2.2 every

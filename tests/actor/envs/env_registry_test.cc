@@ -26,6 +26,10 @@ std::unique_ptr<Environment> Make(const std::string& name) {
 }
 
 std::vector<double> RandomAction(const EnvSpec& spec, std::mt19937_64& rng) {
+  if (spec.discrete) {
+    return {static_cast<double>(
+        std::uniform_int_distribution<int64_t>(0, spec.action_size - 1)(rng))};
+  }
   std::vector<double> action(spec.action_size);
   for (int64_t i = 0; i < spec.action_size; ++i) {
     action[i] = std::uniform_real_distribution<double>(
@@ -93,7 +97,8 @@ TEST(EnvRegistryTest, EveryRegisteredEnvStepsWithFiniteValues) {
     const auto env = Make(name);
     ASSERT_NE(env, nullptr) << name;
     const EnvSpec& spec = env->spec();
-    EXPECT_EQ(spec.action_low.size(), static_cast<size_t>(spec.action_size));
+    EXPECT_EQ(spec.action_low.size(),
+              spec.discrete ? 0u : static_cast<size_t>(spec.action_size));
     EXPECT_GT(spec.control_dt, 0.0);
     StepResult last;
     for (const auto& observation : Episode(*env, 3, 200, &last)) {
