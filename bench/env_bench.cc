@@ -26,21 +26,18 @@ int RunEnvBenchmark(const std::string& env_name) {
                  std::string(made.status().message()).c_str());
     return 2;
   }
+  // Without a bare engine (the raycast maze: its picture is the work)
+  // only the environment's own rates are measured.
   std::unique_ptr<RawPhysics> physics = MakeRawPhysics(**made);
-  if (physics == nullptr) {
-    std::fprintf(stderr,
-                 "vantage bench env: %s has no MuJoCo or Bullet model or "
-                 "MinAtar game to compare with\n",
-                 env_name.c_str());
-    return 2;
-  }
   Environment& env = **made;
   const EnvSpec spec = env.spec();
   const std::vector<double> action = BenchAction(spec);
 
   absl::StatusOr<int64_t> episode_length = FixedActionEpisodeLength(env);
   if (!episode_length.ok()) return 1;
-  RegisterRawBenchmark("raw", *physics, *episode_length);
+  if (physics != nullptr) {
+    RegisterRawBenchmark("raw", *physics, *episode_length);
+  }
 
   std::vector<double> observation(spec.observation_size);
   uint64_t episode = 1 << 20;  // seeds the probe did not use
@@ -66,16 +63,29 @@ int RunEnvBenchmark(const std::string& env_name) {
     for (auto _ : state) benchmark::DoNotOptimize((*vector)->Step(actions));
   })->Apply(UseFastestOfRepetitions);
 
-  std::printf(
-      "env %s: frame skip %d, one thread, episodes of %ld steps under the "
-      "fixed action\n",
-      env_name.c_str(), physics->frame_skip(),
-      static_cast<long>(*episode_length));
+  if (physics == nullptr) {
+    std::printf(
+        "env %s: one thread, episodes of %ld steps under the fixed action; "
+        "no bare engine to compare with\n",
+        env_name.c_str(), static_cast<long>(*episode_length));
+  } else {
+    std::printf(
+        "env %s: frame skip %d, one thread, episodes of %ld steps under the "
+        "fixed action\n",
+        env_name.c_str(), physics->frame_skip(),
+        static_cast<long>(*episode_length));
+  }
   FastestCollector collector;
   benchmark::RunSpecifiedBenchmarks(&collector);
-  const double raw = 1.0 / collector.Seconds("raw");
   const double stepped = 1.0 / collector.Seconds("env");
   const double vec16 = kVectorEnvs / collector.Seconds("vec16");
+  if (physics == nullptr) {
+    std::printf(
+        "RESULT env name=%s env_steps_per_s=%.0f vec16_steps_per_s=%.0f\n",
+        env_name.c_str(), stepped, vec16);
+    return 0;
+  }
+  const double raw = 1.0 / collector.Seconds("raw");
   std::printf(
       "RESULT env name=%s raw_steps_per_s=%.0f env_steps_per_s=%.0f "
       "vec16_steps_per_s=%.0f ratio=%.3f\n",

@@ -11,6 +11,7 @@
 #include "actor/envs/bullet/biped_walk.h"
 #include "actor/envs/bullet/bullet_hopper.h"
 #include "actor/envs/bullet/terrain_biped.h"
+#include "actor/envs/maze/first_person_maze.h"
 #include "actor/envs/minatar/minatar_env.h"
 #include "actor/envs/mujoco/gym_tasks.h"
 #include "actor/envs/mujoco/humanoid_env.h"
@@ -30,6 +31,7 @@ const std::map<std::string, Factory>& Factories() {
       {"BipedWalkFlat", MakeBipedWalkFlat},
       {"BipedWalkIncline", MakeBipedWalkIncline},
       {"BulletHopper", MakeBulletHopper},
+      {"FirstPersonMaze", MakeFirstPersonMaze},
       {"HalfCheetah", MakeHalfCheetah},
       {"Hopper", MakeHopper},
       {"Humanoid", MakeHumanoid},

@@ -241,7 +241,7 @@ INSTANTIATE_TEST_SUITE_P(AllEnvs, EnvReplayTest,
                          });
 
 TEST(EnvStateTest, EveryRegisteredEnvIsCovered) {
-  EXPECT_EQ(RegisteredEnvironments().size(), 21u);
+  EXPECT_EQ(RegisteredEnvironments().size(), 22u);
 }
 
 // The state is the whole mjData buffer: check that in MuJoCo 2.2.2 every
