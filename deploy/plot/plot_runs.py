@@ -539,11 +539,29 @@ def arrange(runs, group_by, panel_by):
   return panel_path, panel_values, panels, ordered
 
 
+def _sections_present(groups, label_paths):
+  """Splits off the paths that differ between groups only by their section
+  being absent in some (a method's settings, e.g. exploration.ex2.*): those
+  say no more than whether the section is there. Returns the other paths
+  and, per such section, one of its paths."""
+  kept, sections = [], {}
+  for path in label_paths:
+    values = [g.runs[0].fields[path] for g in groups]
+    present = {format_value(v) for v in values if v is not NA}
+    if "." in path and len(present) == 1 and len(present) < len(
+        {format_value(v) for v in values}):
+      sections.setdefault(path.rsplit(".", 1)[0], path)
+    else:
+      kept.append(path)
+  return kept, sections
+
+
 def _label_groups(groups, key_paths, label_paths, explicit):
   if not label_paths:
     # One group: name what it is rather than nothing.
     label_paths = ["algo", "advantage.estimator", "advantage.rho",
                    "advantage.ensemble"]
+  label_paths, sections = _sections_present(groups, label_paths)
 
   def labels(simplify_gae):
     result = []
@@ -558,6 +576,9 @@ def _label_groups(groups, key_paths, label_paths, explicit):
             path in ("advantage.rho", "advantage.ensemble")):
           continue
         parts.append(field_text(path, first[path]))
+      for section, path in sections.items():
+        name = section.split(".")[-1]
+        parts.append(f"no {name}" if first[path] is NA else name)
       result.append(" ".join(parts))
     return result
 

@@ -311,6 +311,50 @@ class PlotRunsTest(unittest.TestCase):
                           os.path.dirname(missing_parent))
 
 
+class LegendTest(unittest.TestCase):
+  """Legend labels, on the script's own objects (no runs needed)."""
+
+  @classmethod
+  def setUpClass(cls):
+    sys.path.insert(0, os.path.dirname(SCRIPT))
+    import plot_runs
+    cls.module = plot_runs
+
+  def group(self, **fields):
+    base = {"advantage.estimator": "gae", "advantage.rho": 0.5}
+    base.update(fields)
+    group = self.module.Group(())
+    group.runs.append(self.module.Run("dir", base, [], []))
+    return group
+
+  def test_a_section_absent_from_some_groups_is_named_once(self):
+    na = self.module.NA
+    groups = [
+        self.group(**{"exploration.ex2.hidden": na,
+                      "exploration.ex2.kl_weight": na}),
+        self.group(**{"exploration.ex2.hidden": (16, 16),
+                      "exploration.ex2.kl_weight": 0.01}),
+        self.group(**{"advantage.estimator": "max",
+                      "exploration.ex2.hidden": (16, 16),
+                      "exploration.ex2.kl_weight": 0.01}),
+    ]
+    self.module._label_groups(
+        groups, [], ["advantage.estimator", "exploration.ex2.hidden",
+                     "exploration.ex2.kl_weight"], explicit=False)
+    self.assertEqual([g.label for g in groups],
+                     ["gae no ex2", "gae ex2", "max ex2"])
+
+  def test_values_that_differ_among_present_sections_stay(self):
+    na = self.module.NA
+    groups = [self.group(**{"exploration.ex2.kl_weight": na}),
+              self.group(**{"exploration.ex2.kl_weight": 0.01}),
+              self.group(**{"exploration.ex2.kl_weight": 0.1})]
+    self.module._label_groups(groups, [], ["exploration.ex2.kl_weight"],
+                              explicit=False)
+    self.assertEqual([g.label for g in groups],
+                     ["kl_weight=n/a", "kl_weight=0.01", "kl_weight=0.1"])
+
+
 if __name__ == "__main__":
   path = take_vantage_flag(sys.argv)
   if path:
