@@ -162,6 +162,10 @@ FirstPersonMaze::FirstPersonMaze() : layout_(TheLayout()) {
   spec_.max_episode_steps = kEpisodeSteps;
   spec_.control_dt = kTicsPerStep / 35.0;
   pixels_.resize(3 * kFrameSize * kFrameSize);
+  // A valid pose before the first Reset, so that a state saved then
+  // restores.
+  x_ = layout_.room_centres[0][0];
+  y_ = layout_.room_centres[0][1];
 }
 
 absl::Status FirstPersonMaze::Reset(uint64_t seed,

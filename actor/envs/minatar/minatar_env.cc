@@ -55,6 +55,10 @@ class MinAtarEnv : public Environment {
     // No physics: videos play 15 steps a second.
     spec_.control_dt = 1.0 / 15.0;
     grid_.resize(spec_.observation_size);
+    // Saved before the first Reset, the state must replay like any other:
+    // start from what Reset(seed 0) gives.
+    random_.seed(seed_);
+    game_->Reset(random_);
   }
 
   const EnvSpec& spec() const override { return spec_; }

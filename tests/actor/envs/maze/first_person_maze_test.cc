@@ -220,6 +220,10 @@ std::string State(bool needs_reset, std::vector<double> pose, int64_t held) {
 }
 
 TEST(FirstPersonMazeTest, HostileStatesAreRefusedAndChangeNothing) {
+  FirstPersonMaze fresh;
+  const absl::Status fresh_restored =
+      FirstPersonMaze().RestoreState(*fresh.SaveState());
+  EXPECT_TRUE(fresh_restored.ok()) << fresh_restored;
   FirstPersonMaze env;
   std::vector<double> observation(kObservation);
   ASSERT_TRUE(env.Reset(5, absl::MakeSpan(observation)).ok());

@@ -398,6 +398,21 @@ std::string MinAtarState(const std::string& name, bool needs_reset,
   return std::move(writer).Finish();
 }
 
+TEST(MinAtarEnvTest, AStateSavedBeforeAnyEpisodeRestores) {
+  for (const std::string& name : {"MinAtarBreakout", "MinAtarSeaquest"}) {
+    const auto fresh = MakeEnv(name);
+    const auto other = MakeEnv(name);
+    absl::StatusOr<std::string> state = fresh->SaveState();
+    ASSERT_TRUE(state.ok()) << state.status();
+    const absl::Status restored = other->RestoreState(*state);
+    EXPECT_TRUE(restored.ok()) << name << ": " << restored;
+  }
+  absl::StatusOr<std::unique_ptr<Environment>> inner = MakeMinAtarBreakout();
+  absl::StatusOr<std::unique_ptr<Environment>> copy = MakeMinAtarBreakout();
+  const absl::Status restored = (*copy)->RestoreState(*(*inner)->SaveState());
+  EXPECT_TRUE(restored.ok()) << restored;
+}
+
 TEST(MinAtarEnvTest, StatesReplayExactlyAndHostileOnesChangeNothing) {
   absl::StatusOr<std::unique_ptr<Environment>> made = MakeMinAtarSeaquest();
   ASSERT_TRUE(made.ok());
