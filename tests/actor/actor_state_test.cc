@@ -234,6 +234,22 @@ TEST_P(EnvReplayTest, RestoredEnvReplaysBitIdentically) {
   }
 }
 
+// A state saved before the first episode (a checkpoint of an actor that
+// has not stepped yet) restores, and the restored environment then runs
+// exactly like the saved one.
+TEST_P(EnvReplayTest, AStateSavedBeforeAnyEpisodeRestores) {
+  const std::string name = GetParam();
+  const auto env = Make(name);
+  const auto restored = Make(name);
+  ASSERT_NE(env, nullptr);
+  ASSERT_NE(restored, nullptr);
+  const std::string state = Save(*env);
+  const absl::Status status = restored->RestoreState(state);
+  ASSERT_TRUE(status.ok()) << status;
+  Driver a, b;
+  ExpectBitIdentical(a.Run(*env, 100), b.Run(*restored, 100), name);
+}
+
 INSTANTIATE_TEST_SUITE_P(AllEnvs, EnvReplayTest,
                          ::testing::ValuesIn(RegisteredEnvironments()),
                          [](const ::testing::TestParamInfo<std::string>& info) {
