@@ -246,6 +246,7 @@ TEST_P(EnvReplayTest, AStateSavedBeforeAnyEpisodeRestores) {
   const std::string state = Save(*env);
   const absl::Status status = restored->RestoreState(state);
   ASSERT_TRUE(status.ok()) << status;
+  EXPECT_EQ(Save(*restored), state) << name;
   Driver a, b;
   ExpectBitIdentical(a.Run(*env, 100), b.Run(*restored, 100), name);
 }

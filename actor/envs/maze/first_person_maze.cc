@@ -232,6 +232,13 @@ absl::Status FirstPersonMaze::RestoreState(absl::string_view state) {
   for (double v : values) {
     if (!std::isfinite(v)) return invalid("a non-finite pose or velocity");
   }
+  // Inside the map before anything converts the position to cells.
+  const double inside = kPlayerRadius;
+  if (!(values[0] > inside && values[0] < kCells - inside &&
+        values[1] > inside && values[1] < kCells - inside)) {
+    return invalid(absl::StrCat("the player at (", values[0], ", ", values[1],
+                                ") is outside the map"));
+  }
   if (Blocked(layout_.scene, values[0], values[1])) {
     return invalid(absl::StrCat("the player at (", values[0], ", ", values[1],
                                 ") would overlap a wall"));
@@ -301,14 +308,18 @@ void FirstPersonMaze::Tic(int action) {
   } else {
     vy_ = 0.0;
   }
-  vx_ *= kFriction;
-  vy_ *= kFriction;
+  // P_XYMovement: a slow body with no move command stops instead of
+  // slowing down.
   if (!walking && std::abs(vx_) < kStopSpeed && std::abs(vy_) < kStopSpeed) {
     vx_ = vy_ = 0.0;
+  } else {
+    vx_ *= kFriction;
+    vy_ *= kFriction;
   }
 }
 
-// Channel-major [3, 42, 42] from the renderer's packed rows.
+// Channel-major [3, 42, 42], the layout convolutions take, from the
+// renderer's packed rows.
 void FirstPersonMaze::Observe(absl::Span<double> observation) {
   Raycast(layout_.scene, CameraAt(x_, y_, angle_), kFrameSize, kFrameSize,
           absl::MakeSpan(pixels_));

@@ -44,7 +44,7 @@ class FirstPersonMaze : public Environment {
   // the goal. Cell (x, y) of the world spans [x, x + 1) x [y, y + 1) with
   // y growing northwards, so row r holds y = rows - 1 - r.
   static const std::vector<std::string>& Map();
-  // Where the goal stands, and where each start room's centre is.
+  // Where the goal stands.
   static std::array<double, 2> Goal();
 
   double x() const { return x_; }

@@ -80,7 +80,7 @@ GameStep Breakout::Act(MinAtarAction action, std::mt19937_64&) {
   } else if (new_y == kBottom) {
     if (bricks() == 0) FillBrickRows(brick_map_);
     // The paddle has already moved this step. Under the ball's old column
-    // it bounces the ball straight back up; under its new column (a
+    // it flips the ball's vertical direction only; under its new column (a
     // diagonal hit) it sends it back the way it came.
     if (ball_x_ == paddle_) {
       ball_dir_ = kFlipVertical[ball_dir_];

@@ -90,11 +90,16 @@ class MinAtarEnv : public Environment {
     const int chosen = static_cast<int>(action[0]);
     const GameStep step = Play(chosen);
     actions_.push_back(static_cast<char>(chosen));
-    if (step.terminal) needs_reset_ = true;
-    Observe(observation);
     StepResult result;
     result.reward = step.reward;
     result.terminated = step.terminal;
+    // The limit holds without the TimeLimit wrapper too, so a saved state
+    // never outgrows what RestoreState accepts.
+    result.truncated =
+        !step.terminal &&
+        static_cast<int64_t>(actions_.size()) == kMaxEpisodeSteps;
+    if (result.terminated || result.truncated) needs_reset_ = true;
+    Observe(observation);
     return result;
   }
 
@@ -140,14 +145,20 @@ class MinAtarEnv : public Environment {
     std::mt19937_64 random(seed);
     int last_action = 0;
     game->Reset(random);
+    bool ended = false;
     for (size_t i = 0; i < actions.size(); ++i) {
-      const GameStep step = PlayOn(*game, random, last_action, actions[i]);
-      if (step.terminal != (i + 1 == actions.size() && needs_reset)) {
-        return invalid(step.terminal
-                           ? "the game ends before its saved actions do"
-                           : "the saved actions do not end the game, yet "
-                             "the state says the episode is over");
+      ended = PlayOn(*game, random, last_action, actions[i]).terminal;
+      if (ended && i + 1 < actions.size()) {
+        return invalid("the game ends before its saved actions do");
       }
+    }
+    const bool at_limit =
+        static_cast<int64_t>(actions.size()) == kMaxEpisodeSteps;
+    if ((ended || at_limit) != needs_reset && !actions.empty()) {
+      return invalid(needs_reset ? "the saved actions do not end the game, "
+                                   "yet the state says the episode is over"
+                                 : "the saved actions end the episode, yet "
+                                   "the state says it goes on");
     }
     if (GameFingerprint(*game, last_action) != fingerprint) {
       return invalid(

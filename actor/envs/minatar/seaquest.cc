@@ -50,7 +50,8 @@ void Seaquest::Reset(std::mt19937_64&) {
 }
 
 void Seaquest::SpawnEnemy(std::mt19937_64& random) {
-  // Three draws even when the spawn is then cancelled.
+  // All three draws happen even when the spawn is then cancelled, as in
+  // MinAtar, so that a cancelled spawn uses the generator like any other.
   Mover enemy;
   enemy.moves_right = UniformUnit(random) < 0.5;
   const bool is_sub = UniformUnit(random) < 1.0 / 3.0;

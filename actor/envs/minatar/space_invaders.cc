@@ -85,7 +85,8 @@ GameStep SpaceInvaders::Act(MinAtarAction action, std::mt19937_64&) {
     cannon_ = std::min(kBottom, cannon_ + 1);
   }
 
-  // Bullets leaving the grid wrap round and are cleared at once.
+  // As MinAtar moves them (numpy.roll): a bullet leaving the grid wraps
+  // round and is cleared at once, so it simply disappears.
   friendly_bullets_ = Rolled(friendly_bullets_, -1, 0);
   for (int x = 0; x < kN; ++x) At(friendly_bullets_, kBottom, x) = 0;
   enemy_bullets_ = Rolled(enemy_bullets_, 1, 0);

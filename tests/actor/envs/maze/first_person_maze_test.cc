@@ -221,15 +221,17 @@ std::string State(bool needs_reset, std::vector<double> pose, int64_t held) {
 
 TEST(FirstPersonMazeTest, HostileStatesAreRefusedAndChangeNothing) {
   FirstPersonMaze fresh;
-  const absl::Status fresh_restored =
-      FirstPersonMaze().RestoreState(*fresh.SaveState());
+  FirstPersonMaze copy;
+  const absl::Status fresh_restored = copy.RestoreState(*fresh.SaveState());
   EXPECT_TRUE(fresh_restored.ok()) << fresh_restored;
   FirstPersonMaze env;
   std::vector<double> observation(kObservation);
   ASSERT_TRUE(env.Reset(5, absl::MakeSpan(observation)).ok());
   const std::string before = *env.SaveState();
   const std::vector<std::pair<std::string, std::string>> hostile = {
-      {State(false, {0.5, 0.5, 0, 0, 0}, 0), "would overlap a wall"},
+      {State(false, {0.5, 1.5, 0, 0, 0}, 0), "would overlap a wall"},
+      {State(false, {100.0, 15.5, 0, 0, 0}, 0), "outside the map"},
+      {State(false, {2147483647.9, 15.5, 0, 0, 0}, 0), "outside the map"},
       {State(false, {3.5, std::nan(""), 0, 0, 0}, 0), "non-finite"},
       {State(false, {3.5, 15.5, 7.0, 0, 0}, 0), "not in [-pi, pi]"},
       {State(false, {3.5, 15.5, 0, 2.0, 0}, 0), "above Doom's limit"},
