@@ -1,4 +1,5 @@
 #include <algorithm>
+#include <array>
 #include <cstdlib>
 #include <memory>
 #include <random>
@@ -209,6 +210,78 @@ TEST(SpaceInvadersTest, FiringClearsWavesWhichThenComeFaster) {
   }
   EXPECT_GE(score, 24.0) << "steps " << t;
   EXPECT_EQ(game.move_interval(), 11);
+}
+
+// Cars move every |speed| + 1 steps (MinAtar's timer re-arms to |speed|
+// and counts down through 0), each in its own direction, wrapping round.
+TEST(FreewayTest, ACarMovesEverySpeedPlusOneSteps) {
+  Freeway game;
+  std::mt19937_64 random(12);
+  game.Reset(random);
+  const std::array<Freeway::Car, 8> start = game.cars();
+  std::array<int, 8> moves{};
+  std::array<int, 8> last_move{};
+  for (int t = 1; t <= 60; ++t) {
+    const std::array<Freeway::Car, 8> before = game.cars();
+    game.Act(A::kNoop, random);
+    for (int i = 0; i < 8; ++i) {
+      const Freeway::Car& car = game.cars()[i];
+      if (car.x == before[i].x) continue;
+      const int step = car.speed > 0 ? 1 : -1;
+      ASSERT_EQ((before[i].x + step + 10) % 10, car.x) << "car " << i;
+      if (moves[i] > 0) {
+        EXPECT_EQ(t - last_move[i], std::abs(car.speed) + 1) << "car " << i;
+      }
+      ++moves[i];
+      last_move[i] = t;
+    }
+  }
+  for (int i = 0; i < 8; ++i) {
+    EXPECT_EQ(game.cars()[i].speed, start[i].speed);  // no crossing
+    EXPECT_GE(moves[i], 60 / (std::abs(start[i].speed) + 1) - 1);
+  }
+}
+
+// The alien nearest the cannon's column fires from the lowest alien of
+// that column, on step 11.
+TEST(SpaceInvadersTest, TheLowestAlienOfTheNearestColumnFires) {
+  SpaceInvaders game(/*ramping=*/true);
+  std::mt19937_64 random(13);
+  game.Reset(random);
+  for (int t = 1; t <= 11; ++t) {
+    // To the right edge: the nearest aliens are then in column 7.
+    game.Act(t <= 4 ? A::kRight : A::kNoop, random);
+    if (t < 11) ASSERT_TRUE(Cells(game, 5).empty()) << t;
+  }
+  ASSERT_EQ(game.cannon(), 9);
+  EXPECT_EQ(Cells(game, 5), (std::vector<std::pair<int, int>>{{3, 7}}));
+}
+
+// With ramping, spawns first speed up on step 102 (from every 10 steps to
+// every 9); moves only from the second ramp on.
+TEST(AsterixTest, TheFirstRampComesOnStep102) {
+  int checked = 0;
+  for (uint64_t seed = 0; seed < 50 && checked == 0; ++seed) {
+    Asterix game(/*ramping=*/true);
+    std::mt19937_64 random(seed);
+    game.Reset(random);
+    bool alive = true;
+    for (int t = 1; t <= 102 && alive; ++t) {
+      const Asterix::Entity& lane = game.lanes()[game.player_y() - 1];
+      const A action = lane.present && !lane.gold
+                           ? (game.player_y() > 1 ? A::kUp : A::kDown)
+                           : A::kNoop;
+      alive = !game.Act(action, random).terminal;
+      if (alive && t == 101) {
+        ASSERT_EQ(game.spawn_interval(), 10);
+      }
+    }
+    if (!alive) continue;
+    EXPECT_EQ(game.spawn_interval(), 9);
+    EXPECT_EQ(game.move_interval(), 5);
+    ++checked;
+  }
+  EXPECT_EQ(checked, 1);
 }
 
 TEST(SeaquestTest, OxygenDrainsBelowAndSurfacingWithoutDiversEndsTheGame) {
