@@ -204,12 +204,13 @@ Command BenchCommand() {
       "learner | train) [flags] [--benchmark_*]";
   command.description =
       "advantages: the path-ensemble estimators against GAE; env: the\n"
-      "environment layer against raw physics; learner: a PPO update against\n"
-      "a bare LibTorch loop; ingest: the learner's segment ingest in actors;\n"
-      "actor: a streaming actor against raw physics; connections: a\n"
+      "environment layer against raw physics (a MinAtar game: its bare\n"
+      "rules; the raycast maze: its own rates only); learner: a PPO update\n"
+      "against a bare LibTorch loop; ingest: the learner's segment ingest in\n"
+      "actors; actor: a streaming actor against raw physics; connections: a\n"
       "learner's memory and threads per connected actor against its idle\n"
-      "footprint; train: the distributed\n"
-      "main job (`vantage train` with the run flags given) against the\n"
+      "footprint; train: the distributed main job (`vantage train` with the\n"
+      "run flags given) against the\n"
       "machine's limit from raw physics and a bare update. Each ends with a\n"
       "line `RESULT <name> ... ratio=...` measured in the same run. Google\n"
       "Benchmark's --benchmark_* flags apply.";
