@@ -53,6 +53,11 @@ absl::StatusOr<std::unique_ptr<ActorCore>> ActorCore::Create(
   absl::StatusOr<std::unique_ptr<VectorEnv>> envs =
       VectorEnv::Create(config.env, config.num_envs, config.seed);
   if (!envs.ok()) return envs.status();
+  if (absl::StatusOr<Torso> torso =
+          ResolveTorso(config.network.torso, (*envs)->spec());
+      !torso.ok()) {
+    return torso.status();
+  }
   if (absl::Status status = (*envs)->Reset(); !status.ok()) return status;
   return std::unique_ptr<ActorCore>(new ActorCore(config, std::move(*envs)));
 }
@@ -79,10 +84,7 @@ absl::Status ActorCore::SetWeights(const PolicyWeights& weights) {
 }
 
 at::Tensor ActorCore::CurrentObservations() const {
-  const absl::Span<const double> observations = envs_->observations();
-  return at::from_blob(const_cast<double*>(observations.data()),
-                       {envs_->size(), spec().observation_size}, at::kDouble)
-      .to(at::kFloat);
+  return ObservationTensor(spec(), envs_->observations().data(), envs_->size());
 }
 
 absl::Status ActorCore::CollectSegments(SegmentSink& sink) {
@@ -94,7 +96,9 @@ absl::Status ActorCore::CollectSegments(SegmentSink& sink) {
   const int64_t steps = config_.segment_length;
   const int64_t obs = spec().observation_size;
   const int64_t act = spec().discrete ? 1 : spec().action_size;
-  at::Tensor observations = at::empty({steps + 1, m, obs}, at::kFloat);
+  const at::ScalarType observation_dtype =
+      spec().byte_observations() ? at::kByte : at::kFloat;
+  at::Tensor observations = at::empty({steps + 1, m, obs}, observation_dtype);
   at::Tensor actions = at::empty({steps, m, act}, at::kFloat);
   at::Tensor log_probs = at::empty({steps, m}, at::kFloat);
   at::Tensor rewards = at::empty({steps, m}, at::kFloat);
@@ -107,8 +111,8 @@ absl::Status ActorCore::CollectSegments(SegmentSink& sink) {
   observations[0].copy_(CurrentObservations());
   for (int64_t t = 0; t < steps; ++t) {
     const auto inference_start = std::chrono::steady_clock::now();
-    const at::Tensor output = policy_->forward(
-        normalizer_.Normalize(observations[t], config_.observation_clip));
+    const at::Tensor output = policy_->forward(ObservationsForNetwork(
+        spec(), normalizer_, observations[t], config_.observation_clip));
     const at::Tensor action = policy_->Act(output, false, generator_);
     actions[t].copy_(action);
     log_probs[t].copy_(policy_->LogProb(output, action));
@@ -138,11 +142,10 @@ absl::Status ActorCore::CollectSegments(SegmentSink& sink) {
       segment.episode_lengths.push_back(episode.length);
       if (episode.truncated) {
         finals[episode.env_index].push_back(
-            at::from_blob(
-                const_cast<double*>(envs_->final_observations().data() +
-                                    episode.env_index * obs),
-                {obs}, at::kDouble)
-                .to(at::kFloat));
+            ObservationTensor(
+                spec(),
+                envs_->final_observations().data() + episode.env_index * obs, 1)
+                .squeeze(0));
       }
     }
     observations[t + 1].copy_(CurrentObservations());
@@ -162,7 +165,7 @@ absl::Status ActorCore::CollectSegments(SegmentSink& sink) {
     segment.terminated = terminated.select(1, i).clone();
     segment.truncated = truncated.select(1, i).clone();
     segment.final_observations = finals[i].empty()
-                                     ? at::empty({0, obs}, at::kFloat)
+                                     ? at::empty({0, obs}, observation_dtype)
                                      : at::stack(finals[i]);
     if (absl::Status status = sink.Send(std::move(segment)); !status.ok()) {
       return status;

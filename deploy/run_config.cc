@@ -233,6 +233,12 @@ absl::StatusOr<pb::RunConfig> ResolveRunConfig(const pb::RunConfig& given) {
   for (int64_t h : t.hidden()) {
     if (h < 1) return Invalid("hidden", "sizes must be >= 1");
   }
+  if (!t.has_torso()) t.set_torso(TorsoName(local.learner.network.torso));
+  if (!ParseTorso(t.torso()).ok()) {
+    return Invalid("torso", absl::StrCat("'", t.torso(),
+                                         "' is not one of auto, mlp, minatar, "
+                                         "nature"));
+  }
   if (!t.has_scale_rewards()) t.set_scale_rewards(local.learner.scale_rewards);
   if (!t.has_segment_length()) {
     t.set_segment_length(DefaultSegmentLength(t.horizon()));
@@ -345,6 +351,7 @@ LocalTrainingConfig ToLocalTrainingConfig(const pb::RunConfig& c) {
   learner.max_policy_lag = c.distributed().max_policy_lag();
   learner.scale_rewards = t.scale_rewards();
   learner.network.hidden.assign(t.hidden().begin(), t.hidden().end());
+  learner.network.torso = ParseTorso(t.torso()).value_or(Torso::kAuto);
   const pb::AdvantageSettings& a = c.advantage();
   AdvantageConfig& advantage = learner.advantage;
   if (absl::StatusOr<Statistic> statistic = ParseStatistic(a.estimator());

@@ -38,6 +38,7 @@ absl::StatusOr<TrainedPolicy> LoadCheckpointFile(const std::string& path) {
   trained.config = *config;
   trained.checkpoint_path = path;
   trained.version = (*learner)->policy_version();
+  trained.spec = (*env)->spec();
   trained.policy = PolicyNetwork((*env)->spec(), local.learner.network);
   trained.normalizer = RunningMeanStd((*env)->spec().observation_size);
   trained.observation_clip = local.learner.observation_clip;
@@ -55,13 +56,11 @@ std::vector<double> TrainedPolicy::Act(absl::Span<const double> observation,
                                        bool deterministic,
                                        at::Generator generator) {
   at::NoGradGuard no_grad;
-  const at::Tensor x =
-      at::tensor(std::vector<double>(observation.begin(), observation.end()),
-                 at::kFloat)
-          .unsqueeze(0);
+  const at::Tensor x = ObservationTensor(spec, observation.data(), 1);
   const at::Tensor action =
       policy
-          ->Act(policy->forward(normalizer.Normalize(x, observation_clip)),
+          ->Act(policy->forward(ObservationsForNetwork(spec, normalizer, x,
+                                                       observation_clip)),
                 deterministic, generator)
           .to(at::kDouble)
           .contiguous();

@@ -19,6 +19,7 @@ struct TrainedPolicy {
   pb::RunConfig config;  // the run's resolved config
   std::string checkpoint_path;
   int64_t version = 0;
+  EnvSpec spec;
   PolicyNetwork policy{nullptr};
   RunningMeanStd normalizer{1};
   double observation_clip = 10.0;

@@ -28,6 +28,13 @@ absl::Status LearnerConfig::Validate() const {
   if (spec.observation_size < 1 || spec.action_size < 1) {
     return absl::InvalidArgumentError("learner needs an environment spec");
   }
+  if (absl::Status status = CheckObservationLayout(spec); !status.ok()) {
+    return status;
+  }
+  if (absl::StatusOr<Torso> torso = ResolveTorso(network.torso, spec);
+      !torso.ok()) {
+    return torso.status();
+  }
   if (horizon < 1 || rollouts_per_batch < 1 || total_env_steps < 1) {
     return absl::InvalidArgumentError(
         "learner horizon, rollouts_per_batch and total_env_steps must be "
@@ -98,7 +105,7 @@ LearnerCore::LearnerCore(const LearnerConfig& config,
     : config_(config),
       replicas_(std::move(replicas)),
       policy_(config.spec, config.network),
-      value_(config.spec.observation_size, config.network),
+      value_(config.spec, config.network),
       normalizer_(config.spec.observation_size),
       reward_scaler_(config.advantage.gamma, config.reward_clip),
       // Validated by Create, so the algorithm exists.
@@ -281,7 +288,8 @@ absl::StatusOr<UpdateStats> LearnerCore::Update(std::vector<Rollout> rollouts) {
     absl::StatusOr<TrainingBatch> batch =
         AssembleBatch(rollouts, [&](const at::Tensor& observations) {
           at::NoGradGuard no_grad;
-          return value_->forward(normalizer_.Normalize(observations, clip));
+          return value_->forward(ObservationsForNetwork(
+              config_.spec, normalizer_, observations, clip));
         });
     if (!batch.ok()) {
       guard.Restore();
@@ -305,7 +313,7 @@ absl::StatusOr<UpdateStats> LearnerCore::Update(std::vector<Rollout> rollouts) {
 
     const UpdateBatch update =
         MakeUpdateBatch(*batch, *advantages, [&](const at::Tensor& raw) {
-          return normalizer_.Normalize(raw, clip);
+          return ObservationsForNetwork(config_.spec, normalizer_, raw, clip);
         });
     const int64_t samples = update.horizon * update.streams;
     const double progress =
@@ -373,16 +381,19 @@ absl::StatusOr<UpdateStats> LearnerCore::Update(std::vector<Rollout> rollouts) {
                    stats.rollback_reason.c_str(),
                    static_cast<long>(global_samples));
     } else {
-      // A dropped batch must not move the statistics either.
-      std::vector<at::Tensor> observations;
-      for (const Rollout& rollout : rollouts) {
-        observations.push_back(
-            rollout.observations.slice(0, 0, config_.horizon));
-      }
-      if (absl::Status status = UpdateAcrossReplicas(replicas, normalizer_,
-                                                     at::cat(observations));
-          !status.ok()) {
-        return status;
+      // A dropped batch must not move the statistics either; byte
+      // observations are not normalised, so have none.
+      if (!config_.spec.byte_observations()) {
+        std::vector<at::Tensor> observations;
+        for (const Rollout& rollout : rollouts) {
+          observations.push_back(
+              rollout.observations.slice(0, 0, config_.horizon));
+        }
+        if (absl::Status status = UpdateAcrossReplicas(replicas, normalizer_,
+                                                       at::cat(observations));
+            !status.ok()) {
+          return status;
+        }
       }
       if (exploration_ != nullptr) exploration_->Commit();
     }

@@ -244,31 +244,33 @@ absl::StatusOr<Segment> SegmentFromProto(const pb::Segment& proto,
     bool present;
     const pb::Tensor& proto;
     const char* name;
-    pb::Tensor::DType dtype;
+    absl::Span<const pb::Tensor::DType> dtypes;
     at::Tensor* out;
   };
+  static constexpr pb::Tensor::DType kFloat[] = {pb::Tensor::FLOAT32};
+  static constexpr pb::Tensor::DType kBool[] = {pb::Tensor::BOOL};
+  // Which of the two the run's spec wants is ValidateSegment's check.
+  static constexpr pb::Tensor::DType kObservation[] = {pb::Tensor::FLOAT32,
+                                                       pb::Tensor::UINT8};
   const Field fields[] = {
       {proto.has_observations(), proto.observations(), "segment.observations",
-       pb::Tensor::FLOAT32, &segment.observations},
-      {proto.has_actions(), proto.actions(), "segment.actions",
-       pb::Tensor::FLOAT32, &segment.actions},
-      {proto.has_rewards(), proto.rewards(), "segment.rewards",
-       pb::Tensor::FLOAT32, &segment.rewards},
-      {proto.has_terminated(), proto.terminated(), "segment.terminated",
-       pb::Tensor::BOOL, &segment.terminated},
-      {proto.has_truncated(), proto.truncated(), "segment.truncated",
-       pb::Tensor::BOOL, &segment.truncated},
+       kObservation, &segment.observations},
+      {proto.has_actions(), proto.actions(), "segment.actions", kFloat,
+       &segment.actions},
+      {proto.has_rewards(), proto.rewards(), "segment.rewards", kFloat,
+       &segment.rewards},
+      {proto.has_terminated(), proto.terminated(), "segment.terminated", kBool,
+       &segment.terminated},
+      {proto.has_truncated(), proto.truncated(), "segment.truncated", kBool,
+       &segment.truncated},
       {proto.has_final_observations(), proto.final_observations(),
-       "segment.final_observations", pb::Tensor::FLOAT32,
-       &segment.final_observations},
+       "segment.final_observations", kObservation, &segment.final_observations},
       {proto.has_behaviour_log_probs(), proto.behaviour_log_probs(),
-       "segment.behaviour_log_probs", pb::Tensor::FLOAT32,
-       &segment.behaviour_log_probs},
+       "segment.behaviour_log_probs", kFloat, &segment.behaviour_log_probs},
   };
   for (const Field& field : fields) {
-    absl::StatusOr<at::Tensor> tensor =
-        DecodeField(field.present, field.proto, field.name,
-                    absl::MakeConstSpan(&field.dtype, 1), max_bytes);
+    absl::StatusOr<at::Tensor> tensor = DecodeField(
+        field.present, field.proto, field.name, field.dtypes, max_bytes);
     if (!tensor.ok()) return tensor.status();
     *field.out = *std::move(tensor);
   }
@@ -282,11 +284,13 @@ absl::StatusOr<Segment> SegmentFromProto(const pb::Segment& proto,
 int64_t MaxSegmentMessageBytes(const EnvSpec& spec, int64_t max_steps) {
   const int64_t t = std::max<int64_t>(1, max_steps);
   const int64_t act = spec.discrete ? 1 : spec.action_size;
-  // observations [T+1, obs] and at most T final observations, float32;
-  // actions [T, act], rewards and log-probs [T] float32; two bool [T];
-  // at most T episodes of a double and a varint (<= 10 bytes) each.
-  const int64_t payload = 4 * spec.observation_size * (2 * t + 1) +
-                          4 * act * t + 8 * t + 2 * t + 18 * t;
+  // observations [T+1, obs] and at most T final observations, float32 or
+  // uint8; actions [T, act], rewards and log-probs [T] float32; two bool
+  // [T]; at most T episodes of a double and a varint (<= 10 bytes) each.
+  const int64_t observation_bytes = spec.byte_observations() ? 1 : 4;
+  const int64_t payload =
+      observation_bytes * spec.observation_size * (2 * t + 1) + 4 * act * t +
+      8 * t + 2 * t + 18 * t;
   // Tags, lengths, shapes and the four integers, generously.
   constexpr int64_t kFraming = 4096;
   return payload + kFraming;
@@ -349,6 +353,9 @@ void EnvSpecToProto(const EnvSpec& spec, pb::EnvSpec* proto) {
                                     spec.action_high.end());
   proto->set_max_episode_steps(spec.max_episode_steps);
   proto->set_control_dt(spec.control_dt);
+  proto->mutable_observation_shape()->Add(spec.observation_shape.begin(),
+                                          spec.observation_shape.end());
+  proto->set_observation_high(spec.observation_high);
 }
 
 absl::StatusOr<EnvSpec> EnvSpecFromProto(const pb::EnvSpec& proto,
@@ -374,6 +381,11 @@ absl::StatusOr<EnvSpec> EnvSpecFromProto(const pb::EnvSpec& proto,
                    absl::StrCat(proto.max_episode_steps(),
                                 ", expected <= ", limits.max_episode_steps));
   }
+  if (proto.observation_shape_size() > 3) {
+    return Invalid("spec.observation_shape",
+                   absl::StrCat(proto.observation_shape_size(),
+                                " dimensions, expected none or 3"));
+  }
   EnvSpec spec;
   spec.name = proto.name();
   spec.observation_size = proto.observation_size();
@@ -384,11 +396,17 @@ absl::StatusOr<EnvSpec> EnvSpecFromProto(const pb::EnvSpec& proto,
                           proto.action_high().end());
   spec.max_episode_steps = proto.max_episode_steps();
   spec.control_dt = proto.control_dt();
+  spec.observation_shape.assign(proto.observation_shape().begin(),
+                                proto.observation_shape().end());
+  spec.observation_high = proto.observation_high();
 
   if (spec.name.empty()) return Invalid("spec.name", "empty");
   if (spec.observation_size < 1) {
     return Invalid("spec.observation_size",
                    absl::StrCat(spec.observation_size, ", expected >= 1"));
+  }
+  if (absl::Status status = CheckObservationLayout(spec); !status.ok()) {
+    return status;
   }
   if (spec.action_size < 1) {
     return Invalid("spec.action_size",
@@ -436,6 +454,17 @@ absl::Status CheckSameSpec(const EnvSpec& expected, const EnvSpec& got) {
   if (expected.observation_size != got.observation_size) {
     return Differs("observation_size", absl::StrCat(expected.observation_size),
                    absl::StrCat(got.observation_size));
+  }
+  if (expected.observation_shape != got.observation_shape) {
+    const auto text = [](const std::vector<int64_t>& shape) {
+      return shape.empty() ? std::string("none") : absl::StrJoin(shape, "x");
+    };
+    return Differs("observation_shape", text(expected.observation_shape),
+                   text(got.observation_shape));
+  }
+  if (expected.observation_high != got.observation_high) {
+    return Differs("observation_high", absl::StrCat(expected.observation_high),
+                   absl::StrCat(got.observation_high));
   }
   if (expected.discrete != got.discrete) {
     return Differs("discrete", expected.discrete ? "true" : "false",

@@ -119,6 +119,14 @@ class Session {
       actor_config.actor_id = response.actor_id();
       actor_config.network.hidden.assign(run.training().hidden().begin(),
                                          run.training().hidden().end());
+      // A learner from before torsos existed built MLPs.
+      absl::StatusOr<Torso> torso = ParseTorso(
+          run.training().has_torso() ? run.training().torso() : "mlp");
+      if (!torso.ok()) {
+        return absl::InvalidArgumentError(absl::StrCat(
+            "the learner's run config: ", torso.status().message()));
+      }
+      actor_config.network.torso = *torso;
       absl::StatusOr<std::unique_ptr<ActorCore>> created =
           ActorCore::Create(actor_config);
       if (!created.ok()) return created.status();

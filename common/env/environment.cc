@@ -3,11 +3,18 @@
 #include <cmath>
 
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_join.h"
 
 namespace vantage {
 
 std::string EnvSpec::ActionString() const {
   return absl::StrCat(discrete ? "discrete:" : "continuous:", action_size);
+}
+
+std::string EnvSpec::ObservationString() const {
+  if (observation_shape.empty()) return absl::StrCat(observation_size);
+  return absl::StrCat(byte_observations() ? "uint8 " : "",
+                      absl::StrJoin(observation_shape, "x"));
 }
 
 absl::StatusOr<std::string> Environment::SaveState() const {
@@ -57,6 +64,45 @@ absl::Status CheckStep(const EnvSpec& spec, bool needs_reset,
   if (absl::Status status = CheckAction(spec, action); !status.ok()) {
     return status;
   }
+  return CheckObservationBuffer(spec, observation);
+}
+
+absl::Status CheckObservationLayout(const EnvSpec& spec) {
+  if (spec.observation_high < 0 || spec.observation_high > 255) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("spec.observation_high: ", spec.observation_high,
+                     ", expected 0 (real values) or 1..255 (bytes)"));
+  }
+  if (spec.observation_shape.empty()) return absl::OkStatus();
+  const std::string shape = absl::StrJoin(spec.observation_shape, "x");
+  if (spec.observation_shape.size() != 3) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("spec.observation_shape: ", shape,
+                     ", expected [channels, height, width] or nothing"));
+  }
+  int64_t product = 1;
+  for (int64_t dimension : spec.observation_shape) {
+    // Each bounded before multiplying, so the product cannot overflow.
+    if (dimension < 1 || dimension > spec.observation_size) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("spec.observation_shape: ", shape,
+                       ", expected dimensions in [1, observation_size ",
+                       spec.observation_size, "]"));
+    }
+    product *= dimension;
+    if (product > spec.observation_size) break;
+  }
+  if (product != spec.observation_size) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "spec.observation_shape: ", shape, " holds ",
+        product > spec.observation_size ? "more than " : "", product,
+        " values, expected observation_size ", spec.observation_size));
+  }
+  return absl::OkStatus();
+}
+
+absl::Status CheckObservationBuffer(const EnvSpec& spec,
+                                    absl::Span<double> observation) {
   if (observation.size() != static_cast<size_t>(spec.observation_size)) {
     return absl::InvalidArgumentError(absl::StrCat(
         spec.name, ": observation buffer holds ", observation.size(),

@@ -19,6 +19,15 @@ namespace vantage {
 struct EnvSpec {
   std::string name;
   int64_t observation_size = 0;  // observations are flat [observation_size]
+  // Images (pixels, MinAtar's grids): [channels, height, width], whose
+  // product is observation_size, for convolutional torsos; empty for
+  // vectors.
+  std::vector<int64_t> observation_shape;
+  // > 0: every observation value is an integer in [0, observation_high]
+  // (<= 255); such observations travel and are batched as uint8, are never
+  // normalised, and enter the networks divided by observation_high.
+  // 0: real-valued vectors, float32 on the wire, normalised.
+  int64_t observation_high = 0;
   bool discrete = false;
   // Continuous: the action dimension, with [action_low, action_high] bounds.
   // Discrete: the number of actions, and the bounds are empty.
@@ -32,6 +41,9 @@ struct EnvSpec {
 
   // "continuous:6" or "discrete:4".
   std::string ActionString() const;
+  bool byte_observations() const { return observation_high > 0; }
+  // "17" or "uint8 4x10x10".
+  std::string ObservationString() const;
 };
 
 struct StepResult {
@@ -83,6 +95,15 @@ class Environment {
 // Checks an action's size and finiteness against the spec (and, if
 // discrete, that it is an integer in range); the message names the entry.
 absl::Status CheckAction(const EnvSpec& spec, absl::Span<const double> action);
+
+// The observation fields agree: observation_shape is empty or three
+// positive dimensions whose product is observation_size, and
+// observation_high is in [0, 255]. The message names the field.
+absl::Status CheckObservationLayout(const EnvSpec& spec);
+
+// The observation buffer a Reset or Step writes holds the spec's size.
+absl::Status CheckObservationBuffer(const EnvSpec& spec,
+                                    absl::Span<double> observation);
 
 // What every Step checks before touching its physics: an episode is under
 // way (FailedPrecondition otherwise), the action passes CheckAction and the

@@ -3,6 +3,7 @@
 #include <ATen/ATen.h>
 #include <torch/nn/init.h>
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -36,19 +37,75 @@ at::Tensor TanhMlpImpl::forward(const at::Tensor& x) {
   return h;
 }
 
+namespace {
+
+// The torso's convolutions (registered first, so that an MLP network's
+// parameters keep their order) and the MLP after them: for images the
+// MLP is just the output layer.
+TanhMlp MakeBody(torch::nn::Module& network, const EnvSpec& spec,
+                 const NetworkConfig& config, int64_t outputs,
+                 double output_gain, ConvTorso& conv) {
+  const Torso torso = ResolveTorso(config.torso, spec).value();
+  if (torso == Torso::kMlp) {
+    return network.register_module(
+        "body",
+        TanhMlp(spec.observation_size, config.hidden, outputs, output_gain));
+  }
+  conv =
+      network.register_module("conv", ConvTorso(torso, spec.observation_shape));
+  return network.register_module(
+      "body",
+      TanhMlp(conv->features(), std::vector<int64_t>{}, outputs, output_gain));
+}
+
+at::Tensor Forward(const EnvSpec& spec, ConvTorso& conv, TanhMlp& body,
+                   const at::Tensor& observations) {
+  at::Tensor inputs = NetworkInputs(spec, observations);
+  if (!conv.is_empty()) inputs = conv->forward(inputs);
+  return body->forward(inputs);
+}
+
+EnvSpec FlatSpec(int64_t observation_size) {
+  EnvSpec spec;
+  spec.observation_size = observation_size;
+  return spec;
+}
+
+}  // namespace
+
+at::Tensor NetworkInputs(const EnvSpec& spec, const at::Tensor& observations) {
+  if (observations.scalar_type() != at::kByte) return observations;
+  return observations.to(at::kFloat)
+      .mul_(1.0 /
+            static_cast<double>(std::max<int64_t>(spec.observation_high, 1)));
+}
+
+at::Tensor ObservationTensor(const EnvSpec& spec, const double* values,
+                             int64_t rows) {
+  return at::from_blob(const_cast<double*>(values),
+                       {rows, spec.observation_size}, at::kDouble)
+      .to(spec.byte_observations() ? at::kByte : at::kFloat);
+}
+
+at::Tensor ObservationsForNetwork(const EnvSpec& spec,
+                                  const RunningMeanStd& normalizer,
+                                  const at::Tensor& observations, double clip) {
+  if (spec.byte_observations()) return observations;
+  return normalizer.Normalize(observations, clip);
+}
+
 PolicyNetworkImpl::PolicyNetworkImpl(const EnvSpec& spec,
                                      const NetworkConfig& config)
-    : discrete_(spec.discrete) {
-  body_ = register_module(
-      "body", TanhMlp(spec.observation_size, config.hidden, spec.action_size,
-                      /*output_gain=*/0.01));
+    : spec_(spec), discrete_(spec.discrete) {
+  body_ = MakeBody(*this, spec, config, spec.action_size,
+                   /*output_gain=*/0.01, conv_);
   if (!discrete_) {
     log_std_ = register_parameter("log_std", at::zeros({spec.action_size}));
   }
 }
 
 at::Tensor PolicyNetworkImpl::forward(const at::Tensor& observations) {
-  return body_->forward(observations);
+  return Forward(spec_, conv_, body_, observations);
 }
 
 at::Tensor PolicyNetworkImpl::LogProb(const at::Tensor& output,
@@ -84,14 +141,18 @@ at::Tensor PolicyNetworkImpl::Act(const at::Tensor& output, bool deterministic,
                                                  generator, output.options());
 }
 
-ValueNetworkImpl::ValueNetworkImpl(int64_t observation_size,
-                                   const NetworkConfig& config) {
-  body_ = register_module(
-      "body", TanhMlp(observation_size, config.hidden, 1, /*output_gain=*/1.0));
+ValueNetworkImpl::ValueNetworkImpl(const EnvSpec& spec,
+                                   const NetworkConfig& config)
+    : spec_(spec) {
+  body_ = MakeBody(*this, spec, config, 1, /*output_gain=*/1.0, conv_);
 }
 
+ValueNetworkImpl::ValueNetworkImpl(int64_t observation_size,
+                                   const NetworkConfig& config)
+    : ValueNetworkImpl(FlatSpec(observation_size), config) {}
+
 at::Tensor ValueNetworkImpl::forward(const at::Tensor& observations) {
-  return body_->forward(observations).squeeze(-1);
+  return Forward(spec_, conv_, body_, observations).squeeze(-1);
 }
 
 }  // namespace vantage

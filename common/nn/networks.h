@@ -3,9 +3,13 @@
 
 // The policy and value networks: tanh MLPs with orthogonal initialisation
 // (gain sqrt(2) for hidden layers, 0.01 for the policy's output, 1 for the
-// value's, zero biases), as in the baselines the paper builds on. A
-// continuous policy is a Gaussian with a state-independent log-std
-// (initially 0); a discrete one is categorical over logits.
+// value's, zero biases), as in the baselines the paper builds on, or for
+// images a convolutional torso (common/nn/torso.h) and then the output
+// layer. Each network has its own torso. A continuous policy is a Gaussian
+// with a state-independent log-std (initially 0); a discrete one is
+// categorical over logits. Byte observations (EnvSpec::observation_high)
+// enter as uint8 and are divided by observation_high here, so that
+// nothing before the network holds a float copy of them.
 
 #include <torch/nn/module.h>
 #include <torch/nn/modules/container/modulelist.h>
@@ -15,11 +19,14 @@
 #include <vector>
 
 #include "common/env/environment.h"
+#include "common/nn/running_mean_std.h"
+#include "common/nn/torso.h"
 
 namespace vantage {
 
 struct NetworkConfig {
-  std::vector<int64_t> hidden = {64, 64};
+  std::vector<int64_t> hidden = {64, 64};  // the MLP torso's layers
+  Torso torso = Torso::kAuto;
 };
 
 // Linear layers with tanh between them (none after the last).
@@ -34,6 +41,24 @@ class TanhMlpImpl : public torch::nn::Module {
 };
 TORCH_MODULE(TanhMlp);
 
+// The float inputs of the networks for `spec`: byte observations divided
+// by observation_high, float ones as they are.
+at::Tensor NetworkInputs(const EnvSpec& spec, const at::Tensor& observations);
+
+// `rows` observations as an environment wrote them (doubles, row-major) in
+// the dtype segments and batches hold: uint8 for byte observations (the
+// values are integers in range), float32 otherwise. [rows, size].
+at::Tensor ObservationTensor(const EnvSpec& spec, const double* values,
+                             int64_t rows);
+
+// Raw observations as both networks take them: real-valued ones
+// normalised by `normalizer` and clipped to +-clip; byte observations are
+// never normalised and stay uint8.
+at::Tensor ObservationsForNetwork(const EnvSpec& spec,
+                                  const RunningMeanStd& normalizer,
+                                  const at::Tensor& observations, double clip);
+
+// Both networks: `config.torso` must fit the spec (ResolveTorso).
 class PolicyNetworkImpl : public torch::nn::Module {
  public:
   PolicyNetworkImpl(const EnvSpec& spec, const NetworkConfig& config);
@@ -58,7 +83,9 @@ class PolicyNetworkImpl : public torch::nn::Module {
   const at::Tensor& log_std() const { return log_std_; }
 
  private:
+  EnvSpec spec_;
   bool discrete_;
+  ConvTorso conv_{nullptr};  // images only
   TanhMlp body_{nullptr};
   at::Tensor log_std_;
 };
@@ -66,11 +93,15 @@ TORCH_MODULE(PolicyNetwork);
 
 class ValueNetworkImpl : public torch::nn::Module {
  public:
+  ValueNetworkImpl(const EnvSpec& spec, const NetworkConfig& config);
+  // For float vectors of `observation_size`.
   ValueNetworkImpl(int64_t observation_size, const NetworkConfig& config);
   // V(s) [B].
   at::Tensor forward(const at::Tensor& observations);
 
  private:
+  EnvSpec spec_;
+  ConvTorso conv_{nullptr};
   TanhMlp body_{nullptr};
 };
 TORCH_MODULE(ValueNetwork);

@@ -17,7 +17,8 @@ std::string Shape(const at::Tensor& t) {
   return absl::StrCat("[", absl::StrJoin(t.sizes(), ", "), "]");
 }
 
-// `max_abs` bounds the magnitude of float32 fields (infinite: none).
+// `max_abs` bounds the magnitude of float32 and uint8 fields (infinite:
+// none).
 absl::Status Expect(const at::Tensor& t, const char* field,
                     std::vector<int64_t> shape, at::ScalarType dtype,
                     double max_abs = std::numeric_limits<double>::infinity()) {
@@ -49,6 +50,18 @@ absl::Status Expect(const at::Tensor& t, const char* field,
         return absl::InvalidArgumentError(absl::StrCat(
             "segment field ", field, " holds ", values[i], " at element ", i,
             ", beyond the limit of +-", max_abs));
+      }
+    }
+  }
+  if (dtype == at::kByte) {
+    const at::Tensor dense = t.contiguous();
+    const uint8_t* values = dense.data_ptr<uint8_t>();
+    for (int64_t i = 0, n = dense.numel(); i < n; ++i) {
+      if (values[i] > max_abs) {
+        return absl::InvalidArgumentError(
+            absl::StrCat("segment field ", field, " holds ",
+                         static_cast<int>(values[i]), " at element ", i,
+                         ", above the env's observation_high of ", max_abs));
       }
     }
   }
@@ -159,6 +172,11 @@ absl::Status ValidateSegment(const Segment& segment, const EnvSpec& spec,
         absl::StrCat("segment has ", steps, " steps, expected 1..", max_steps));
   }
   const int64_t obs = spec.observation_size;
+  const at::ScalarType observation_dtype =
+      spec.byte_observations() ? at::kByte : at::kFloat;
+  const double max_abs_observation =
+      spec.byte_observations() ? static_cast<double>(spec.observation_high)
+                               : limits.max_abs_observation;
   const int64_t act = spec.discrete ? 1 : spec.action_size;
   const int64_t truncations =
       segment.truncated.defined() && segment.truncated.numel() == steps &&
@@ -169,7 +187,7 @@ absl::Status ValidateSegment(const Segment& segment, const EnvSpec& spec,
            Expect(segment.rewards, "rewards", {steps}, at::kFloat,
                   limits.max_abs_reward),
            Expect(segment.observations, "observations", {steps + 1, obs},
-                  at::kFloat, limits.max_abs_observation),
+                  observation_dtype, max_abs_observation),
            Expect(segment.actions, "actions", {steps, act}, at::kFloat,
                   limits.max_abs_action),
            Expect(segment.terminated, "terminated", {steps}, at::kBool),
@@ -181,7 +199,7 @@ absl::Status ValidateSegment(const Segment& segment, const EnvSpec& spec,
   }
   if (absl::Status status =
           Expect(segment.final_observations, "final_observations",
-                 {truncations, obs}, at::kFloat, limits.max_abs_observation);
+                 {truncations, obs}, observation_dtype, max_abs_observation);
       !status.ok()) {
     return status;
   }

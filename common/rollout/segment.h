@@ -22,7 +22,8 @@ struct Segment {
   int64_t sequence = 0;
   int64_t policy_version = 0;
 
-  // T steps; all float32 unless noted.
+  // T steps; all float32 unless noted. Observations are uint8 instead when
+  // the spec says they are bytes (EnvSpec::observation_high > 0).
   at::Tensor observations;  // [T + 1, obs]: s_0 .. s_T, s_T after the last step
   at::Tensor actions;       // [T, act] (discrete: [T, 1] indices)
   at::Tensor rewards;       // [T]
@@ -62,7 +63,8 @@ struct ValueLimits {
 };
 
 // Everything a learner must check before a segment touches training data:
-// shapes against the spec, dtypes, finite numbers within `limits`, T in
+// shapes against the spec, dtypes, finite numbers within `limits` (byte
+// observations within the spec's observation_high), T in
 // [1, max_steps], one final observation per truncated step, no step both
 // terminated and truncated, and one finite episode return and length per
 // episode end (terminated or truncated step), each length >= 1, no longer

@@ -140,9 +140,8 @@ int RunEnvs(const std::vector<std::string>&) {
     absl::StatusOr<std::unique_ptr<Environment>> env = MakeEnvironment(name);
     if (!env.ok()) return Fail("envs", env.status(), kRuntimeError);
     const EnvSpec& spec = (*env)->spec();
-    std::printf("%s obs=[%ld] act=%s\n", name.c_str(),
-                static_cast<long>(spec.observation_size),
-                spec.ActionString().c_str());
+    std::printf("%s obs=[%s] act=%s\n", name.c_str(),
+                spec.ObservationString().c_str(), spec.ActionString().c_str());
   }
   return 0;
 }

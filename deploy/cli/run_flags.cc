@@ -28,6 +28,12 @@ ABSL_FLAG(int64_t, steps, 0, "environment steps of the run");
 ABSL_FLAG(int64_t, horizon, 0, "rollout length per environment and update");
 ABSL_FLAG(std::vector<std::string>, hidden, {},
           "hidden layer sizes of the policy and value networks");
+ABSL_FLAG(std::string, torso, "",
+          "what both networks put before their output layer: auto (mlp for "
+          "vectors; for images minatar below 36x36 pixels, else nature) | "
+          "mlp (tanh layers of --hidden) | minatar (MinAtar's net: 16 3x3 "
+          "convolutions, 128 units) | nature (the DQN net: 32 8x8/4, 64 "
+          "4x4/2, 64 3x3/1, 512 units)");
 ABSL_FLAG(bool, scale_rewards, false,
           "divide rewards by the running std of discounted returns");
 ABSL_FLAG(int64_t, segment_length, 0,

@@ -9,6 +9,7 @@
 #include <utility>
 
 #include "absl/strings/str_cat.h"
+#include "common/nn/networks.h"
 #include "learner/algorithms/gradient_step.h"
 #include "learner/archive_io.h"
 
@@ -51,7 +52,8 @@ at::Tensor Ex2Bonus::Inputs(const std::vector<Rollout>& rollouts) const {
   std::vector<at::Tensor> rows;
   for (const Rollout& rollout : rollouts) {
     const int64_t steps = rollout.rewards.size(0);
-    at::Tensor states = rollout.observations.slice(0, 0, steps);
+    at::Tensor states =
+        NetworkInputs(spec_, rollout.observations.slice(0, 0, steps));
     if (!config_.use_actions) {
       rows.push_back(states);
       continue;

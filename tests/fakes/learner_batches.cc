@@ -25,9 +25,10 @@ LearnerConfig TestLearnerConfig(const EnvSpec& spec,
   return config;
 }
 
-std::unique_ptr<ActorCore> MakeTestActor(int64_t segment_length) {
+std::unique_ptr<ActorCore> MakeTestActor(int64_t segment_length,
+                                         const std::string& env) {
   ActorConfig config;
-  config.env = "Hopper";
+  config.env = env;
   config.num_envs = kTestEnvs;
   config.segment_length = segment_length;
   config.seed = 9;

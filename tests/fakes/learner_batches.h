@@ -22,7 +22,8 @@ inline constexpr int kTestEnvs = 2;
 LearnerConfig TestLearnerConfig(const EnvSpec& spec,
                                 const std::string& algorithm);
 
-std::unique_ptr<ActorCore> MakeTestActor(int64_t segment_length = kTestHorizon);
+std::unique_ptr<ActorCore> MakeTestActor(int64_t segment_length = kTestHorizon,
+                                         const std::string& env = "Hopper");
 
 // One batch of segments acted by `learner`'s current weights.
 std::vector<Segment> ActOneBatch(ActorCore& actor, LearnerCore& learner);

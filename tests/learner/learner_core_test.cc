@@ -235,6 +235,51 @@ TEST(BufferBudgetTest, StreamsThatNeverCompleteCannotGrowTheBuffers) {
   EXPECT_EQ(stats.evicted_steps, learner->stitcher().stats().evicted_steps);
 }
 
+// Pixel-style observations stay uint8 from the environment to the
+// learner's batches, are never normalised, and train a convolutional
+// network; a checkpoint continues it exactly.
+TEST(ByteObservationsTest, TravelAsBytesAndTrainAConvolutionalNetwork) {
+  for (const std::string env : {"MinAtarBreakout", "FirstPersonMaze"}) {
+    SCOPED_TRACE(env);
+    auto actor = MakeTestActor(60, env);
+    ASSERT_TRUE(actor->spec().byte_observations());
+    LearnerConfig config = TestLearnerConfig(actor->spec(), "a2c");
+    auto learner = *LearnerCore::Create(config);
+    const PolicyWeights initial = learner->CurrentWeights();
+    // The convolutions come first.
+    EXPECT_EQ(initial.parameters[0].dim(), 4);
+    const std::vector<Segment> batch = ActOneBatch(*actor, *learner);
+    for (const Segment& segment : batch) {
+      EXPECT_EQ(segment.observations.scalar_type(), at::kByte);
+      EXPECT_EQ(segment.final_observations.scalar_type(), at::kByte);
+      EXPECT_GT(segment.observations.max().item<int>(), 0);
+    }
+    const UpdateStats stats = UpdateWith(*learner, batch);
+    EXPECT_FALSE(stats.rolled_back) << stats.rollback_reason;
+    const PolicyWeights trained = learner->CurrentWeights();
+    EXPECT_FALSE(trained.parameters[0].equal(initial.parameters[0]));
+    EXPECT_EQ(trained.normalizer_count, initial.normalizer_count);
+    EXPECT_TRUE(trained.normalizer_mean.equal(initial.normalizer_mean));
+
+    const std::string path =
+        std::string(::testing::TempDir()) + "/bytes_" + env + ".pt";
+    ASSERT_TRUE(WriteCheckpoint(path, *learner, {}).ok());
+    absl::StatusOr<std::unique_ptr<LearnerCore>> restored =
+        ReadCheckpoint(path, config);
+    ASSERT_TRUE(restored.ok()) << restored.status();
+    const std::vector<Segment> next = ActOneBatch(*actor, *learner);
+    UpdateWith(*learner, next);
+    UpdateWith(**restored, next);
+    ExpectSameWeights(*learner, **restored);
+  }
+  // A torso that cannot take the observations is refused up front.
+  auto actor = MakeTestActor(60, "MinAtarBreakout");
+  LearnerConfig config = TestLearnerConfig(actor->spec(), "a2c");
+  config.network.torso = Torso::kNature;
+  EXPECT_THAT(LearnerCore::Create(config).status().message(),
+              HasSubstr("torso nature needs frames of at least 36x36"));
+}
+
 TEST(LearnerConfigTest, RefusesBadLimits) {
   auto actor = MakeTestActor();
   LearnerConfig config = TestLearnerConfig(actor->spec(), "ppo");

@@ -330,6 +330,39 @@ TEST(SegmentWireTest, NonContiguousFieldsRoundTrip) {
   ExpectSameSegment(segment, *back);
 }
 
+// Byte observations travel as one byte per value and validate against a
+// byte spec exactly as they were sent.
+TEST(SegmentWireTest, ByteObservationsRoundTripAsBytes) {
+  EnvSpec spec;
+  spec.name = "Grid";
+  spec.observation_size = 2 * 3 * 3;
+  spec.observation_shape = {2, 3, 3};
+  spec.observation_high = 255;
+  spec.discrete = true;
+  spec.action_size = 4;
+  Segment s = RealisticSegment();
+  s.observations = at::randint(0, 256, {17, 18}, at::kByte);
+  s.final_observations = at::randint(0, 256, {1, 18}, at::kByte);
+  s.actions = at::randint(0, 4, {16, 1}).to(at::kFloat);
+  s.episode_lengths = {100, 7};
+  pb::Segment proto;
+  SegmentToProto(s, &proto);
+  EXPECT_EQ(proto.observations().data().size(), 17 * 18);
+  EXPECT_LE(static_cast<int64_t>(proto.ByteSizeLong()),
+            MaxSegmentMessageBytes(spec, 16));
+  absl::StatusOr<Segment> back = SegmentOverWire(s);
+  ASSERT_TRUE(back.ok()) << back.status();
+  ExpectSameSegment(s, *back);
+  EXPECT_EQ(back->observations.scalar_type(), at::kByte);
+  EXPECT_TRUE(ValidateSegment(*back, spec, 16).ok())
+      << ValidateSegment(*back, spec, 16);
+  // The float segment of the same values is not what a byte spec takes.
+  Segment floats = *back;
+  floats.observations = floats.observations.to(at::kFloat);
+  EXPECT_EQ(ValidateSegment(floats, spec, 16).message(),
+            "segment field observations has dtype Float, expected Byte");
+}
+
 TEST(SegmentWireTest, RefusesWrongDtypeForEachField) {
   struct Case {
     std::function<void(Segment&)> corrupt;
@@ -337,7 +370,7 @@ TEST(SegmentWireTest, RefusesWrongDtypeForEachField) {
   };
   const std::vector<Case> cases = {
       {[](Segment& s) { s.observations = s.observations.to(at::kDouble); },
-       "segment.observations: dtype float64, expected float32"},
+       "segment.observations: dtype float64, expected float32 or uint8"},
       {[](Segment& s) { s.actions = s.actions.to(at::kLong); },
        "segment.actions: dtype int64, expected float32"},
       {[](Segment& s) { s.rewards = s.rewards.to(at::kDouble); },
@@ -349,7 +382,8 @@ TEST(SegmentWireTest, RefusesWrongDtypeForEachField) {
       {[](Segment& s) {
          s.final_observations = s.final_observations.to(at::kDouble);
        },
-       "segment.final_observations: dtype float64, expected float32"},
+       "segment.final_observations: dtype float64, expected float32 or "
+       "uint8"},
       {[](Segment& s) {
          s.behaviour_log_probs = s.behaviour_log_probs.to(at::kBool);
        },
@@ -622,7 +656,12 @@ TEST(EnvSpecWireTest, RoundTrips) {
   discrete.discrete = true;
   discrete.action_size = 2;
   discrete.max_episode_steps = 0;
-  for (const EnvSpec& spec : {continuous, discrete}) {
+  EnvSpec pixels = discrete;
+  pixels.name = "Pixels";
+  pixels.observation_size = 3 * 42 * 40;
+  pixels.observation_shape = {3, 42, 40};
+  pixels.observation_high = 255;
+  for (const EnvSpec& spec : {continuous, discrete, pixels}) {
     absl::StatusOr<EnvSpec> back = SpecOverWire(spec);
     ASSERT_TRUE(back.ok()) << back.status();
     EXPECT_TRUE(CheckSameSpec(spec, *back).ok()) << CheckSameSpec(spec, *back);
@@ -630,6 +669,8 @@ TEST(EnvSpecWireTest, RoundTrips) {
     EXPECT_EQ(back->action_low, spec.action_low);
     EXPECT_EQ(back->action_high, spec.action_high);
     EXPECT_EQ(back->control_dt, spec.control_dt);
+    EXPECT_EQ(back->observation_shape, spec.observation_shape);
+    EXPECT_EQ(back->observation_high, spec.observation_high);
   }
 }
 
@@ -684,6 +725,31 @@ TEST(EnvSpecWireTest, RefusesImpossibleSpecs) {
        "spec.control_dt: -0.01, expected >= 0"},
       {[](EnvSpec& s) { s.control_dt = INFINITY; },
        "spec.control_dt: inf, expected >= 0"},
+      {[](EnvSpec& s) { s.observation_shape = {17}; },
+       "spec.observation_shape: 17, expected [channels, height, width] or "
+       "nothing"},
+      {[](EnvSpec& s) {
+         s.observation_shape = {1, 4, 4};
+       },
+       "spec.observation_shape: 1x4x4 holds 16 values, expected "
+       "observation_size 17"},
+      {[](EnvSpec& s) {
+         s.observation_shape = {17, 17, 17};
+       },
+       "spec.observation_shape: 17x17x17 holds more than 289 values, "
+       "expected observation_size 17"},
+      {[](EnvSpec& s) {
+         s.observation_shape = {17, -1, -1};
+       },
+       "spec.observation_shape: 17x-1x-1, expected dimensions in [1, "
+       "observation_size 17]"},
+      {[](EnvSpec& s) {
+         s.observation_shape = {1, 2, 3, 4};
+       },
+       "spec.observation_shape: 4 dimensions, expected none or 3"},
+      {[](EnvSpec& s) { s.observation_high = 256; },
+       "spec.observation_high: 256, expected 0 (real values) or 1..255 "
+       "(bytes)"},
   };
   for (const Case& c : cases) {
     EnvSpec spec = ContinuousSpec();
@@ -726,6 +792,12 @@ TEST(EnvSpecWireTest, CheckSameSpecNamesTheFirstDifference) {
        "env spec differs in max_episode_steps: expected 1000, got 0"},
       {[](EnvSpec& s) { s.control_dt = 0.01; },
        "env spec differs in control_dt: expected 0.05, got 0.01"},
+      {[](EnvSpec& s) {
+         s.observation_shape = {17, 1, 1};
+       },
+       "env spec differs in observation_shape: expected none, got 17x1x1"},
+      {[](EnvSpec& s) { s.observation_high = 1; },
+       "env spec differs in observation_high: expected 0, got 1"},
       // Several differences: the first in declaration order is named.
       {[](EnvSpec& s) {
          s.control_dt = 0.01;

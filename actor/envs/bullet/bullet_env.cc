@@ -74,10 +74,9 @@ void BulletEnv::Begin(uint64_t seed) {
 }
 
 absl::Status BulletEnv::Reset(uint64_t seed, absl::Span<double> observation) {
-  if (observation.size() != static_cast<size_t>(spec_.observation_size)) {
-    return absl::InvalidArgumentError(absl::StrCat(
-        spec_.name, ": observation buffer holds ", observation.size(),
-        " values, expected ", spec_.observation_size));
+  if (absl::Status status = CheckObservationBuffer(spec_, observation);
+      !status.ok()) {
+    return status;
   }
   Begin(seed);
   Observe(*world_, observation.data());

@@ -157,6 +157,8 @@ std::array<double, 2> FirstPersonMaze::Goal() {
 FirstPersonMaze::FirstPersonMaze() : layout_(TheLayout()) {
   spec_.name = "FirstPersonMaze";
   spec_.observation_size = 3 * kFrameSize * kFrameSize;
+  spec_.observation_shape = {3, kFrameSize, kFrameSize};
+  spec_.observation_high = 255;
   spec_.discrete = true;
   spec_.action_size = kActions;
   spec_.max_episode_steps = kEpisodeSteps;
@@ -170,10 +172,9 @@ FirstPersonMaze::FirstPersonMaze() : layout_(TheLayout()) {
 
 absl::Status FirstPersonMaze::Reset(uint64_t seed,
                                     absl::Span<double> observation) {
-  if (observation.size() != pixels_.size()) {
-    return absl::InvalidArgumentError(
-        absl::StrCat(spec_.name, ": observation buffer holds ",
-                     observation.size(), " values, expected ", pixels_.size()));
+  if (absl::Status status = CheckObservationBuffer(spec_, observation);
+      !status.ok()) {
+    return status;
   }
   std::mt19937_64 random(seed);
   const auto& centre = layout_.room_centres[std::uniform_int_distribution<int>(

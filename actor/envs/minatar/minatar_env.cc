@@ -49,6 +49,9 @@ class MinAtarEnv : public Environment {
       : factory_(std::move(factory)), game_(factory_()) {
     spec_.name = std::move(name);
     spec_.observation_size = game_->channels() * kMinAtarCells;
+    spec_.observation_shape = {game_->channels(), kMinAtarGridSize,
+                               kMinAtarGridSize};
+    spec_.observation_high = 1;
     spec_.discrete = true;
     spec_.action_size = kMinAtarActions;
     spec_.max_episode_steps = kMaxEpisodeSteps;
@@ -65,10 +68,9 @@ class MinAtarEnv : public Environment {
   std::unique_ptr<MinAtarGame> MakeGame() const { return factory_(); }
 
   absl::Status Reset(uint64_t seed, absl::Span<double> observation) override {
-    if (observation.size() != grid_.size()) {
-      return absl::InvalidArgumentError(
-          absl::StrCat(spec_.name, ": observation buffer holds ",
-                       observation.size(), " values, expected ", grid_.size()));
+    if (absl::Status status = CheckObservationBuffer(spec_, observation);
+        !status.ok()) {
+      return status;
     }
     seed_ = seed;
     random_.seed(seed);

@@ -88,10 +88,9 @@ absl::StatusOr<Frame> MujocoEnv::Render(int width, int height) {
 }
 
 absl::Status MujocoEnv::Reset(uint64_t seed, absl::Span<double> observation) {
-  if (observation.size() != static_cast<size_t>(spec_.observation_size)) {
-    return absl::InvalidArgumentError(absl::StrCat(
-        spec_.name, ": observation buffer holds ", observation.size(),
-        " values, expected ", spec_.observation_size));
+  if (absl::Status status = CheckObservationBuffer(spec_, observation);
+      !status.ok()) {
+    return status;
   }
   rng_.seed(seed);
   absl::Status status = GuardMujoco([&] {

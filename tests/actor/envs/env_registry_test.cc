@@ -100,11 +100,20 @@ TEST(EnvRegistryTest, EveryRegisteredEnvStepsWithFiniteValues) {
     EXPECT_EQ(spec.action_low.size(),
               spec.discrete ? 0u : static_cast<size_t>(spec.action_size));
     EXPECT_GT(spec.control_dt, 0.0);
+    EXPECT_TRUE(CheckObservationLayout(spec).ok())
+        << CheckObservationLayout(spec);
     StepResult last;
     for (const auto& observation : Episode(*env, 3, 200, &last)) {
       ASSERT_EQ(observation.size(), static_cast<size_t>(spec.observation_size));
-      for (double value : observation)
+      for (double value : observation) {
         ASSERT_TRUE(std::isfinite(value)) << name;
+        // Byte observations are what a uint8 holds exactly.
+        if (spec.byte_observations()) {
+          ASSERT_EQ(value, std::floor(value)) << name;
+          ASSERT_GE(value, 0) << name;
+          ASSERT_LE(value, spec.observation_high) << name;
+        }
+      }
     }
     EXPECT_TRUE(std::isfinite(last.reward)) << name;
   }

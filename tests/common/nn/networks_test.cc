@@ -87,5 +87,119 @@ TEST(NetworksTest, ValueNetworkShape) {
   EXPECT_EQ(value->forward(at::randn({7, 5})).sizes(), at::IntArrayRef({7}));
 }
 
+EnvSpec ImageSpec(int64_t channels, int64_t side, int64_t high) {
+  EnvSpec spec;
+  spec.name = "Image";
+  spec.observation_size = channels * side * side;
+  spec.observation_shape = {channels, side, side};
+  spec.observation_high = high;
+  spec.discrete = true;
+  spec.action_size = 6;
+  return spec;
+}
+
+int64_t ParameterCount(torch::nn::Module& module) {
+  int64_t count = 0;
+  for (const at::Tensor& p : module.parameters()) count += p.numel();
+  return count;
+}
+
+TEST(TorsoTest, NamesParseAndAutoPicksByTheObservations) {
+  for (Torso torso :
+       {Torso::kAuto, Torso::kMlp, Torso::kMinAtar, Torso::kNature}) {
+    EXPECT_EQ(ParseTorso(TorsoName(torso)).value(), torso);
+  }
+  EXPECT_EQ(ParseTorso("resnet").status().message(),
+            "unknown torso \"resnet\"; valid: auto, mlp, minatar, nature");
+  EXPECT_EQ(ResolveTorso(Torso::kAuto, ContinuousSpec()).value(), Torso::kMlp);
+  EXPECT_EQ(ResolveTorso(Torso::kAuto, ImageSpec(4, 10, 1)).value(),
+            Torso::kMinAtar);
+  EXPECT_EQ(ResolveTorso(Torso::kAuto, ImageSpec(3, 35, 255)).value(),
+            Torso::kMinAtar);
+  EXPECT_EQ(ResolveTorso(Torso::kAuto, ImageSpec(3, 36, 255)).value(),
+            Torso::kNature);
+  EXPECT_EQ(ResolveTorso(Torso::kMlp, ImageSpec(3, 42, 255)).value(),
+            Torso::kMlp);
+  EXPECT_EQ(
+      ResolveTorso(Torso::kNature, ImageSpec(4, 10, 1)).status().message(),
+      "torso nature needs frames of at least 36x36 pixels; Image has "
+      "4x10x10 (use --torso=minatar)");
+  EXPECT_EQ(ResolveTorso(Torso::kMinAtar, ContinuousSpec()).status().message(),
+            "torso minatar needs image observations; test has vectors of 5 "
+            "(use --torso=mlp)");
+}
+
+// The published layer sizes, counted: MinAtar's net on Breakout's 4x10x10
+// and the DQN net on the maze's 3x42x42 frames.
+TEST(TorsoTest, ConvolutionalTorsosHaveThePublishedLayers) {
+  at::manual_seed(0);
+  PolicyNetwork minatar(ImageSpec(4, 10, 1), NetworkConfig{});
+  EXPECT_EQ(ParameterCount(*minatar),
+            (4 * 16 * 9 + 16) + (16 * 8 * 8 * 128 + 128) + (128 * 6 + 6));
+  ValueNetwork minatar_value(ImageSpec(4, 10, 1), NetworkConfig{});
+  EXPECT_EQ(ParameterCount(*minatar_value),
+            (4 * 16 * 9 + 16) + (16 * 8 * 8 * 128 + 128) + (128 + 1));
+  PolicyNetwork nature(ImageSpec(3, 42, 255), NetworkConfig{});
+  EXPECT_EQ(ParameterCount(*nature),
+            (3 * 32 * 64 + 32) + (32 * 64 * 16 + 64) + (64 * 64 * 9 + 64) +
+                (64 * 1 * 1 * 512 + 512) + (512 * 6 + 6));
+  // Convolutions orthogonal with gain sqrt(2) over their flattened inputs,
+  // zero biases; the output layer keeps the policy's 0.01.
+  const auto parameters = nature->named_parameters();
+  const at::Tensor conv = parameters["conv.layers.0.weight"].reshape({32, -1});
+  EXPECT_TRUE(
+      at::allclose(conv.matmul(conv.t()), 2.0 * at::eye(32), 1e-4, 1e-4));
+  EXPECT_EQ(parameters["conv.layers.0.bias"].abs().sum().item<float>(), 0.0f);
+  const at::Tensor out = parameters["body.layers.0.weight"];
+  EXPECT_TRUE(at::allclose(out.matmul(out.t()), 1e-4 * at::eye(6), 1e-7, 1e-7));
+  // A --hidden for the MLP changes nothing of a convolutional network.
+  at::manual_seed(0);
+  EXPECT_EQ(
+      ParameterCount(*PolicyNetwork(ImageSpec(4, 10, 1), NetworkConfig{{7}})),
+      ParameterCount(*minatar));
+}
+
+// Byte observations enter as uint8 and mean value / observation_high: the
+// network gives what it gives on the scaled floats.
+TEST(TorsoTest, ByteObservationsAreScaledByTheirHigh) {
+  for (Torso torso : {Torso::kMlp, Torso::kNature}) {
+    at::manual_seed(3);
+    const EnvSpec spec = ImageSpec(3, 36, 255);
+    PolicyNetwork policy(spec, NetworkConfig{{32}, torso});
+    ValueNetwork value(spec, NetworkConfig{{32}, torso});
+    const at::Tensor bytes =
+        at::randint(0, 256, {5, spec.observation_size}, at::kByte);
+    const at::Tensor floats = bytes.to(at::kFloat) / 255.0;
+    const at::Tensor logits = policy->forward(bytes);
+    ASSERT_EQ(logits.sizes(), at::IntArrayRef({5, 6}));
+    EXPECT_TRUE(at::allclose(logits, policy->forward(floats), 1e-6, 1e-6));
+    EXPECT_TRUE(at::allclose(value->forward(bytes), value->forward(floats),
+                             1e-6, 1e-6));
+    // Each sample is its own: a batch of one gives the row.
+    EXPECT_TRUE(at::allclose(policy->forward(bytes.slice(0, 2, 3)),
+                             logits.slice(0, 2, 3), 1e-6, 1e-6));
+  }
+  // Byte observations are never normalised; real ones are.
+  RunningMeanStd normalizer(3);
+  ASSERT_TRUE(normalizer.Update(at::full({1, 3}, 5.0f)).ok());
+  EnvSpec bytes = ImageSpec(3, 1, 1);
+  const at::Tensor grid = at::ones({1, 3}, at::kByte);
+  EXPECT_TRUE(
+      at::equal(ObservationsForNetwork(bytes, normalizer, grid, 10), grid));
+  EnvSpec reals = bytes;
+  reals.observation_high = 0;
+  const at::Tensor x = at::full({1, 3}, 5.0f);
+  EXPECT_TRUE(at::equal(ObservationsForNetwork(reals, normalizer, x, 10),
+                        normalizer.Normalize(x, 10)));
+  // What an environment wrote, in the dtype segments hold.
+  const double written[] = {0, 1, 1, 255, 0, 7};
+  EXPECT_TRUE(
+      at::equal(ObservationTensor(ImageSpec(3, 1, 255), written, 2),
+                at::tensor({0, 1, 1, 255, 0, 7}, at::kByte).reshape({2, 3})));
+  EXPECT_TRUE(
+      at::equal(ObservationTensor(reals, written, 2),
+                at::tensor({0, 1, 1, 255, 0, 7}, at::kFloat).reshape({2, 3})));
+}
+
 }  // namespace
 }  // namespace vantage

@@ -121,6 +121,34 @@ TEST(SegmentTest, ValuesBeyondTheLimitsAreNamed) {
               HasSubstr("max_abs_reward must be > 0"));
 }
 
+TEST(SegmentTest, ByteObservationsAreBytesWithinTheSpecsHigh) {
+  EnvSpec spec = Spec();
+  spec.observation_shape = {3, 1, 1};
+  spec.observation_high = 1;
+  Segment s = ValidSegment();
+  s.observations = at::ones({5, 3}, at::kByte);
+  s.final_observations = at::zeros({1, 3}, at::kByte);
+  EXPECT_TRUE(ValidateSegment(s, spec, 128).ok())
+      << ValidateSegment(s, spec, 128);
+  // Float observations where the spec says bytes, and the other way round.
+  EXPECT_EQ(ValidateSegment(ValidSegment(), spec, 128).message(),
+            "segment field observations has dtype Float, expected Byte");
+  EXPECT_EQ(ValidateSegment(s, Spec(), 128).message(),
+            "segment field observations has dtype Byte, expected Float");
+  // Tensors share storage when a Segment is copied: change clones only.
+  Segment above = s;
+  above.observations = s.observations.clone();
+  above.observations[3][2] = 2;
+  EXPECT_EQ(ValidateSegment(above, spec, 128).message(),
+            "segment field observations holds 2 at element 11, above the "
+            "env's observation_high of 1");
+  above = s;
+  above.final_observations = s.final_observations.clone();
+  above.final_observations[0][0] = 255;
+  EXPECT_THAT(ValidateSegment(above, spec, 128).message(),
+              HasSubstr("final_observations holds 255 at element 0"));
+}
+
 TEST(SegmentTest, EpisodesMustMatchTheEpisodeEnds) {
   struct Case {
     std::function<void(Segment&)> change;

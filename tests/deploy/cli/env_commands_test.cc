@@ -22,6 +22,10 @@ TEST(EnvsCommandTest, ListsEveryTaskWithItsShapes) {
   EXPECT_THAT(outcome.out, HasSubstr("Ant obs=[27] act=continuous:8"));
   EXPECT_THAT(outcome.out,
               HasSubstr("InvertedPendulum obs=[4] act=continuous:1"));
+  EXPECT_THAT(outcome.out,
+              HasSubstr("MinAtarBreakout obs=[uint8 4x10x10] act=discrete:6"));
+  EXPECT_THAT(outcome.out,
+              HasSubstr("FirstPersonMaze obs=[uint8 3x42x42] act=discrete:4"));
 }
 
 TEST(RolloutCommandTest, SameSeedSameDigestOtherSeedOther) {
