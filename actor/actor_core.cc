@@ -50,8 +50,8 @@ absl::Status ActorConfig::Validate() const {
 absl::StatusOr<std::unique_ptr<ActorCore>> ActorCore::Create(
     const ActorConfig& config) {
   if (absl::Status status = config.Validate(); !status.ok()) return status;
-  absl::StatusOr<std::unique_ptr<VectorEnv>> envs =
-      VectorEnv::Create(config.env, config.num_envs, config.seed);
+  absl::StatusOr<std::unique_ptr<VectorEnv>> envs = VectorEnv::Create(
+      config.env, config.num_envs, config.seed, config.env_options);
   if (!envs.ok()) return envs.status();
   if (absl::StatusOr<Torso> torso =
           ResolveTorso(config.network.torso, (*envs)->spec());

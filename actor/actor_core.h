@@ -21,6 +21,7 @@ namespace vantage {
 
 struct ActorConfig {
   std::string env;
+  EnvOptions env_options;
   int num_envs = 1;
   int64_t segment_length = 128;
   uint64_t seed = 0;

@@ -21,14 +21,16 @@ absl::string_view AsBytes(const std::vector<uint8_t>& flags) {
 }  // namespace
 
 absl::StatusOr<std::unique_ptr<VectorEnv>> VectorEnv::Create(
-    absl::string_view name, int count, uint64_t seed) {
+    absl::string_view name, int count, uint64_t seed,
+    const EnvOptions& options) {
   if (count < 1) {
     return absl::InvalidArgumentError(
         absl::StrCat("a vector of environments needs count >= 1, got ", count));
   }
   std::vector<std::unique_ptr<Environment>> envs;
   for (int i = 0; i < count; ++i) {
-    absl::StatusOr<std::unique_ptr<Environment>> env = MakeEnvironment(name);
+    absl::StatusOr<std::unique_ptr<Environment>> env =
+        MakeEnvironment(name, options);
     if (!env.ok()) return env.status();
     envs.push_back(std::move(*env));
   }

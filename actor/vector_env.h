@@ -11,6 +11,7 @@
 #include "absl/status/statusor.h"
 #include "absl/strings/string_view.h"
 #include "absl/types/span.h"
+#include "actor/envs/env_registry.h"
 #include "common/env/environment.h"
 
 namespace vantage {
@@ -32,7 +33,8 @@ class VectorEnv {
   // Environment `name` (see MakeEnvironment) x `count`; episode seeds are
   // drawn from `seed`, so the same seed replays the same episodes.
   static absl::StatusOr<std::unique_ptr<VectorEnv>> Create(
-      absl::string_view name, int count, uint64_t seed);
+      absl::string_view name, int count, uint64_t seed,
+      const EnvOptions& options = {});
 
   const EnvSpec& spec() const { return envs_[0]->spec(); }
   int size() const { return static_cast<int>(envs_.size()); }

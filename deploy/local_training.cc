@@ -28,6 +28,7 @@ absl::Status RunLocalTraining(
     const std::atomic<bool>* stop) {
   ActorConfig actor_config;
   actor_config.env = config.env;
+  actor_config.env_options = config.env_options;
   actor_config.num_envs = config.num_envs;
   const int64_t segment_length = config.segment_length > 0
                                      ? config.segment_length

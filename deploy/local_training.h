@@ -8,6 +8,7 @@
 
 #include "absl/status/status.h"
 #include "actor/actor_core.h"
+#include "actor/envs/env_registry.h"
 #include "deploy/run_directory.h"
 #include "learner/learner_core.h"
 
@@ -15,6 +16,7 @@ namespace vantage {
 
 struct LocalTrainingConfig {
   std::string env = "InvertedPendulum";
+  EnvOptions env_options;
   int num_envs = 1;
   int64_t total_env_steps = 150000;
   uint64_t seed = 0;

@@ -12,6 +12,7 @@
 #include "absl/strings/str_replace.h"
 #include "absl/strings/str_split.h"
 #include "common/advantage/advantage_config.h"
+#include "common/env/frame_stack.h"
 #include "learner/algorithms/algorithm.h"
 #include "learner/exploration/ex2_config.h"
 #include "proto/flat_run_config.pb.h"
@@ -239,6 +240,11 @@ absl::StatusOr<pb::RunConfig> ResolveRunConfig(const pb::RunConfig& given) {
                                          "' is not one of auto, mlp, minatar, "
                                          "nature"));
   }
+  if (!t.has_frame_stack()) t.set_frame_stack(local.env_options.frame_stack);
+  if (t.frame_stack() < 1 || t.frame_stack() > kMaxFrameStack) {
+    return Invalid("frame_stack",
+                   absl::StrCat("must be in [1, ", kMaxFrameStack, "]"));
+  }
   if (!t.has_scale_rewards()) t.set_scale_rewards(local.learner.scale_rewards);
   if (!t.has_segment_length()) {
     t.set_segment_length(DefaultSegmentLength(t.horizon()));
@@ -336,10 +342,20 @@ std::string RunConfigToJson(const pb::RunConfig& config) {
   return json;
 }
 
+EnvOptions EnvOptionsOf(const pb::RunConfig& resolved) {
+  EnvOptions options;
+  // Configs from before frame stacking existed have none.
+  if (resolved.training().has_frame_stack()) {
+    options.frame_stack = resolved.training().frame_stack();
+  }
+  return options;
+}
+
 LocalTrainingConfig ToLocalTrainingConfig(const pb::RunConfig& c) {
   const pb::TrainingSettings& t = c.training();
   LocalTrainingConfig local;
   local.env = t.env();
+  local.env_options = EnvOptionsOf(c);
   local.num_envs = t.envs();
   local.total_env_steps = t.steps();
   local.seed = t.seed();

@@ -35,6 +35,8 @@ std::string RunConfigDifference(const pb::RunConfig& held,
 
 // The local training a resolved config describes.
 LocalTrainingConfig ToLocalTrainingConfig(const pb::RunConfig& resolved);
+// How the run wraps its environments (every maker of its env uses this).
+EnvOptions EnvOptionsOf(const pb::RunConfig& resolved);
 
 }  // namespace vantage
 

@@ -28,7 +28,7 @@ absl::StatusOr<TrainedPolicy> LoadCheckpointFile(const std::string& path) {
   absl::StatusOr<pb::RunConfig> config = ResolveRunConfig(*parsed);
   if (!config.ok()) return config.status();
   absl::StatusOr<std::unique_ptr<Environment>> env =
-      MakeEnvironment(config->training().env());
+      MakeEnvironment(config->training().env(), EnvOptionsOf(*config));
   if (!env.ok()) return env.status();
   const LocalTrainingConfig local = ToLocalTrainingConfig(*config);
   absl::StatusOr<std::unique_ptr<LearnerCore>> learner =

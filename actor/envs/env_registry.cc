@@ -18,6 +18,7 @@
 #include "actor/envs/mujoco/pendulum_envs.h"
 #include "actor/envs/mujoco/point_maze_env.h"
 #include "actor/envs/mujoco/twod_maze_env.h"
+#include "common/env/frame_stack.h"
 #include "common/env/time_limit.h"
 
 namespace vantage {
@@ -56,7 +57,7 @@ const std::map<std::string, Factory>& Factories() {
 }  // namespace
 
 absl::StatusOr<std::unique_ptr<Environment>> MakeEnvironment(
-    absl::string_view name) {
+    absl::string_view name, const EnvOptions& options) {
   absl::StatusOr<std::unique_ptr<Environment>> env;
   absl::string_view path = name;
   if (absl::ConsumePrefix(&path, "mjcf:")) {
@@ -76,7 +77,9 @@ absl::StatusOr<std::unique_ptr<Environment>> MakeEnvironment(
     env = factory->second();
   }
   if (!env.ok()) return env.status();
-  return std::unique_ptr<Environment>(new TimeLimit(std::move(*env)));
+  auto limited = std::make_unique<TimeLimit>(std::move(*env));
+  if (options.frame_stack == 1) return limited;
+  return FrameStack::Wrap(std::move(limited), options.frame_stack);
 }
 
 std::vector<std::string> RegisteredEnvironments() {

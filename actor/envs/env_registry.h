@@ -1,6 +1,7 @@
 #ifndef VANTAGE_ACTOR_ENVS_ENV_REGISTRY_H_
 #define VANTAGE_ACTOR_ENVS_ENV_REGISTRY_H_
 
+#include <cstdint>
 #include <memory>
 #include <string>
 #include <vector>
@@ -11,10 +12,18 @@
 
 namespace vantage {
 
+// How a run wraps every environment it makes.
+struct EnvOptions {
+  // > 1: each observation is the last `frame_stack` ones, oldest first
+  // (see common/env/frame_stack.h); 1: as the environment gives them.
+  int64_t frame_stack = 1;
+};
+
 // A registered name ("HalfCheetah", ...) or "mjcf:/path/model.xml", wrapped
-// in its time limit. An unknown name is an error that lists the valid ones.
+// in its time limit and then as `options` say. An unknown name is an error
+// that lists the valid ones.
 absl::StatusOr<std::unique_ptr<Environment>> MakeEnvironment(
-    absl::string_view name);
+    absl::string_view name, const EnvOptions& options = {});
 
 // The registered names, sorted (mjcf:PATH not included).
 std::vector<std::string> RegisteredEnvironments();

@@ -113,6 +113,11 @@ class Session {
     if (actor == nullptr) {
       ActorConfig actor_config;
       actor_config.env = config_.env;
+      // The learner's run config says how it wraps the environment; the
+      // registration carried the environment's own spec.
+      if (run.training().has_frame_stack()) {
+        actor_config.env_options.frame_stack = run.training().frame_stack();
+      }
       actor_config.num_envs = config_.num_envs;
       actor_config.segment_length = run.training().segment_length();
       actor_config.seed = config_.seed;

@@ -77,7 +77,7 @@ int RunTrainBench() {
     return Usage("train: the limit counts PPO's epochs; use --algo=ppo");
   }
   absl::StatusOr<std::unique_ptr<Environment>> env =
-      MakeEnvironment(config.training().env());
+      MakeEnvironment(config.training().env(), EnvOptionsOf(config));
   if (!env.ok()) return Usage(std::string(env.status().message()).c_str());
   TrainBenchConfig bench;
   bench.config_path =

@@ -16,6 +16,7 @@
 #include "deploy/cli/stop_signal.h"
 #include "deploy/cli/train_command.h"
 #include "deploy/learner_server.h"
+#include "deploy/run_config.h"
 #include "learner/service/actor_gateway.h"
 
 ABSL_FLAG(std::string, listen, "127.0.0.1:0",
@@ -148,8 +149,8 @@ int RunLearner(const std::vector<std::string>&) {
   at::set_num_threads(learner_threads);
   // The learner's own configuration pins the environment; no actor's
   // registration decides it.
-  absl::StatusOr<std::unique_ptr<Environment>> env =
-      MakeEnvironment(resolved->config.training().env());
+  absl::StatusOr<std::unique_ptr<Environment>> env = MakeEnvironment(
+      resolved->config.training().env(), EnvOptionsOf(resolved->config));
   if (!env.ok()) return Fail(kUsageError, env.status().message());
   server.training = resolved->local;
   server.run_config = resolved->config;

@@ -34,6 +34,9 @@ ABSL_FLAG(std::string, torso, "",
           "mlp (tanh layers of --hidden) | minatar (MinAtar's net: 16 3x3 "
           "convolutions, 128 units) | nature (the DQN net: 32 8x8/4, 64 "
           "4x4/2, 64 3x3/1, 512 units)");
+ABSL_FLAG(int64_t, frame_stack, 0,
+          "each observation is the last N ones, oldest first (images: "
+          "stacked along their channels, [N*C, H, W]); 1: none");
 ABSL_FLAG(bool, scale_rewards, false,
           "divide rewards by the running std of discounted returns");
 ABSL_FLAG(int64_t, segment_length, 0,

@@ -18,6 +18,7 @@
 #include "deploy/cli/stop_signal.h"
 #include "deploy/launcher.h"
 #include "deploy/local_training.h"
+#include "deploy/run_config.h"
 #include "deploy/run_directory.h"
 #include "learner/algorithms/algorithm.h"
 
@@ -161,8 +162,8 @@ int RunTrain(const std::vector<std::string>&) {
 }  // namespace
 
 absl::Status CheckRunCanStart(const ResolvedRun& run) {
-  if (absl::StatusOr<std::unique_ptr<Environment>> env =
-          MakeEnvironment(run.config.training().env());
+  if (absl::StatusOr<std::unique_ptr<Environment>> env = MakeEnvironment(
+          run.config.training().env(), EnvOptionsOf(run.config));
       !env.ok()) {
     return env.status();
   }

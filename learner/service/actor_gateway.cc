@@ -6,6 +6,7 @@
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "common/env/frame_stack.h"
 #include "common/util/constant_time.h"
 
 namespace vantage {
@@ -69,7 +70,12 @@ absl::StatusOr<pb::RegisterResponse> ActorGateway::Register(
     return refuse(absl::InvalidArgumentError(absl::StrCat(
         "this learner trains ", config_.spec.name, ", not ", spec->name)));
   }
-  if (absl::Status status = CheckSameSpec(config_.spec, *spec); !status.ok()) {
+  // Actors register their environment's own spec and wrap it as the run
+  // config they receive says.
+  const int64_t frames = config_.run_config.training().frame_stack();
+  if (absl::Status status =
+          CheckSameSpec(config_.spec, StackedSpec(*spec, frames));
+      !status.ok()) {
     return refuse(status);
   }
   const int64_t num_envs = request.num_envs();

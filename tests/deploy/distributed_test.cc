@@ -36,11 +36,13 @@ constexpr char kRun[] = "--steps=3072 --horizon=256 --envs=2 --seed=5";
 
 // A --sync run with one actor trains on exactly the data of local mode and
 // repeats its progress.csv (wall clock aside); with EX2 too, whose model
-// fits on the learner from update 2 on.
-void ExpectSyncWithOneActorReproducesLocalMode(const std::string& extra) {
-  const bool ex2 = !extra.empty();
-  const std::string local = FreshDirectory(ex2 ? "local_ex2" : "local");
-  const std::string remote = FreshDirectory(ex2 ? "remote_ex2" : "remote");
+// fits on the learner from update 2 on, and with stacked frames, which the
+// actor learns from the learner's run config.
+void ExpectSyncWithOneActorReproducesLocalMode(const std::string& tag,
+                                               const std::string& extra) {
+  const bool ex2 = tag == "ex2";
+  const std::string local = FreshDirectory("local" + tag);
+  const std::string remote = FreshDirectory("remote" + tag);
   const std::string run = std::string(kRun) + extra;
   ASSERT_EQ(
       RunVantage("train --mode=local " + run + " --run_dir=" + local).exit_code,
@@ -67,11 +69,16 @@ void ExpectSyncWithOneActorReproducesLocalMode(const std::string& extra) {
 }
 
 TEST(DistributedTest, SyncWithOneActorReproducesLocalMode) {
-  ExpectSyncWithOneActorReproducesLocalMode("");
+  ExpectSyncWithOneActorReproducesLocalMode("", "");
+}
+
+TEST(DistributedTest, SyncWithOneActorReproducesLocalModeWithStackedFrames) {
+  ExpectSyncWithOneActorReproducesLocalMode("stacked", " --frame_stack=3");
 }
 
 TEST(DistributedTest, SyncWithOneActorReproducesLocalModeWithEx2) {
   ExpectSyncWithOneActorReproducesLocalMode(
+      "ex2",
       " --exploration=ex2 --ex2_replay_min=500 --ex2_first_train_iterations=50 "
       "--ex2_train_iterations=20 --ex2_bonus_coeff=0.1");
 }

@@ -56,6 +56,7 @@ TEST(RunConfigTest, DefaultsAreTheComponentsOwn) {
   EXPECT_EQ(config->advantage().estimator(), "maxabs");
   EXPECT_EQ(config->ppo().minibatches(), PpoConfig().minibatches);
   EXPECT_EQ(config->recording().checkpoint_every(), local.checkpoint_every);
+  EXPECT_EQ(config->training().frame_stack(), 1);
   // Only the chosen algorithm's section is there.
   EXPECT_EQ(config->algorithm_case(), pb::RunConfig::kPpo);
   absl::StatusOr<pb::RunConfig> a2c = Resolve(R"({"a2c": {"n": 3}})");
@@ -67,6 +68,22 @@ TEST(RunConfigTest, DefaultsAreTheComponentsOwn) {
   ASSERT_TRUE(local_run.ok()) << local_run.status();
   EXPECT_FALSE(local_run->has_distributed());
   EXPECT_EQ(local_run->training().envs(), local.num_envs);
+}
+
+TEST(RunConfigTest, FrameStacksAreOneToSixteen) {
+  for (const char* json : {R"({"training": {"frame_stack": 0}})",
+                           R"({"training": {"frame_stack": 17}})"}) {
+    EXPECT_EQ(Resolve(json).status().message(),
+              "--frame_stack must be in [1, 16]")
+        << json;
+  }
+  absl::StatusOr<pb::RunConfig> config =
+      Resolve(R"({"training": {"env": "MinAtarBreakout", "frame_stack": 4}})");
+  ASSERT_TRUE(config.ok()) << config.status();
+  EXPECT_EQ(EnvOptionsOf(*config).frame_stack, 4);
+  EXPECT_EQ(ToLocalTrainingConfig(*config).env_options.frame_stack, 4);
+  // A config from before frame stacking existed stacks nothing.
+  EXPECT_EQ(EnvOptionsOf(pb::RunConfig()).frame_stack, 1);
 }
 
 TEST(RunConfigTest, AResolvedConfigSurvivesItsJson) {
