@@ -16,6 +16,7 @@
 #include "absl/strings/str_split.h"
 #include "actor/envs/env_registry.h"
 #include "deploy/cli/shared_flags.h"
+#include "deploy/run_config.h"
 #include "deploy/trained_policy.h"
 #include "deploy/video_writer.h"
 
@@ -194,7 +195,10 @@ int RunRollout(const std::vector<std::string>&) {
     return Fail("rollout",
                 absl::InvalidArgumentError("--episodes must be >= 1"));
   }
-  absl::StatusOr<std::unique_ptr<Environment>> made = MakeEnvironment(env_name);
+  // A trained policy sees the environment as its run wrapped it.
+  absl::StatusOr<std::unique_ptr<Environment>> made = MakeEnvironment(
+      env_name,
+      trained.has_value() ? EnvOptionsOf(trained->config) : EnvOptions{});
   if (!made.ok()) return Fail("rollout", made.status());
   Environment& env = **made;
   const EnvSpec& spec = env.spec();

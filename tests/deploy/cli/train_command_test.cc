@@ -57,6 +57,27 @@ TEST(TrainCommandTest, ShortRunWritesARunDirectory) {
   EXPECT_THAT(ReadFile(again + "/config.json"), HasSubstr("\"seed\": \"3\""));
 }
 
+// A policy trained on stacked frames acts on stacked frames.
+TEST(TrainCommandTest, AStackedFramesPolicyRollsOut) {
+  const std::string run = FreshDirectory("cli_stacked");
+  const Outcome outcome = RunVantage(
+      "train --mode=local --env=MinAtarBreakout --algo=a2c --steps=400 "
+      "--envs=2 --frame_stack=4 --run_dir=" +
+      run);
+  ASSERT_EQ(outcome.exit_code, 0) << outcome.err;
+  EXPECT_THAT(ReadFile(run + "/config.json"),
+              HasSubstr("\"frame_stack\": \"4\""));
+  const Outcome rollout =
+      RunVantage("rollout --episodes=1 --checkpoint=" + run);
+  ASSERT_EQ(rollout.exit_code, 0) << rollout.err;
+  EXPECT_THAT(rollout.out,
+              HasSubstr("RESULT rollout env=MinAtarBreakout obs_dim=1600"));
+  EXPECT_EQ(RunVantage("train --mode=local --env=MinAtarBreakout "
+                       "--frame_stack=17 --steps=400")
+                .exit_code,
+            2);
+}
+
 TEST(TrainCommandTest, ResumeContinuesTheRun) {
   const std::string run = FreshDirectory("cli_resume");
   const std::string config = WriteTemp("resume.json",
