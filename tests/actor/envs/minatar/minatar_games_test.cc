@@ -80,6 +80,50 @@ TEST(BreakoutTest, APaddleTrackingTheBallKeepsItInPlayAndClearsTheBricks) {
   }
 }
 
+A TrackBall(const Breakout& game) {
+  return game.ball_x() < game.paddle()   ? A::kLeft
+         : game.ball_x() > game.paddle() ? A::kRight
+                                         : A::kNoop;
+}
+
+// MinAtar's two paddle hits: under the ball's column the ball's vertical
+// direction flips; under the column it is about to enter (the paddle moved
+// there this step) the ball goes back the way it came. The paddle leads
+// the falling ball by a column to make the second.
+TEST(BreakoutTest, APaddleUnderTheBallsNextColumnSendsItBack) {
+  constexpr int kReverse[4] = {2, 3, 0, 1};
+  int diagonal_hits = 0;
+  for (uint64_t seed : {1, 2, 3, 4}) {
+    Breakout game;
+    std::mt19937_64 random(seed);
+    game.Reset(random);
+    for (int t = 0; t < 400; ++t) {
+      const int direction = game.ball_direction();
+      const int step_x = direction == 1 || direction == 2 ? 1 : -1;
+      const int next_x = game.ball_x() + step_x;
+      const bool falling = direction == 2 || direction == 3;
+      const bool leads = falling && game.ball_y() >= 7 && next_x >= 0 &&
+                         next_x < kMinAtarGridSize;
+      const int target = leads ? next_x : game.ball_x();
+      const A action = target < game.paddle()   ? A::kLeft
+                       : target > game.paddle() ? A::kRight
+                                                : A::kNoop;
+      const bool diagonal =
+          leads && game.ball_y() == 8 && std::abs(game.paddle() - next_x) <= 1;
+      const GameStep step = game.Act(action, random);
+      ASSERT_FALSE(step.terminal) << "seed " << seed << " step " << t;
+      if (diagonal) {
+        ASSERT_EQ(game.paddle(), next_x);
+        EXPECT_EQ(game.ball_x(), next_x);
+        EXPECT_EQ(game.ball_y(), 8);
+        EXPECT_EQ(game.ball_direction(), kReverse[direction]);
+        ++diagonal_hits;
+      }
+    }
+  }
+  EXPECT_GT(diagonal_hits, 10);
+}
+
 TEST(BreakoutTest, AStillPaddleLosesTheBallAndTheGameStaysOver) {
   Breakout game;
   std::mt19937_64 random(4);
