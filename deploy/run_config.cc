@@ -240,6 +240,16 @@ absl::StatusOr<pb::RunConfig> ResolveRunConfig(const pb::RunConfig& given) {
                                          "' is not one of auto, mlp, minatar, "
                                          "nature"));
   }
+  if (!t.has_shared_torso()) {
+    t.set_shared_torso(local.learner.network.shared_torso);
+  }
+  if (t.shared_torso() && !AlgorithmStepsBothNetworksAtOnce(algorithm)) {
+    return Invalid(
+        "shared_torso",
+        absl::StrCat("needs ppo or a2c, which step both networks "
+                     "with one optimiser; ",
+                     algorithm.name, " fits its value network alone"));
+  }
   if (!t.has_frame_stack()) t.set_frame_stack(local.env_options.frame_stack);
   if (t.frame_stack() < 1 || t.frame_stack() > kMaxFrameStack) {
     return Invalid("frame_stack",
@@ -368,6 +378,7 @@ LocalTrainingConfig ToLocalTrainingConfig(const pb::RunConfig& c) {
   learner.scale_rewards = t.scale_rewards();
   learner.network.hidden.assign(t.hidden().begin(), t.hidden().end());
   learner.network.torso = ParseTorso(t.torso()).value_or(Torso::kAuto);
+  learner.network.shared_torso = t.shared_torso();
   const pb::AdvantageSettings& a = c.advantage();
   AdvantageConfig& advantage = learner.advantage;
   if (absl::StatusOr<Statistic> statistic = ParseStatistic(a.estimator());

@@ -31,9 +31,14 @@ absl::Status LearnerConfig::Validate() const {
   if (absl::Status status = CheckObservationLayout(spec); !status.ok()) {
     return status;
   }
-  if (absl::StatusOr<Torso> torso = ResolveTorso(network.torso, spec);
-      !torso.ok()) {
-    return torso.status();
+  if (absl::Status status = CheckNetworkConfig(network, spec); !status.ok()) {
+    return status;
+  }
+  if (network.shared_torso && !AlgorithmStepsBothNetworksAtOnce(algorithm)) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "a shared torso needs an algorithm that steps the policy and the "
+        "value network with one optimiser (a2c, ppo); ",
+        algorithm.name, " fits its value network on its own"));
   }
   if (horizon < 1 || rollouts_per_batch < 1 || total_env_steps < 1) {
     return absl::InvalidArgumentError(
@@ -105,7 +110,7 @@ LearnerCore::LearnerCore(const LearnerConfig& config,
     : config_(config),
       replicas_(std::move(replicas)),
       policy_(config.spec, config.network),
-      value_(config.spec, config.network),
+      value_(MakeValueNetwork(config.spec, config.network, *policy_)),
       normalizer_(config.spec.observation_size),
       reward_scaler_(config.advantage.gamma, config.reward_clip),
       // Validated by Create, so the algorithm exists.
@@ -128,8 +133,7 @@ LearnerCore::~LearnerCore() = default;
 absl::Status LearnerCore::SynchroniseReplicas() {
   if (replicas_->world_size() == 1) return absl::OkStatus();
   at::NoGradGuard no_grad;
-  std::vector<at::Tensor> parameters = policy_->parameters();
-  for (const at::Tensor& p : value_->parameters()) parameters.push_back(p);
+  std::vector<at::Tensor> parameters = NetworkParameters(*policy_, *value_);
   if (exploration_ != nullptr) {
     for (const at::Tensor& p : exploration_->parameters()) {
       parameters.push_back(p);
@@ -460,6 +464,10 @@ void LearnerCore::Save(torch::serialize::OutputArchive& archive) const {
   archive.write("spec.shape", SpecShape(config_.spec));
   WriteBytes(archive, "algorithm", config_.algorithm.name);
   WriteModule(archive, "policy", *policy_);
+  // A shared torso is written with both networks; this says the copies are
+  // one.
+  archive.write("shared_torso",
+                at::tensor(int64_t{config_.network.shared_torso ? 1 : 0}));
   WriteModule(archive, "value", *value_);
   torch::serialize::OutputArchive updater, scaler;
   updater_->Save(updater);
@@ -516,6 +524,23 @@ absl::StatusOr<std::unique_ptr<LearnerCore>> LearnerCore::Load(
     return absl::InvalidArgumentError(
         absl::StrCat("checkpoint was trained with ", *algorithm, ", not ",
                      config.algorithm.name));
+  }
+  // Checkpoints written before torsos could be shared hold no entry.
+  at::Tensor shared_entry;
+  bool shared_torso = false;
+  if (archive.try_read("shared_torso", shared_entry)) {
+    if (shared_entry.scalar_type() != at::kLong || shared_entry.numel() != 1 ||
+        shared_entry.item<int64_t>() < 0 || shared_entry.item<int64_t>() > 1) {
+      return absl::InvalidArgumentError(
+          "checkpoint entry 'shared_torso' is not one 0 or 1");
+    }
+    shared_torso = shared_entry.item<int64_t>() == 1;
+  }
+  if (shared_torso != config.network.shared_torso) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "checkpoint's networks ", shared_torso ? "share" : "do not share",
+        " their torso, but the run config says the opposite "
+        "(--shared_torso)"));
   }
   torch::serialize::InputArchive updater, scaler;
   if (absl::Status status = CatchTorchErrors(

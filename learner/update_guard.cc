@@ -15,13 +15,6 @@
 namespace vantage {
 namespace {
 
-std::vector<at::Tensor> AllParameters(PolicyNetworkImpl& policy,
-                                      ValueNetworkImpl& value) {
-  std::vector<at::Tensor> parameters = policy.parameters();
-  for (const at::Tensor& p : value.parameters()) parameters.push_back(p);
-  return parameters;
-}
-
 template <typename Saver>
 std::string SaveToBytes(Saver save) {
   torch::serialize::OutputArchive archive;
@@ -41,7 +34,7 @@ UpdateGuard::UpdateGuard(PolicyNetworkImpl& policy, ValueNetworkImpl& value,
       updater_(updater),
       reward_scaler_(reward_scaler),
       exploration_(exploration) {
-  for (const at::Tensor& p : AllParameters(policy_, value_)) {
+  for (const at::Tensor& p : NetworkParameters(policy_, value_)) {
     parameters_.push_back(p.detach().clone());
   }
   // The optimisers' state is reached only through their archives.
@@ -92,7 +85,7 @@ std::string UpdateGuard::Fault(const AlgorithmStats& stats,
 void UpdateGuard::Restore() {
   {
     at::NoGradGuard no_grad;
-    std::vector<at::Tensor> parameters = AllParameters(policy_, value_);
+    std::vector<at::Tensor> parameters = NetworkParameters(policy_, value_);
     for (size_t i = 0; i < parameters.size(); ++i) {
       parameters[i].copy_(parameters_[i]);
     }

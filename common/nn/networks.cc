@@ -6,7 +6,9 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <unordered_set>
 
+#include "absl/strings/str_cat.h"
 #include "common/nn/distributions.h"
 
 namespace vantage {
@@ -41,18 +43,22 @@ namespace {
 
 // The torso's convolutions (registered first, so that an MLP network's
 // parameters keep their order) and the MLP after them: for images the
-// MLP is just the output layer.
+// MLP is just the output layer. `shared`, if not empty, is used as the
+// convolutions instead of new ones.
 TanhMlp MakeBody(torch::nn::Module& network, const EnvSpec& spec,
                  const NetworkConfig& config, int64_t outputs,
-                 double output_gain, ConvTorso& conv) {
-  const Torso torso = ResolveTorso(config.torso, spec).value();
-  if (torso == Torso::kMlp) {
-    return network.register_module(
-        "body",
-        TanhMlp(spec.observation_size, config.hidden, outputs, output_gain));
+                 double output_gain, ConvTorso& conv,
+                 ConvTorso shared = nullptr) {
+  if (shared.is_empty()) {
+    const Torso torso = ResolveTorso(config.torso, spec).value();
+    if (torso == Torso::kMlp) {
+      return network.register_module(
+          "body",
+          TanhMlp(spec.observation_size, config.hidden, outputs, output_gain));
+    }
+    shared = ConvTorso(torso, spec.observation_shape);
   }
-  conv =
-      network.register_module("conv", ConvTorso(torso, spec.observation_shape));
+  conv = network.register_module("conv", std::move(shared));
   return network.register_module(
       "body",
       TanhMlp(conv->features(), std::vector<int64_t>{}, outputs, output_gain));
@@ -72,6 +78,19 @@ EnvSpec FlatSpec(int64_t observation_size) {
 }
 
 }  // namespace
+
+absl::Status CheckNetworkConfig(const NetworkConfig& config,
+                                const EnvSpec& spec) {
+  const absl::StatusOr<Torso> torso = ResolveTorso(config.torso, spec);
+  if (!torso.ok()) return torso.status();
+  if (config.shared_torso && *torso == Torso::kMlp) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "a shared torso needs a convolutional one, but '", spec.name,
+        "' gets the mlp torso (--torso=", TorsoName(config.torso),
+        "); share with --torso=minatar or nature on image observations"));
+  }
+  return absl::OkStatus();
+}
 
 at::Tensor NetworkInputs(const EnvSpec& spec, const at::Tensor& observations) {
   if (observations.scalar_type() != at::kByte) return observations;
@@ -147,12 +166,35 @@ ValueNetworkImpl::ValueNetworkImpl(const EnvSpec& spec,
   body_ = MakeBody(*this, spec, config, 1, /*output_gain=*/1.0, conv_);
 }
 
+ValueNetworkImpl::ValueNetworkImpl(const EnvSpec& spec, ConvTorso shared)
+    : spec_(spec) {
+  body_ = MakeBody(*this, spec, NetworkConfig(), 1, /*output_gain=*/1.0, conv_,
+                   std::move(shared));
+}
+
 ValueNetworkImpl::ValueNetworkImpl(int64_t observation_size,
                                    const NetworkConfig& config)
     : ValueNetworkImpl(FlatSpec(observation_size), config) {}
 
 at::Tensor ValueNetworkImpl::forward(const at::Tensor& observations) {
   return Forward(spec_, conv_, body_, observations).squeeze(-1);
+}
+
+ValueNetwork MakeValueNetwork(const EnvSpec& spec, const NetworkConfig& config,
+                              const PolicyNetworkImpl& policy) {
+  if (config.shared_torso) return ValueNetwork(spec, policy.conv_torso());
+  return ValueNetwork(spec, config);
+}
+
+std::vector<at::Tensor> NetworkParameters(PolicyNetworkImpl& policy,
+                                          ValueNetworkImpl& value) {
+  std::vector<at::Tensor> parameters = policy.parameters();
+  std::unordered_set<const void*> seen;
+  for (const at::Tensor& p : parameters) seen.insert(p.unsafeGetTensorImpl());
+  for (const at::Tensor& p : value.parameters()) {
+    if (seen.insert(p.unsafeGetTensorImpl()).second) parameters.push_back(p);
+  }
+  return parameters;
 }
 
 }  // namespace vantage

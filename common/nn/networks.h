@@ -5,7 +5,9 @@
 // (gain sqrt(2) for hidden layers, 0.01 for the policy's output, 1 for the
 // value's, zero biases), as in the baselines the paper builds on, or for
 // images a convolutional torso (common/nn/torso.h) and then the output
-// layer. Each network has its own torso. A continuous policy is a Gaussian
+// layer. Each network has its own torso, unless the value network shares
+// the policy's convolutions (NetworkConfig::shared_torso), as the A2C and
+// PPO agents for Atari do. A continuous policy is a Gaussian
 // with a state-independent log-std (initially 0); a discrete one is
 // categorical over logits. Byte observations (EnvSpec::observation_high)
 // enter as uint8 and are divided by observation_high here, so that
@@ -18,6 +20,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "absl/status/status.h"
 #include "common/env/environment.h"
 #include "common/nn/running_mean_std.h"
 #include "common/nn/torso.h"
@@ -27,7 +30,16 @@ namespace vantage {
 struct NetworkConfig {
   std::vector<int64_t> hidden = {64, 64};  // the MLP torso's layers
   Torso torso = Torso::kAuto;
+  // The value network uses the policy's convolutions instead of its own, so
+  // that one trunk learns from both losses. Needs a convolutional torso,
+  // and an algorithm that steps both networks with one optimiser.
+  bool shared_torso = false;
 };
+
+// Why `config` cannot build networks for `spec`: a torso that does not fit
+// (ResolveTorso), or a shared torso that resolves to the MLP.
+absl::Status CheckNetworkConfig(const NetworkConfig& config,
+                                const EnvSpec& spec);
 
 // Linear layers with tanh between them (none after the last).
 class TanhMlpImpl : public torch::nn::Module {
@@ -81,6 +93,8 @@ class PolicyNetworkImpl : public torch::nn::Module {
   bool discrete() const { return discrete_; }
   // Undefined for discrete policies.
   const at::Tensor& log_std() const { return log_std_; }
+  // Empty for the MLP torso.
+  const ConvTorso& conv_torso() const { return conv_; }
 
  private:
   EnvSpec spec_;
@@ -94,6 +108,9 @@ TORCH_MODULE(PolicyNetwork);
 class ValueNetworkImpl : public torch::nn::Module {
  public:
   ValueNetworkImpl(const EnvSpec& spec, const NetworkConfig& config);
+  // On `shared`, a convolutional torso of another network (its parameters
+  // become this network's too), with only an output layer of its own.
+  ValueNetworkImpl(const EnvSpec& spec, ConvTorso shared);
   // For float vectors of `observation_size`.
   ValueNetworkImpl(int64_t observation_size, const NetworkConfig& config);
   // V(s) [B].
@@ -105,6 +122,16 @@ class ValueNetworkImpl : public torch::nn::Module {
   TanhMlp body_{nullptr};
 };
 TORCH_MODULE(ValueNetwork);
+
+// The value network to train with `policy`: on the policy's torso when
+// `config.shared_torso`, else with its own.
+ValueNetwork MakeValueNetwork(const EnvSpec& spec, const NetworkConfig& config,
+                              const PolicyNetworkImpl& policy);
+
+// The parameters of both networks, each once (a shared torso's are the
+// policy's): policy first, in registration order.
+std::vector<at::Tensor> NetworkParameters(PolicyNetworkImpl& policy,
+                                          ValueNetworkImpl& value);
 
 }  // namespace vantage
 

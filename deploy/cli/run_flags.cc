@@ -34,6 +34,10 @@ ABSL_FLAG(std::string, torso, "",
           "mlp (tanh layers of --hidden) | minatar (MinAtar's net: 16 3x3 "
           "convolutions, 128 units) | nature (the DQN net: 32 8x8/4, 64 "
           "4x4/2, 64 3x3/1, 512 units)");
+ABSL_FLAG(bool, shared_torso, false,
+          "the value network uses the policy's convolutions, one trunk "
+          "trained by both losses (a convolutional --torso; ppo or a2c); "
+          "default: each network has its own");
 ABSL_FLAG(int64_t, frame_stack, 0,
           "each observation is the last N ones, oldest first (images: "
           "stacked along their channels, [N*C, H, W]); 1: none");

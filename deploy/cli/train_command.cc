@@ -12,6 +12,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_join.h"
 #include "actor/envs/env_registry.h"
+#include "common/nn/networks.h"
 #include "deploy/cli/run_flags.h"
 #include "deploy/cli/security_flags.h"
 #include "deploy/cli/shared_flags.h"
@@ -162,10 +163,15 @@ int RunTrain(const std::vector<std::string>&) {
 }  // namespace
 
 absl::Status CheckRunCanStart(const ResolvedRun& run) {
-  if (absl::StatusOr<std::unique_ptr<Environment>> env = MakeEnvironment(
-          run.config.training().env(), EnvOptionsOf(run.config));
-      !env.ok()) {
-    return env.status();
+  absl::StatusOr<std::unique_ptr<Environment>> env =
+      MakeEnvironment(run.config.training().env(), EnvOptionsOf(run.config));
+  if (!env.ok()) return env.status();
+  // Before the run directory exists: networks that cannot be built for the
+  // environment's observations would leave an empty run behind.
+  if (absl::Status status =
+          CheckNetworkConfig(run.local.learner.network, (*env)->spec());
+      !status.ok()) {
+    return status;
   }
   if (run.local.run_dir.empty()) return absl::OkStatus();
   if (run.local.resume) return RunDirectory::Open(run.local.run_dir).status();

@@ -22,6 +22,9 @@ struct Algorithm {
                                                PolicyNetwork, ValueNetwork,
                                                std::shared_ptr<ReplicaGroup>)>
       make;
+  // One optimiser steps the policy and the value network together, so the
+  // two may share parameters.
+  bool one_optimizer = false;
 };
 
 // An algorithm whose config is AlgorithmConfig::*member, whose settings are
@@ -51,6 +54,7 @@ Algorithm Entry(Config AlgorithmConfig::*member,
     return std::make_unique<Updater>(std::move(policy), std::move(value),
                                      config.*member, std::move(replicas));
   };
+  algorithm.one_optimizer = Updater::kOneOptimizer;
   return algorithm;
 }
 
@@ -94,6 +98,11 @@ absl::StatusOr<std::unique_ptr<PolicyUpdater>> MakePolicyUpdater(
   return Algorithms()
       .at(config.name)
       .make(config, std::move(policy), std::move(value), std::move(replicas));
+}
+
+bool AlgorithmStepsBothNetworksAtOnce(const AlgorithmConfig& config) {
+  const auto algorithm = Algorithms().find(config.name);
+  return algorithm != Algorithms().end() && algorithm->second.one_optimizer;
 }
 
 AlgorithmRunDefaults RunDefaultsOf(const AlgorithmConfig& config) {

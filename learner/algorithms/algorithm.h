@@ -39,6 +39,11 @@ absl::StatusOr<std::unique_ptr<PolicyUpdater>> MakePolicyUpdater(
     const AlgorithmConfig& config, PolicyNetwork policy, ValueNetwork value,
     std::shared_ptr<ReplicaGroup> replicas = SoloReplicaGroup());
 
+// Whether the named algorithm steps the policy and the value network with
+// one optimiser (PPO, A2C), which parameters shared by both need; TRPO
+// fits its value network on its own.
+bool AlgorithmStepsBothNetworksAtOnce(const AlgorithmConfig& config);
+
 // What the named algorithm's defaults choose outside its own section.
 AlgorithmRunDefaults RunDefaultsOf(const AlgorithmConfig& config);
 

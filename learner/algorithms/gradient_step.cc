@@ -37,13 +37,6 @@ void SetLearningRate(torch::optim::Optimizer& optimizer, double learning_rate) {
   }
 }
 
-std::vector<at::Tensor> JointParameters(PolicyNetworkImpl& policy,
-                                        ValueNetworkImpl& value) {
-  std::vector<at::Tensor> parameters = policy.parameters();
-  for (const at::Tensor& p : value.parameters()) parameters.push_back(p);
-  return parameters;
-}
-
 void MeanStats::Add(const AlgorithmStats& stats) {
   sum_.policy_loss += stats.policy_loss;
   sum_.value_loss += stats.value_loss;

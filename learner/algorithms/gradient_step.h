@@ -39,10 +39,6 @@ double GradientStep(torch::optim::Optimizer& optimizer,
 // Sets every parameter group's learning rate.
 void SetLearningRate(torch::optim::Optimizer& optimizer, double learning_rate);
 
-// The parameters of both networks, policy first (one optimiser over both).
-std::vector<at::Tensor> JointParameters(PolicyNetworkImpl& policy,
-                                        ValueNetworkImpl& value);
-
 // Averages per-minibatch statistics (a NaN field stays NaN), except
 // max_gradient_norm, which is the largest (NaN if any was).
 class MeanStats {

@@ -86,6 +86,23 @@ TEST(RunConfigTest, FrameStacksAreOneToSixteen) {
   EXPECT_EQ(EnvOptionsOf(pb::RunConfig()).frame_stack, 1);
 }
 
+TEST(RunConfigTest, ASharedTorsoNeedsOneOptimiserOverBothNetworks) {
+  absl::StatusOr<pb::RunConfig> separate = Resolve("{}");
+  ASSERT_TRUE(separate.ok()) << separate.status();
+  EXPECT_FALSE(separate->training().shared_torso());
+  absl::StatusOr<pb::RunConfig> shared = Resolve(
+      R"({"training": {"env": "MinAtarBreakout", "shared_torso": true},
+          "a2c": {}})");
+  ASSERT_TRUE(shared.ok()) << shared.status();
+  EXPECT_TRUE(ToLocalTrainingConfig(*shared).learner.network.shared_torso);
+  EXPECT_EQ(
+      Resolve(R"({"training": {"shared_torso": true}, "trpo": {}})")
+          .status()
+          .message(),
+      "--shared_torso needs ppo or a2c, which step both networks with one "
+      "optimiser; trpo fits its value network alone");
+}
+
 TEST(RunConfigTest, AResolvedConfigSurvivesItsJson) {
   for (const std::string& json :
        {std::string("{}"), std::string(R"({"mode": "local", "trpo": {}})"),

@@ -280,6 +280,56 @@ TEST(ByteObservationsTest, TravelAsBytesAndTrainAConvolutionalNetwork) {
               HasSubstr("torso nature needs frames of at least 36x36"));
 }
 
+// PPO and A2C train one trunk under both losses; a checkpoint keeps it one
+// (a restored learner continues exactly) and says so, and the algorithm
+// that fits its value network alone is refused.
+TEST(SharedTorsoTest, OneTrunkTrainsAndResumesAsOne) {
+  for (const std::string algorithm : {"a2c", "ppo"}) {
+    SCOPED_TRACE(algorithm);
+    LearnerConfig config = TestLearnerConfig(
+        MakeTestActor(1, "MinAtarBreakout")->spec(), algorithm);
+    config.network.shared_torso = true;
+    // One segment per stream and batch.
+    auto actor = MakeTestActor(config.horizon, "MinAtarBreakout");
+    auto learner = *LearnerCore::Create(config);
+    const PolicyWeights initial = learner->CurrentWeights();
+    const UpdateStats stats =
+        UpdateWith(*learner, ActOneBatch(*actor, *learner));
+    EXPECT_FALSE(stats.rolled_back) << stats.rollback_reason;
+    EXPECT_TRUE(std::isfinite(stats.algorithm.value_loss));
+    EXPECT_FALSE(
+        learner->CurrentWeights().parameters[0].equal(initial.parameters[0]));
+
+    const std::string path = std::string(::testing::TempDir()) +
+                             "/shared_torso_" + algorithm + ".pt";
+    ASSERT_TRUE(WriteCheckpoint(path, *learner, {}).ok());
+    absl::StatusOr<std::unique_ptr<LearnerCore>> restored =
+        ReadCheckpoint(path, config);
+    ASSERT_TRUE(restored.ok()) << restored.status();
+    const std::vector<Segment> next = ActOneBatch(*actor, *learner);
+    UpdateWith(*learner, next);
+    UpdateWith(**restored, next);
+    ExpectSameWeights(*learner, **restored);
+
+    LearnerConfig separate = config;
+    separate.network.shared_torso = false;
+    EXPECT_THAT(ReadCheckpoint(path, separate).status().message(),
+                HasSubstr("checkpoint's networks share their torso, but the "
+                          "run config says the opposite"));
+  }
+  LearnerConfig config =
+      TestLearnerConfig(MakeTestActor(1, "MinAtarBreakout")->spec(), "trpo");
+  config.network.shared_torso = true;
+  EXPECT_THAT(config.Validate().message(),
+              HasSubstr("trpo fits its value network on its own"));
+  // Vectors have nothing to share.
+  auto vectors = MakeTestActor();
+  config = TestLearnerConfig(vectors->spec(), "ppo");
+  config.network.shared_torso = true;
+  EXPECT_THAT(config.Validate().message(),
+              HasSubstr("a shared torso needs a convolutional one"));
+}
+
 TEST(LearnerConfigTest, RefusesBadLimits) {
   auto actor = MakeTestActor();
   LearnerConfig config = TestLearnerConfig(actor->spec(), "ppo");

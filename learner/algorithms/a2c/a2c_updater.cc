@@ -17,7 +17,7 @@ A2cUpdater::A2cUpdater(PolicyNetwork policy, ValueNetwork value,
       value_(std::move(value)),
       config_(config),
       replicas_(std::move(replicas)),
-      parameters_(JointParameters(*policy_, *value_)),
+      parameters_(NetworkParameters(*policy_, *value_)),
       optimizer_(std::make_unique<torch::optim::RMSprop>(
           parameters_, torch::optim::RMSpropOptions(config.learning_rate)
                            .alpha(config.rmsprop_alpha)

@@ -20,6 +20,8 @@ namespace vantage {
 // -mean(log pi(a|s) A) + value_coef * value loss - entropy_coef * entropy.
 class A2cUpdater : public PolicyUpdater {
  public:
+  static constexpr bool kOneOptimizer = true;
+
   // `replicas`: the data-parallel learners whose gradients are averaged.
   A2cUpdater(PolicyNetwork policy, ValueNetwork value, const A2cConfig& config,
              std::shared_ptr<ReplicaGroup> replicas = SoloReplicaGroup());

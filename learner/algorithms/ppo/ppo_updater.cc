@@ -21,7 +21,7 @@ PpoUpdater::PpoUpdater(PolicyNetwork policy, ValueNetwork value,
       value_(std::move(value)),
       config_(config),
       replicas_(std::move(replicas)),
-      parameters_(JointParameters(*policy_, *value_)),
+      parameters_(NetworkParameters(*policy_, *value_)),
       optimizer_(std::make_unique<torch::optim::Adam>(
           parameters_,
           torch::optim::AdamOptions(config.learning_rate).eps(1e-5))) {}

@@ -21,6 +21,8 @@ namespace vantage {
 // denominator is the behaviour log-probability carried with the segment.
 class PpoUpdater : public PolicyUpdater {
  public:
+  static constexpr bool kOneOptimizer = true;
+
   // `replicas`: the data-parallel learners whose gradients are averaged.
   PpoUpdater(PolicyNetwork policy, ValueNetwork value, const PpoConfig& config,
              std::shared_ptr<ReplicaGroup> replicas = SoloReplicaGroup());

@@ -23,6 +23,8 @@ namespace vantage {
 // of the surrogate; if none qualifies the policy stays as it was.
 class TrpoUpdater : public PolicyUpdater {
  public:
+  static constexpr bool kOneOptimizer = false;
+
   // `replicas`: the data-parallel learners whose gradients are averaged.
   TrpoUpdater(PolicyNetwork policy, ValueNetwork value,
               const TrpoConfig& config,

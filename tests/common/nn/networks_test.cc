@@ -159,6 +159,53 @@ TEST(TorsoTest, ConvolutionalTorsosHaveThePublishedLayers) {
       ParameterCount(*minatar));
 }
 
+// With a shared torso the value network is the policy's convolutions plus
+// its own output layer: both losses reach the same trunk, and the joint
+// parameter list holds each tensor once.
+TEST(TorsoTest, ASharedTorsoIsOneTrunkForBothNetworks) {
+  at::manual_seed(0);
+  const EnvSpec spec = ImageSpec(4, 10, 1);
+  NetworkConfig config;
+  config.shared_torso = true;
+  ASSERT_TRUE(CheckNetworkConfig(config, spec).ok());
+  PolicyNetwork policy(spec, config);
+  ValueNetwork value = MakeValueNetwork(spec, config, *policy);
+  const auto trunk = policy->named_parameters();
+  const auto value_parameters = value->named_parameters();
+  for (const char* name : {"conv.layers.0.weight", "conv.layers.3.weight"}) {
+    SCOPED_TRACE(name);
+    ASSERT_TRUE(value_parameters.contains(name));
+    EXPECT_TRUE(value_parameters[name].is_same(trunk[name]));
+  }
+  EXPECT_EQ(value_parameters["body.layers.0.weight"].sizes(),
+            at::IntArrayRef({1, 128}));
+  const std::vector<at::Tensor> joint = NetworkParameters(*policy, *value);
+  // The policy's 6 tensors (2 convolution, 2 dense, 2 output) and the
+  // value's output layer.
+  EXPECT_EQ(joint.size(), policy->parameters().size() + 2);
+  int64_t joint_count = 0;
+  for (const at::Tensor& p : joint) joint_count += p.numel();
+  EXPECT_EQ(joint_count, ParameterCount(*policy) + 128 + 1);
+  // The value loss moves the policy's convolutions.
+  const at::Tensor obs =
+      at::randint(0, 2, {3, spec.observation_size}, at::kByte);
+  value->forward(obs).sum().backward();
+  EXPECT_GT(trunk["conv.layers.0.weight"].grad().abs().sum().item<float>(), 0);
+  // Separate networks share nothing.
+  config.shared_torso = false;
+  ValueNetwork own = MakeValueNetwork(spec, config, *policy);
+  EXPECT_FALSE(own->named_parameters()["conv.layers.0.weight"].is_same(
+      trunk["conv.layers.0.weight"]));
+  EXPECT_EQ(NetworkParameters(*policy, *own).size(),
+            policy->parameters().size() + own->parameters().size());
+  // There is nothing to share in an MLP.
+  config.shared_torso = true;
+  EXPECT_EQ(CheckNetworkConfig(config, ContinuousSpec()).message(),
+            "a shared torso needs a convolutional one, but 'test' gets the "
+            "mlp torso (--torso=auto); share with --torso=minatar or nature "
+            "on image observations");
+}
+
 // Byte observations enter as uint8 and mean value / observation_high: the
 // network gives what it gives on the scaled floats.
 TEST(TorsoTest, ByteObservationsAreScaledByTheirHigh) {

@@ -78,6 +78,28 @@ TEST(TrainCommandTest, AStackedFramesPolicyRollsOut) {
             2);
 }
 
+// Networks that cannot be built for the environment are a usage error
+// before the run directory exists; a shared torso trains.
+TEST(TrainCommandTest, NetworksAreCheckedBeforeTheRunDirectoryExists) {
+  const std::string run = FreshDirectory("cli_shared_torso");
+  const Outcome vectors = RunVantage(
+      "train --mode=local --env=InvertedPendulum --shared_torso --steps=400 "
+      "--run_dir=" +
+      run);
+  EXPECT_EQ(vectors.exit_code, 2);
+  EXPECT_THAT(vectors.err, HasSubstr("a shared torso needs a convolutional "
+                                     "one, but 'InvertedPendulum' gets the "
+                                     "mlp torso"));
+  EXPECT_FALSE(std::filesystem::exists(run + "/config.json"));
+  const Outcome shared = RunVantage(
+      "train --mode=local --env=MinAtarBreakout --algo=a2c "
+      "--shared_torso --steps=600 --run_dir=" +
+      run);
+  ASSERT_EQ(shared.exit_code, 0) << shared.err;
+  EXPECT_THAT(ReadFile(run + "/config.json"),
+              HasSubstr("\"shared_torso\": true"));
+}
+
 TEST(TrainCommandTest, ResumeContinuesTheRun) {
   const std::string run = FreshDirectory("cli_resume");
   const std::string config = WriteTemp("resume.json",
