@@ -235,6 +235,26 @@ TEST(BufferBudgetTest, StreamsThatNeverCompleteCannotGrowTheBuffers) {
   EXPECT_EQ(stats.evicted_steps, learner->stitcher().stats().evicted_steps);
 }
 
+// Checkpoints `learner` as `name`, restores it under `config`, and expects
+// both to give the same weights after one more batch. Returns the path.
+std::string ExpectACheckpointContinuesExactly(ActorCore& actor,
+                                              LearnerCore& learner,
+                                              const LearnerConfig& config,
+                                              const std::string& name) {
+  const std::string path =
+      std::string(::testing::TempDir()) + "/" + name + ".pt";
+  EXPECT_TRUE(WriteCheckpoint(path, learner, {}).ok());
+  absl::StatusOr<std::unique_ptr<LearnerCore>> restored =
+      ReadCheckpoint(path, config);
+  EXPECT_TRUE(restored.ok()) << restored.status();
+  if (!restored.ok()) return path;
+  const std::vector<Segment> next = ActOneBatch(actor, learner);
+  UpdateWith(learner, next);
+  UpdateWith(**restored, next);
+  ExpectSameWeights(learner, **restored);
+  return path;
+}
+
 // Pixel-style observations stay uint8 from the environment to the
 // learner's batches, are never normalised, and train a convolutional
 // network; a checkpoint continues it exactly.
@@ -261,16 +281,7 @@ TEST(ByteObservationsTest, TravelAsBytesAndTrainAConvolutionalNetwork) {
     EXPECT_EQ(trained.normalizer_count, initial.normalizer_count);
     EXPECT_TRUE(trained.normalizer_mean.equal(initial.normalizer_mean));
 
-    const std::string path =
-        std::string(::testing::TempDir()) + "/bytes_" + env + ".pt";
-    ASSERT_TRUE(WriteCheckpoint(path, *learner, {}).ok());
-    absl::StatusOr<std::unique_ptr<LearnerCore>> restored =
-        ReadCheckpoint(path, config);
-    ASSERT_TRUE(restored.ok()) << restored.status();
-    const std::vector<Segment> next = ActOneBatch(*actor, *learner);
-    UpdateWith(*learner, next);
-    UpdateWith(**restored, next);
-    ExpectSameWeights(*learner, **restored);
+    ExpectACheckpointContinuesExactly(*actor, *learner, config, "bytes_" + env);
   }
   // A torso that cannot take the observations is refused up front.
   auto actor = MakeTestActor(60, "MinAtarBreakout");
@@ -300,16 +311,8 @@ TEST(SharedTorsoTest, OneTrunkTrainsAndResumesAsOne) {
     EXPECT_FALSE(
         learner->CurrentWeights().parameters[0].equal(initial.parameters[0]));
 
-    const std::string path = std::string(::testing::TempDir()) +
-                             "/shared_torso_" + algorithm + ".pt";
-    ASSERT_TRUE(WriteCheckpoint(path, *learner, {}).ok());
-    absl::StatusOr<std::unique_ptr<LearnerCore>> restored =
-        ReadCheckpoint(path, config);
-    ASSERT_TRUE(restored.ok()) << restored.status();
-    const std::vector<Segment> next = ActOneBatch(*actor, *learner);
-    UpdateWith(*learner, next);
-    UpdateWith(**restored, next);
-    ExpectSameWeights(*learner, **restored);
+    const std::string path = ExpectACheckpointContinuesExactly(
+        *actor, *learner, config, "shared_torso_" + algorithm);
 
     LearnerConfig separate = config;
     separate.network.shared_torso = false;
