@@ -107,6 +107,13 @@ ABSL_FLAG(double, a2c_learning_rate, 0,
 ABSL_FLAG(double, a2c_entropy_coef, 0, "a2c: entropy bonus coefficient");
 ABSL_FLAG(double, a2c_value_coef, 0, "a2c: value loss coefficient");
 ABSL_FLAG(double, a2c_max_grad_norm, 0, "a2c: global gradient norm clip");
+ABSL_FLAG(std::string, a2c_rmsprop, "",
+          "a2c: pytorch | tensorflow: RMSProp as torch.optim.RMSprop "
+          "computes it (the mean square starts at 0, eps outside the square "
+          "root) or as TensorFlow does (starts at 1, eps inside), as the "
+          "baselines' A2C the paper ran");
+ABSL_FLAG(double, a2c_rmsprop_alpha, 0, "a2c: RMSProp's mean-square decay");
+ABSL_FLAG(double, a2c_rmsprop_eps, 0, "a2c: RMSProp's epsilon");
 ABSL_FLAG(double, trpo_max_kl, 0, "trpo: the trust region's mean-KL bound");
 ABSL_FLAG(int, trpo_cg_iterations, 0, "trpo: conjugate gradient iterations");
 ABSL_FLAG(double, trpo_cg_damping, 0, "trpo: Fisher-vector product damping");

@@ -1,5 +1,6 @@
 #include "learner/algorithms/a2c/a2c_config.h"
 
+#include "absl/strings/str_cat.h"
 #include "proto/run_config.pb.h"
 
 namespace vantage {
@@ -19,9 +20,15 @@ absl::Status A2cConfig::Validate() const {
   if (!(max_grad_norm > 0)) {
     return absl::InvalidArgumentError("a2c.max_grad_norm must be > 0");
   }
-  if (!(rmsprop_alpha > 0 && rmsprop_alpha < 1) || !(rmsprop_eps > 0)) {
-    return absl::InvalidArgumentError(
-        "a2c rmsprop alpha must be in (0, 1) and eps > 0");
+  if (rmsprop != "tensorflow" && rmsprop != "pytorch") {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "a2c.rmsprop must be tensorflow or pytorch, not '", rmsprop, "'"));
+  }
+  if (!(rmsprop_alpha > 0 && rmsprop_alpha < 1)) {
+    return absl::InvalidArgumentError("a2c.rmsprop_alpha must be in (0, 1)");
+  }
+  if (!(rmsprop_eps > 0)) {
+    return absl::InvalidArgumentError("a2c.rmsprop_eps must be > 0");
   }
   if (!(value_coef >= 0)) {
     return absl::InvalidArgumentError("a2c.value_coef must be >= 0");
@@ -50,6 +57,9 @@ A2cConfig FromSettings(const pb::A2cSettings& s) {
   if (s.has_entropy_coef()) c.entropy_coef = s.entropy_coef();
   if (s.has_value_coef()) c.value_coef = s.value_coef();
   if (s.has_max_grad_norm()) c.max_grad_norm = s.max_grad_norm();
+  if (s.has_rmsprop()) c.rmsprop = s.rmsprop();
+  if (s.has_rmsprop_alpha()) c.rmsprop_alpha = s.rmsprop_alpha();
+  if (s.has_rmsprop_eps()) c.rmsprop_eps = s.rmsprop_eps();
   return c;
 }
 
@@ -60,6 +70,9 @@ void ToSettings(const A2cConfig& c, pb::A2cSettings& s) {
   s.set_entropy_coef(c.entropy_coef);
   s.set_value_coef(c.value_coef);
   s.set_max_grad_norm(c.max_grad_norm);
+  s.set_rmsprop(c.rmsprop);
+  s.set_rmsprop_alpha(c.rmsprop_alpha);
+  s.set_rmsprop_eps(c.rmsprop_eps);
 }
 
 }  // namespace vantage

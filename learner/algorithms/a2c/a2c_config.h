@@ -2,6 +2,7 @@
 #define VANTAGE_LEARNER_ALGORITHMS_A2C_A2C_CONFIG_H_
 
 #include <cstdint>
+#include <string>
 
 #include "absl/status/status.h"
 #include "learner/algorithms/run_defaults.h"
@@ -11,7 +12,7 @@ namespace pb {
 class A2cSettings;
 }  // namespace pb
 
-// Defaults of the baselines' A2C the paper builds on.
+// Defaults of the baselines' A2C the paper builds on (but for rmsprop).
 struct A2cConfig {
   // The paper's path-ensemble trick: rollouts of steps_per_minibatch * n
   // steps (longer paths for the k-step estimates), updated as n
@@ -20,6 +21,12 @@ struct A2cConfig {
   int n = 4;
   int steps_per_minibatch = 5;  // A2C's rollout length
   double learning_rate = 7e-4;  // decays linearly to 0 over the run
+  // How RMSProp computes its step: "pytorch" (torch::optim::RMSprop) or
+  // "tensorflow" (TensorflowRmsprop, the baselines' arithmetic), whose tiny
+  // first steps cost short runs (60k steps of Breakout reach 0.9 instead
+  // of 3.3) and which did not stop the policy collapses of longer runs
+  // (bench/results/README.md (e)).
+  std::string rmsprop = "pytorch";
   double rmsprop_alpha = 0.99;
   double rmsprop_eps = 1e-5;
   double max_grad_norm = 0.5;

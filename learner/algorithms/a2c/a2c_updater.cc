@@ -6,9 +6,30 @@
 #include <algorithm>
 #include <limits>
 
+#include "learner/algorithms/a2c/tensorflow_rmsprop.h"
 #include "learner/algorithms/gradient_step.h"
 
 namespace vantage {
+namespace {
+
+std::unique_ptr<torch::optim::Optimizer> MakeRmsprop(
+    const std::vector<at::Tensor>& parameters, const A2cConfig& config) {
+  const auto options = torch::optim::RMSpropOptions(config.learning_rate)
+                           .alpha(config.rmsprop_alpha)
+                           .eps(config.rmsprop_eps);
+  if (config.rmsprop == "pytorch") {
+    return std::make_unique<torch::optim::RMSprop>(parameters, options);
+  }
+  return std::make_unique<TensorflowRmsprop>(parameters, options);
+}
+
+// The two arithmetics keep the same state, so the checkpoint key says which
+// one made it: a run cannot silently continue under the other.
+std::string OptimizerKey(const A2cConfig& config) {
+  return config.rmsprop == "pytorch" ? "rmsprop" : "rmsprop_tensorflow";
+}
+
+}  // namespace
 
 A2cUpdater::A2cUpdater(PolicyNetwork policy, ValueNetwork value,
                        const A2cConfig& config,
@@ -18,10 +39,7 @@ A2cUpdater::A2cUpdater(PolicyNetwork policy, ValueNetwork value,
       config_(config),
       replicas_(std::move(replicas)),
       parameters_(NetworkParameters(*policy_, *value_)),
-      optimizer_(std::make_unique<torch::optim::RMSprop>(
-          parameters_, torch::optim::RMSpropOptions(config.learning_rate)
-                           .alpha(config.rmsprop_alpha)
-                           .eps(config.rmsprop_eps))) {}
+      optimizer_(MakeRmsprop(parameters_, config)) {}
 
 A2cUpdater::~A2cUpdater() = default;
 
@@ -66,11 +84,11 @@ AlgorithmStats A2cUpdater::Update(const UpdateBatch& batch, double progress,
 }
 
 void A2cUpdater::Save(torch::serialize::OutputArchive& archive) const {
-  SaveOptimizer(*optimizer_, "rmsprop", archive);
+  SaveOptimizer(*optimizer_, OptimizerKey(config_), archive);
 }
 
 absl::Status A2cUpdater::Load(torch::serialize::InputArchive& archive) {
-  return LoadOptimizer(*optimizer_, "rmsprop", archive);
+  return LoadOptimizer(*optimizer_, OptimizerKey(config_), archive);
 }
 
 }  // namespace vantage

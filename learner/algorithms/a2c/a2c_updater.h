@@ -11,12 +11,12 @@
 #include "learner/parallel/replica_group.h"
 
 namespace torch::optim {
-class RMSprop;
+class Optimizer;
 }  // namespace torch::optim
 
 namespace vantage {
 
-// A2C: per minibatch one RMSProp step on
+// A2C: per minibatch one RMSProp step (a2c.rmsprop's arithmetic) on
 // -mean(log pi(a|s) A) + value_coef * value loss - entropy_coef * entropy.
 class A2cUpdater : public PolicyUpdater {
  public:
@@ -40,7 +40,7 @@ class A2cUpdater : public PolicyUpdater {
   A2cConfig config_;
   std::shared_ptr<ReplicaGroup> replicas_;
   std::vector<at::Tensor> parameters_;
-  std::unique_ptr<torch::optim::RMSprop> optimizer_;
+  std::unique_ptr<torch::optim::Optimizer> optimizer_;
 };
 
 }  // namespace vantage
