@@ -29,9 +29,11 @@ done
 # --video` renders MuJoCo offscreen on OSMesa (libosmesa6-dev), draws the
 # Bullet characters with Cairo (libcairo2-dev) and encodes with FFmpeg's
 # libraries (libav*-dev, libswscale-dev); its tests read the files back
-# with ffprobe and ffmpeg (ffmpeg).
+# with ffprobe and ffmpeg (ffmpeg). ccache keeps compiled objects for the
+# next build of any clone, the fuzz build and the container image's
+# (CMakeLists.txt).
 packages=(
-  build-essential cmake ninja-build pkgconf clang-format openssl
+  build-essential cmake ninja-build ccache pkgconf clang-format openssl
   libtorch-dev libgloo-dev libopenblas0-serial
   libmujoco-dev libqhull-dev libgl-dev libopengl-dev
   libbullet-dev

@@ -27,6 +27,12 @@
 #                         store's, else overlay if the kernel mounts it in
 #                         the cache directory, else vfs, slower and bigger)
 #   --nice N              niceness of debootstrap and the build (default 19)
+#   --ccache-dir DIR      a ccache cache the build stage compiles through,
+#                         mounted at /ccache (default: this machine's, from
+#                         `ccache --get-config cache_dir`, if ccache is
+#                         installed: objects of the machine's builds of the
+#                         same sources are reused)
+#   --no-ccache           compile everything in the build stage
 #   --build-arg K=V       passed to buildah bud (repeatable; see the Dockerfile)
 #   --rebuild-base        debootstrap and import the base again
 #   --no-cache            build every layer again
@@ -42,6 +48,8 @@ mirror=""
 security_mirror=""
 storage_driver="${STORAGE_DRIVER:-}"
 niceness=19
+ccache_dir=""
+use_ccache=1
 build_args=()
 rebuild_base=0
 no_cache=()
@@ -59,11 +67,13 @@ while [[ $# -gt 0 ]]; do
     --security-mirror) need_value "$@"; security_mirror="$2"; shift 2 ;;
     --storage-driver) need_value "$@"; storage_driver="$2"; shift 2 ;;
     --nice) need_value "$@"; niceness="$2"; shift 2 ;;
+    --ccache-dir) need_value "$@"; ccache_dir="$2"; shift 2 ;;
+    --no-ccache) use_ccache=0; shift ;;
     --build-arg) need_value "$@"; build_args+=(--build-arg "$2"); shift 2 ;;
     --rebuild-base) rebuild_base=1; shift ;;
     --no-cache) no_cache=(--no-cache); shift ;;
     --base-only) base_only=1; shift ;;
-    -h|--help) sed -n '2,32p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h|--help) sed -n '2,38p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "build_image.sh: unknown argument '$1' (see --help)" >&2; exit 2 ;;
   esac
 done
@@ -226,11 +236,28 @@ fi
 
 [[ "${base_only}" -eq 0 ]] || exit 0
 
-# 3. The image.
-echo "build_image.sh: buildah bud -t ${tag} (BASE_IMAGE=${base}, storage ${storage_driver})"
+# 3. The image, compiled through this machine's ccache cache if there is one.
+ccache_args=()
+if [[ "${use_ccache}" -eq 1 ]]; then
+  if [[ -z "${ccache_dir}" ]] && command -v ccache >/dev/null; then
+    ccache_dir="$(ccache --get-config cache_dir)"
+  fi
+  if [[ -n "${ccache_dir}" ]]; then
+    mkdir -p "${ccache_dir}"
+    ccache_args=(--build-arg CCACHE=ON --volume "$(cd "${ccache_dir}" && pwd):/ccache")
+    # ccache hashes these (they change the compiler's messages): the build
+    # stage compiles with this caller's, as the machine's builds did.
+    for variable in LANG LC_ALL LC_CTYPE LC_MESSAGES; do
+      if [[ -n "${!variable+set}" ]]; then
+        ccache_args+=(--build-arg "${variable}=${!variable}")
+      fi
+    done
+  fi
+fi
+echo "build_image.sh: buildah bud -t ${tag} (BASE_IMAGE=${base}, storage ${storage_driver}, ccache ${ccache_dir:-none})"
 start=$(date +%s)
 nice -n "${niceness}" buildah bud --isolation=chroot --layers --pull-never \
-    "${no_cache[@]}" --build-arg "BASE_IMAGE=${base}" "${build_args[@]}" \
+    "${no_cache[@]}" --build-arg "BASE_IMAGE=${base}" "${ccache_args[@]}" "${build_args[@]}" \
     -t "${tag}" -f "${repo_root}/deploy/docker/Dockerfile" "${repo_root}" ||
   die "buildah bud failed (output above)"
 echo "build_image.sh: built ${tag} in $(elapsed "${start}")"

@@ -3,6 +3,7 @@
 # copy of its seed corpus for a bounded time; fails on any crash, leak,
 # timeout or sanitizer report.
 # Usage: tests/fuzz/run_fuzzers.sh [--seconds N] [--build-dir DIR] [--jobs J]
+#   J: parallel compile jobs and fuzzers running at once (default 2)
 set -euo pipefail
 
 repo_root="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
@@ -15,12 +16,16 @@ while [[ $# -gt 0 ]]; do
     --seconds) seconds="$2"; shift 2 ;;
     --build-dir) build_dir="$2"; shift 2 ;;
     --jobs) jobs="$2"; shift 2 ;;
-    -h|--help) sed -n '2,5p' "${BASH_SOURCE[0]}"; exit 0 ;;
+    -h|--help) sed -n '2,6p' "${BASH_SOURCE[0]}"; exit 0 ;;
     *) echo "run_fuzzers.sh: unknown argument '$1' (see --help)" >&2; exit 2 ;;
   esac
 done
 if ! [[ "${seconds}" =~ ^[1-9][0-9]*$ ]]; then
   echo "run_fuzzers.sh: --seconds needs a whole number >= 1, got '${seconds}'" >&2
+  exit 2
+fi
+if ! [[ "${jobs}" =~ ^[1-9][0-9]*$ ]]; then
+  echo "run_fuzzers.sh: --jobs needs a whole number >= 1, got '${jobs}'" >&2
   exit 2
 fi
 
@@ -49,40 +54,62 @@ declare -A extra_asan_options=(
 runs_dir="${build_dir}/fuzz-runs"
 rm -rf "${runs_dir}"
 mkdir -p "${runs_dir}"
+
+# Runs one fuzzer for the time given; its verdict is the exit status, its
+# output the log in its work directory.
+run_one() {
+  local name="$1" work="$2"
+  local binary="${build_dir}/fuzz/${name}_fuzzer"
+  # A copy: libFuzzer adds what it finds to the corpus it is given.
+  mkdir "${work}/corpus"
+  cp -R "${fuzz_dir}/corpus/${name}/." "${work}/corpus/" || return 1
+  # A dictionary of the input's tokens, if the fuzzer has one.
+  local dict=()
+  if [[ -f "${fuzz_dir}/${name}.dict" ]]; then
+    dict=(-dict="${fuzz_dir}/${name}.dict")
+  fi
+  cd "${work}" && ASAN_OPTIONS="${asan_options}${extra_asan_options[${name}]:-}" \
+    "${binary}" -max_total_time="${seconds}" \
+    -rss_limit_mb=4096 -timeout=25 -print_final_stats=1 \
+    -artifact_prefix="${work}/" "${dict[@]}" corpus >"${work}/log.txt" 2>&1
+}
+
+# Up to --jobs fuzzers at once (each is one process on one core); the
+# verdicts are read in a fixed order once all have ended.
+names=()
 summary=()
 passed=0
 failed=0
 for source in "${fuzz_dir}"/*_fuzzer.cc; do
   name="$(basename "${source}" _fuzzer.cc)"
-  binary="${build_dir}/fuzz/${name}_fuzzer"
-  work="${runs_dir}/${name}"
-  mkdir -p "${work}/corpus"
-  log="${work}/log.txt"
   if [[ ! -d "${fuzz_dir}/corpus/${name}" ]]; then
     echo "run_fuzzers.sh: ${name} has no seed corpus tests/fuzz/corpus/${name}" >&2
     summary+=("fuzz ${name}: 0 runs, FAILED (no seed corpus)")
     failed=$((failed + 1))
     continue
   fi
-  # A copy: libFuzzer adds what it finds to the corpus it is given.
-  cp -R "${fuzz_dir}/corpus/${name}/." "${work}/corpus/"
-  echo "run_fuzzers.sh: ${name} for ${seconds} s (log ${log})"
-  # A dictionary of the input's tokens, if the fuzzer has one.
-  dict=()
-  if [[ -f "${fuzz_dir}/${name}.dict" ]]; then
-    dict=(-dict="${fuzz_dir}/${name}.dict")
-  fi
-  status=0
-  (cd "${work}" && ASAN_OPTIONS="${asan_options}${extra_asan_options[${name}]:-}" \
-      "${binary}" -max_total_time="${seconds}" \
-      -rss_limit_mb=4096 -timeout=25 -print_final_stats=1 \
-      -artifact_prefix="${work}/" "${dict[@]}" corpus) >"${log}" 2>&1 ||
-    status=$?
+  while [[ "$(jobs -rp | wc -l)" -ge "${jobs}" ]]; do wait -n || true; done
+  mkdir -p "${runs_dir}/${name}"
+  echo "run_fuzzers.sh: ${name} for ${seconds} s (log ${runs_dir}/${name}/log.txt)"
+  {
+    status=0
+    run_one "${name}" "${runs_dir}/${name}" || status=$?
+    echo "${status}" >"${runs_dir}/${name}/status"
+  } &
+  names+=("${name}")
+done
+
+wait
+for name in "${names[@]}"; do
+  work="${runs_dir}/${name}"
+  log="${work}/log.txt"
+  binary="${build_dir}/fuzz/${name}_fuzzer"
+  status="$(cat "${work}/status" 2>/dev/null || echo "no status")"
   runs="$(sed -n 's/^stat::number_of_executed_units: *\([0-9]*\).*/\1/p' "${log}" | tail -n 1)"
   runs="${runs:-0}"
   reproducer="$(sed -n 's/.*Test unit written to \(.*\)$/\1/p' "${log}" | tail -n 1)"
   report="$(grep -m 1 -E 'ERROR: (Address|Leak|Undefined)Sanitizer|runtime error:|ERROR: libFuzzer|fuzz invariant broken' "${log}" || true)"
-  if [[ ${status} -eq 0 && -z "${reproducer}" && -z "${report}" ]]; then
+  if [[ "${status}" == 0 && -z "${reproducer}" && -z "${report}" ]]; then
     summary+=("fuzz ${name}: ${runs} runs, ok")
     passed=$((passed + 1))
   else
