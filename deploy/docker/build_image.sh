@@ -73,7 +73,7 @@ while [[ $# -gt 0 ]]; do
     --rebuild-base) rebuild_base=1; shift ;;
     --no-cache) no_cache=(--no-cache); shift ;;
     --base-only) base_only=1; shift ;;
-    -h|--help) sed -n '2,38p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h|--help) sed -n '2,40p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "build_image.sh: unknown argument '$1' (see --help)" >&2; exit 2 ;;
   esac
 done
