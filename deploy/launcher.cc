@@ -24,8 +24,8 @@
 #include "deploy/run_config.h"
 #include "deploy/run_directory.h"
 #include "deploy/scrape_targets.h"
-#include "learner/algorithms/algorithm.h"
-#include "learner/checkpoint.h"
+#include "learner/algorithms/algorithm_config.h"
+#include "learner/checkpoint_files.h"
 
 namespace vantage {
 namespace {

@@ -1,8 +1,10 @@
 #include "deploy/local_training.h"
 
 #include "absl/strings/str_cat.h"
+#include "actor/actor_core.h"
 #include "deploy/training_run.h"
 #include "learner/checkpoint.h"
+#include "learner/learner_core.h"
 
 namespace vantage {
 namespace {
@@ -10,17 +12,6 @@ namespace {
 constexpr char kActorState[] = "actor_state";
 
 }  // namespace
-
-LearnerConfig MakeLearnerConfig(const LocalTrainingConfig& config,
-                                const EnvSpec& spec) {
-  LearnerConfig learner = config.learner;
-  learner.spec = spec;
-  learner.rollouts_per_batch = config.num_envs;
-  learner.max_segment_steps = config.learner.horizon;
-  learner.total_env_steps = config.total_env_steps;
-  learner.seed = config.seed;
-  return learner;
-}
 
 absl::Status RunLocalTraining(
     const LocalTrainingConfig& config,

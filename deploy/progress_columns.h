@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "learner/learner_core.h"
+#include "learner/update_stats.h"
 
 namespace vantage {
 

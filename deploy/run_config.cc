@@ -13,7 +13,7 @@
 #include "absl/strings/str_split.h"
 #include "common/advantage/advantage_config.h"
 #include "common/env/frame_stack.h"
-#include "learner/algorithms/algorithm.h"
+#include "learner/algorithms/algorithm_config.h"
 #include "learner/exploration/ex2_config.h"
 #include "proto/flat_run_config.pb.h"
 

@@ -7,7 +7,8 @@
 #include <string>
 
 #include "absl/status/statusor.h"
-#include "deploy/local_training.h"
+#include "actor/envs/env_registry.h"
+#include "deploy/local_training_config.h"
 #include "proto/run_config.pb.h"
 
 namespace vantage {

@@ -1,17 +1,32 @@
 #!/usr/bin/env bash
 # Installs vantage's build dependencies from Debian packages (only the ones
-# missing), then configures and builds the project into ./build with Ninja.
-# Usage: deploy/setup.sh [--build-dir DIR] [--build-type Release|Debug|...]
+# missing), then configures and builds into ./build with Ninja: the
+# `vantage` binary alone, or with --tests everything (the test suite, the
+# benchmarks of `vantage bench`) after the packages only the tests need.
+# Usage: deploy/setup.sh [--tests] [--packages-only] [--build-dir DIR]
+#          [--build-type Release|Debug|...]
+#   --tests          also the tests' packages, tests and benchmarks
+#   --packages-only  install the packages and stop (the container image's
+#                    build stage); without --tests, the binary's only
+# A build directory configured with the tests keeps them when setup.sh runs
+# again without --tests (only the binary is rebuilt then).
 set -euo pipefail
 
 repo_root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 build_dir="${repo_root}/build"
 build_type="Release"
+with_tests=0
+packages_only=0
+need_value() {
+  [[ $# -ge 2 && -n "$2" ]] || { echo "setup.sh: $1 needs a value (see --help)" >&2; exit 2; }
+}
 while [[ $# -gt 0 ]]; do
   case "$1" in
-    --build-dir) build_dir="$2"; shift 2 ;;
-    --build-type) build_type="$2"; shift 2 ;;
-    -h|--help) sed -n '2,4p' "${BASH_SOURCE[0]}"; exit 0 ;;
+    --tests) with_tests=1; shift ;;
+    --packages-only) packages_only=1; shift ;;
+    --build-dir) need_value "$@"; build_dir="$2"; shift 2 ;;
+    --build-type) need_value "$@"; build_type="$2"; shift 2 ;;
+    -h|--help) sed -n '2,12p' "${BASH_SOURCE[0]}"; exit 0 ;;
     *) echo "setup.sh: unknown argument '$1' (see --help)" >&2; exit 2 ;;
   esac
 done
@@ -23,43 +38,58 @@ done
 # alternatives) over from the reference BLAS that LibTorch's GEMMs would
 # otherwise run on; serial, because every vantage process computes on one
 # thread of its own and several share the machine (docs/benchmarks.md).
-# prometheus (with promtool) serves deploy/prometheus/ and its test;
+# prometheus (with promtool) serves deploy/prometheus/watch_runs.sh;
 # python3-matplotlib draws `vantage plot`'s figures and python3-scipy computes
 # the statistics of `vantage experiment report`. `vantage rollout
 # --video` renders MuJoCo offscreen on OSMesa (libosmesa6-dev), draws the
 # Bullet characters with Cairo (libcairo2-dev) and encodes with FFmpeg's
-# libraries (libav*-dev, libswscale-dev); its tests read the files back
-# with ffprobe and ffmpeg (ffmpeg). ccache keeps compiled objects for the
-# next build of any clone, the fuzz build and the container image's
-# (CMakeLists.txt).
+# libraries (libav*-dev, libswscale-dev). libbenchmark-dev: the container
+# image's build stage, which installs this list, builds `vantage bench`.
+# ccache keeps compiled objects for the next build of any clone, the fuzz
+# build and the container image's (CMakeLists.txt).
 packages=(
-  build-essential cmake ninja-build ccache pkgconf clang-format openssl
+  build-essential cmake ninja-build ccache pkgconf openssl
   libtorch-dev libgloo-dev libopenblas0-serial
   libmujoco-dev libqhull-dev libgl-dev libopengl-dev
   libbullet-dev
   libgrpc++-dev protobuf-compiler-grpc libprotobuf-dev protobuf-compiler
   libabsl-dev
-  libgtest-dev libgmock-dev libbenchmark-dev
+  libbenchmark-dev
   prometheus-cpp-dev
   libminizip-dev
   prometheus python3-matplotlib python3-scipy
   libosmesa6-dev libcairo2-dev
-  libavcodec-dev libavformat-dev libswscale-dev libavutil-dev ffmpeg
+  libavcodec-dev libavformat-dev libswscale-dev libavutil-dev
 )
 
-# Only the tests of deploy/ need these (kept apart from packages=(...),
-# which the container image's build stage installs): Slurm's daemons
-# (slurm-wlm, munge) for tests/deploy/slurm/; buildah and debootstrap to
-# build the image here (tests/deploy/docker/); python3-yaml to read the
-# rendered Kubernetes manifests (tests/deploy/k8s/), kubectl to render them
-# and Node.js with npm to validate them. A machine that has kubectl or
-# npm from elsewhere keeps them (Debian's packages would conflict).
-test_packages=(slurm-wlm munge buildah debootstrap python3-yaml)
+# Only the tests need these (kept apart from packages=(...), which the
+# container image's build stage installs): GoogleTest and clang-format (the
+# format check); ffprobe and ffmpeg (ffmpeg) read the videos of `vantage
+# rollout --video` back; Slurm's daemons (slurm-wlm, munge) for
+# tests/deploy/slurm/; buildah and debootstrap to build the image here
+# (tests/deploy/docker/); python3-yaml to read the rendered Kubernetes
+# manifests (tests/deploy/k8s/), kubectl to render them and Node.js with npm
+# to validate them. A machine that has kubectl or npm from elsewhere keeps
+# them (Debian's packages would conflict).
+test_packages=(libgtest-dev libgmock-dev clang-format ffmpeg
+  slurm-wlm munge buildah debootstrap python3-yaml)
 command -v kubectl >/dev/null || test_packages+=(kubernetes-client)
 command -v npm >/dev/null || test_packages+=(nodejs npm)
 
-"${repo_root}/deploy/install_packages.sh" setup.sh "${packages[@]}" \
-  "${test_packages[@]}"
+wanted=("${packages[@]}")
+[[ "${with_tests}" -eq 1 ]] && wanted+=("${test_packages[@]}")
+"${repo_root}/deploy/install_packages.sh" setup.sh "${wanted[@]}"
+[[ "${packages_only}" -eq 1 ]] && exit 0
 
-cmake -S "${repo_root}" -B "${build_dir}" -G Ninja -DCMAKE_BUILD_TYPE="${build_type}"
-cmake --build "${build_dir}"
+configure=(-G Ninja -DCMAKE_BUILD_TYPE="${build_type}")
+if [[ "${with_tests}" -eq 1 ]]; then
+  configure+=(-DVANTAGE_BUILD_TESTS=ON -DVANTAGE_BUILD_BENCHMARKS=ON)
+elif [[ ! -f "${build_dir}/CMakeCache.txt" ]]; then
+  configure+=(-DVANTAGE_BUILD_TESTS=OFF -DVANTAGE_BUILD_BENCHMARKS=OFF)
+fi
+cmake -S "${repo_root}" -B "${build_dir}" "${configure[@]}"
+if [[ "${with_tests}" -eq 1 ]]; then
+  cmake --build "${build_dir}"
+else
+  cmake --build "${build_dir}" --target vantage
+fi

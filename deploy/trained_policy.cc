@@ -1,18 +1,29 @@
 #include "deploy/trained_policy.h"
 
 #include <ATen/ATen.h>
+#include <ATen/CPUGeneratorImpl.h>
 #include <ATen/core/grad_mode.h>
 
 #include <filesystem>
 
 #include "absl/strings/str_cat.h"
 #include "actor/envs/env_registry.h"
+#include "common/nn/networks.h"
 #include "common/nn/policy_weights.h"
+#include "common/nn/running_mean_std.h"
 #include "deploy/local_training.h"
 #include "deploy/run_config.h"
 #include "learner/checkpoint.h"
 
 namespace vantage {
+
+struct TrainedPolicy::Networks {
+  PolicyNetwork policy{nullptr};
+  RunningMeanStd normalizer{1};
+  double observation_clip = 10.0;
+  at::Generator generator = at::detail::createCPUGenerator(0);
+};
+
 namespace {
 
 absl::StatusOr<TrainedPolicy> LoadCheckpointFile(const std::string& path) {
@@ -39,11 +50,13 @@ absl::StatusOr<TrainedPolicy> LoadCheckpointFile(const std::string& path) {
   trained.checkpoint_path = path;
   trained.version = (*learner)->policy_version();
   trained.spec = (*env)->spec();
-  trained.policy = PolicyNetwork((*env)->spec(), local.learner.network);
-  trained.normalizer = RunningMeanStd((*env)->spec().observation_size);
-  trained.observation_clip = local.learner.observation_clip;
+  trained.networks = std::make_shared<TrainedPolicy::Networks>();
+  TrainedPolicy::Networks& networks = *trained.networks;
+  networks.policy = PolicyNetwork((*env)->spec(), local.learner.network);
+  networks.normalizer = RunningMeanStd((*env)->spec().observation_size);
+  networks.observation_clip = local.learner.observation_clip;
   if (absl::Status status = ImportPolicyWeights(
-          (*learner)->CurrentWeights(), *trained.policy, trained.normalizer);
+          (*learner)->CurrentWeights(), *networks.policy, networks.normalizer);
       !status.ok()) {
     return status;
   }
@@ -52,16 +65,20 @@ absl::StatusOr<TrainedPolicy> LoadCheckpointFile(const std::string& path) {
 
 }  // namespace
 
+void TrainedPolicy::Seed(uint64_t seed) {
+  networks->generator = at::detail::createCPUGenerator(seed);
+}
+
 std::vector<double> TrainedPolicy::Act(absl::Span<const double> observation,
-                                       bool deterministic,
-                                       at::Generator generator) {
+                                       bool deterministic) {
   at::NoGradGuard no_grad;
+  Networks& n = *networks;
   const at::Tensor x = ObservationTensor(spec, observation.data(), 1);
   const at::Tensor action =
-      policy
-          ->Act(policy->forward(ObservationsForNetwork(spec, normalizer, x,
-                                                       observation_clip)),
-                deterministic, generator)
+      n.policy
+          ->Act(n.policy->forward(ObservationsForNetwork(spec, n.normalizer, x,
+                                                         n.observation_clip)),
+                deterministic, n.generator)
           .to(at::kDouble)
           .contiguous();
   const double* data = action.data_ptr<double>();

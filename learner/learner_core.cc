@@ -24,59 +24,6 @@
 
 namespace vantage {
 
-absl::Status LearnerConfig::Validate() const {
-  if (spec.observation_size < 1 || spec.action_size < 1) {
-    return absl::InvalidArgumentError("learner needs an environment spec");
-  }
-  if (absl::Status status = CheckObservationLayout(spec); !status.ok()) {
-    return status;
-  }
-  if (absl::Status status = CheckNetworkConfig(network, spec); !status.ok()) {
-    return status;
-  }
-  if (network.shared_torso && !AlgorithmStepsBothNetworksAtOnce(algorithm)) {
-    return absl::InvalidArgumentError(absl::StrCat(
-        "a shared torso needs an algorithm that steps the policy and the "
-        "value network with one optimiser (a2c, ppo); ",
-        algorithm.name, " fits its value network on its own"));
-  }
-  if (horizon < 1 || rollouts_per_batch < 1 || total_env_steps < 1) {
-    return absl::InvalidArgumentError(
-        "learner horizon, rollouts_per_batch and total_env_steps must be "
-        ">= 1");
-  }
-  if (!(observation_clip > 0) || !(reward_clip > 0)) {
-    return absl::InvalidArgumentError(
-        "observation_clip and reward_clip must be > 0");
-  }
-  if (max_buffered_steps < 0) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("max_buffered_steps must be >= 0 (0: 8 batches), got ",
-                     max_buffered_steps));
-  }
-  if (!(rollback_gradient_norm > 0)) {
-    return absl::InvalidArgumentError(absl::StrCat(
-        "rollback_gradient_norm must be > 0, got ", rollback_gradient_norm));
-  }
-  if (absl::Status status = value_limits.Validate(); !status.ok()) {
-    return status;
-  }
-  if (absl::Status status = advantage.Validate(); !status.ok()) return status;
-  if (absl::Status status = algorithm.Validate(); !status.ok()) return status;
-  if (exploration.ex2.has_value()) {
-    if (absl::Status status = exploration.ex2->Validate(); !status.ok()) {
-      return status;
-    }
-  }
-  if (algorithm.name == "a2c" &&
-      horizon % algorithm.a2c.steps_per_minibatch != 0) {
-    return absl::InvalidArgumentError(absl::StrCat(
-        "a2c needs a horizon that is a multiple of its ",
-        algorithm.a2c.steps_per_minibatch, "-step minibatches; got ", horizon));
-  }
-  return absl::OkStatus();
-}
-
 namespace {
 
 std::mutex& InitialisationMutex() {

@@ -3,14 +3,12 @@
 
 #include <cstdint>
 #include <deque>
-#include <limits>
 #include <memory>
 #include <random>
 #include <string>
 #include <vector>
 
 #include "absl/status/statusor.h"
-#include "common/advantage/advantage_config.h"
 #include "common/env/environment.h"
 #include "common/nn/networks.h"
 #include "common/nn/policy_weights.h"
@@ -18,89 +16,15 @@
 #include "common/rollout/segment.h"
 #include "common/rollout/segment_queue.h"
 #include "learner/algorithms/algorithm.h"
-#include "learner/exploration/ex2_config.h"
-#include "learner/exploration/exploration_stats.h"
 #include "learner/ingest/reward_scaler.h"
 #include "learner/ingest/rollout_stitcher.h"
+#include "learner/learner_config.h"
 #include "learner/parallel/replica_group.h"
+#include "learner/update_stats.h"
 
 namespace vantage {
 
 class Ex2Bonus;
-
-struct LearnerConfig {
-  EnvSpec spec;
-  int64_t horizon = 2048;  // steps per rollout and env stream
-  // Env streams per update of this learner (of each replica, in a
-  // data-parallel run: the global batch is world_size times as large).
-  int64_t rollouts_per_batch = 1;
-  int64_t max_segment_steps = 4096;
-  // Steps acted by a policy older than version - max_policy_lag are
-  // dropped and counted (0: strictly on-policy, the sync mode); -1: any.
-  int64_t max_policy_lag = 0;
-  int64_t total_env_steps = 1000000;  // the learning rate decays to 0 there
-  uint64_t seed = 0;
-  double observation_clip = 10.0;
-  // Divide rewards by the running std of discounted returns (then clip).
-  bool scale_rewards = false;
-  double reward_clip = 10.0;
-  // An update with a larger global gradient norm (before clipping) in any
-  // of its gradient steps is rolled back like one that produced non-finite
-  // numbers; infinite: only non-finite numbers roll back.
-  double rollback_gradient_norm = std::numeric_limits<double>::infinity();
-  // Steps the stitcher may hold in partial rollouts over all streams; past
-  // it, the least recently fed streams are dropped (counted in
-  // evicted_steps). 0: 8 batches (horizon * rollouts_per_batch * 8).
-  int64_t max_buffered_steps = 0;
-  // What a segment's values must stay within (see ValidateSegment).
-  ValueLimits value_limits;
-  AdvantageConfig advantage;
-  AlgorithmConfig algorithm;
-  NetworkConfig network;
-  // A bonus added to the rewards before advantages (none by default).
-  ExplorationConfig exploration;
-
-  absl::Status Validate() const;
-};
-
-// Over the global batch (every replica's) in a data-parallel run.
-struct UpdateStats {
-  int64_t policy_version = 0;  // published after this update
-  int64_t env_steps = 0;       // consumed so far
-  int64_t episodes = 0;        // finished, reported by consumed segments
-  // Of the last 100 episodes each replica saw; NaN before the first ends.
-  double mean_return = 0.0;
-  AlgorithmStats algorithm;
-  ExplorationStats exploration;  // rank 0's, in a data-parallel run
-  double biased_fraction = 0.0;  // share of samples using the bias
-  double mean_abs_bias = 0.0;    // mean |biased - GAE|
-  double explained_variance = 0.0;
-  int64_t rejected_segments = 0;  // so far, any reason (stale included)
-  // Why the first segment this update refused was refused (what
-  // ValidateSegment or the stitcher said, with the segment's actor and
-  // slot); empty if it refused none. Stale segments are only counted.
-  std::string first_rejection;
-  int64_t stale_segments = 0;  // so far, too old a policy version
-  int64_t stale_steps = 0;     // so far, dropped for their version
-  int64_t evicted_steps = 0;   // so far, dropped to stay in budget
-  // This update produced a non-finite loss or parameter (or too large a
-  // gradient) and was undone: the networks, the optimiser state and the
-  // reward scaler are as before it, the batch is dropped, the version still
-  // advances (with unchanged weights) so that synchronous actors go on.
-  bool rolled_back = false;
-  std::string rollback_reason;      // why, if rolled_back
-  int64_t rolled_back_updates = 0;  // so far
-  // Wall-clock seconds of this update once its batch was complete (not
-  // reproducible, so not in progress.csv).
-  double update_seconds = 0.0;
-  // Of which: the critic's values and the advantages (batch assembly
-  // included), and the algorithm's optimisation.
-  double advantage_seconds = 0.0;
-  double optimisation_seconds = 0.0;
-  // Per rollout of this batch: how many versions behind the updated policy
-  // its oldest step was acted (0 throughout in sync mode).
-  std::vector<int64_t> rollout_policy_lags;
-};
 
 // Consumes segments, stitches rollouts, evaluates the critic, estimates
 // advantages (GAE + the biased path ensemble, rho-mixed), runs the

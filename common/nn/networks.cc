@@ -79,19 +79,6 @@ EnvSpec FlatSpec(int64_t observation_size) {
 
 }  // namespace
 
-absl::Status CheckNetworkConfig(const NetworkConfig& config,
-                                const EnvSpec& spec) {
-  const absl::StatusOr<Torso> torso = ResolveTorso(config.torso, spec);
-  if (!torso.ok()) return torso.status();
-  if (config.shared_torso && *torso == Torso::kMlp) {
-    return absl::InvalidArgumentError(absl::StrCat(
-        "a shared torso needs a convolutional one, but '", spec.name,
-        "' gets the mlp torso (--torso=", TorsoName(config.torso),
-        "); share with --torso=minatar or nature on image observations"));
-  }
-  return absl::OkStatus();
-}
-
 at::Tensor NetworkInputs(const EnvSpec& spec, const at::Tensor& observations) {
   if (observations.scalar_type() != at::kByte) return observations;
   return observations.to(at::kFloat)

@@ -22,24 +22,11 @@
 
 #include "absl/status/status.h"
 #include "common/env/environment.h"
+#include "common/nn/network_config.h"
 #include "common/nn/running_mean_std.h"
 #include "common/nn/torso.h"
 
 namespace vantage {
-
-struct NetworkConfig {
-  std::vector<int64_t> hidden = {64, 64};  // the MLP torso's layers
-  Torso torso = Torso::kAuto;
-  // The value network uses the policy's convolutions instead of its own, so
-  // that one trunk learns from both losses. Needs a convolutional torso,
-  // and an algorithm that steps both networks with one optimiser.
-  bool shared_torso = false;
-};
-
-// Why `config` cannot build networks for `spec`: a torso that does not fit
-// (ResolveTorso), or a shared torso that resolves to the MLP.
-absl::Status CheckNetworkConfig(const NetworkConfig& config,
-                                const EnvSpec& spec);
 
 // Linear layers with tanh between them (none after the last).
 class TanhMlpImpl : public torch::nn::Module {

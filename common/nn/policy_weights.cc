@@ -6,6 +6,8 @@
 #include <string>
 
 #include "absl/strings/str_cat.h"
+#include "common/nn/networks.h"
+#include "common/nn/running_mean_std.h"
 
 namespace vantage {
 

@@ -7,10 +7,11 @@
 #include <vector>
 
 #include "absl/status/status.h"
-#include "common/nn/networks.h"
-#include "common/nn/running_mean_std.h"
 
 namespace vantage {
+
+class PolicyNetworkImpl;
+class RunningMeanStd;
 
 // What the learner publishes as policy version `version`: the policy's
 // parameters (in registration order) and the observation normaliser's

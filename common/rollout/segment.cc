@@ -68,14 +68,6 @@ absl::Status Expect(const at::Tensor& t, const char* field,
   return absl::OkStatus();
 }
 
-absl::Status CheckLimit(double value, const char* name) {
-  if (!(value > 0)) {
-    return absl::InvalidArgumentError(
-        absl::StrCat(name, " must be > 0, got ", value));
-  }
-  return absl::OkStatus();
-}
-
 // The number of set flags, and whether any step has both.
 int64_t CountSet(const at::Tensor& flags) {
   const at::Tensor dense = flags.contiguous();
@@ -152,17 +144,6 @@ absl::Status CheckEpisodes(const Segment& segment, const EnvSpec& spec,
 }
 
 }  // namespace
-
-absl::Status ValueLimits::Validate() const {
-  for (absl::Status status :
-       {CheckLimit(max_abs_observation, "max_abs_observation"),
-        CheckLimit(max_abs_action, "max_abs_action"),
-        CheckLimit(max_abs_reward, "max_abs_reward"),
-        CheckLimit(max_abs_log_prob, "max_abs_log_prob")}) {
-    if (!status.ok()) return status;
-  }
-  return absl::OkStatus();
-}
 
 absl::Status ValidateSegment(const Segment& segment, const EnvSpec& spec,
                              int64_t max_steps, const ValueLimits& limits) {

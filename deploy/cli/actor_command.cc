@@ -1,13 +1,12 @@
 #include "deploy/cli/actor_command.h"
 
-#include <ATen/Parallel.h>
-
 #include <cstdio>
 #include <string>
 
 #include "absl/flags/flag.h"
 #include "absl/strings/str_cat.h"
 #include "actor/remote/remote_actor.h"
+#include "common/nn/compute_threads.h"
 #include "deploy/cli/command_line.h"
 #include "deploy/cli/security_flags.h"
 #include "deploy/cli/shared_flags.h"
@@ -44,7 +43,7 @@ int RunActor(const std::vector<std::string>&) {
   if (!security.ok()) return Fail(kUsageError, security.status().message());
   config.security = *std::move(security);
   // One intra-op thread per actor: actors are many processes already.
-  at::set_num_threads(1);
+  SetComputeThreads(1);
   const absl::Status status = RunRemoteActor(config, StopRequested());
   if (!status.ok()) return Fail(kRuntimeError, status.message());
   return 0;

@@ -4,28 +4,24 @@
 
 #include "deploy/cli/actor_command.h"
 #include "deploy/cli/advantages_command.h"
+#include "deploy/cli/bench_command.h"
 #include "deploy/cli/env_commands.h"
 #include "deploy/cli/experiment_command.h"
 #include "deploy/cli/health_command.h"
 #include "deploy/cli/learner_command.h"
 #include "deploy/cli/plot_command.h"
 #include "deploy/cli/train_command.h"
-#ifdef VANTAGE_WITH_BENCHMARKS
-#include "deploy/cli/bench_command.h"
-#endif
 
 namespace vantage {
 
 const std::vector<Command>& AllCommands() {
   static const auto* commands = [] {
     auto* all = new std::vector<Command>{
-        ActorCommand(),      AdvantagesCommand(), EnvsCommand(),
-        ExperimentCommand(), HealthCommand(),     LearnerCommand(),
-        PlotCommand(),       RolloutCommand(),    TrainCommand(),
+        ActorCommand(),   AdvantagesCommand(), BenchCommand(),
+        EnvsCommand(),    ExperimentCommand(), HealthCommand(),
+        LearnerCommand(), PlotCommand(),       RolloutCommand(),
+        TrainCommand(),
     };
-#ifdef VANTAGE_WITH_BENCHMARKS
-    all->push_back(BenchCommand());
-#endif
     std::sort(all->begin(), all->end(), [](const Command& a, const Command& b) {
       return a.name < b.name;
     });

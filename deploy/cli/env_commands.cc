@@ -1,7 +1,5 @@
 #include "deploy/cli/env_commands.h"
 
-#include <ATen/CPUGeneratorImpl.h>
-
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -186,7 +184,7 @@ int RunRollout(const std::vector<std::string>&) {
                 static_cast<long>(trained->version),
                 request.stochastic ? "sampled" : "deterministic");
   }
-  at::Generator generator = at::detail::createCPUGenerator(seed);
+  if (trained.has_value()) trained->Seed(seed);
   if (env_name.empty()) {
     return Fail("rollout", absl::InvalidArgumentError(
                                "--env=NAME is required (see `vantage envs`)"));
@@ -227,7 +225,7 @@ int RunRollout(const std::vector<std::string>&) {
     int64_t length = 0;
     while (true) {
       if (trained.has_value()) {
-        action = trained->Act(observation, !request.stochastic, generator);
+        action = trained->Act(observation, !request.stochastic);
       } else if (spec.discrete) {
         action[0] = static_cast<double>(std::uniform_int_distribution<int64_t>(
             0, spec.action_size - 1)(rng));

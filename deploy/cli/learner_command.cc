@@ -1,7 +1,5 @@
 #include "deploy/cli/learner_command.h"
 
-#include <ATen/Parallel.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -10,6 +8,7 @@
 #include "absl/flags/flag.h"
 #include "absl/strings/str_cat.h"
 #include "actor/envs/env_registry.h"
+#include "common/nn/compute_threads.h"
 #include "deploy/cli/run_flags.h"
 #include "deploy/cli/security_flags.h"
 #include "deploy/cli/shared_flags.h"
@@ -146,7 +145,7 @@ int RunLearner(const std::vector<std::string>&) {
   absl::StatusOr<SecurityOptions> security = SecurityFromFlags(/*server=*/true);
   if (!security.ok()) return Fail(kUsageError, security.status().message());
   const int learner_threads = LearnerThreads(resolved->config.distributed());
-  at::set_num_threads(learner_threads);
+  SetComputeThreads(learner_threads);
   // The learner's own configuration pins the environment; no actor's
   // registration decides it.
   absl::StatusOr<std::unique_ptr<Environment>> env = MakeEnvironment(

@@ -12,7 +12,7 @@
 #include "absl/strings/str_split.h"
 #include "deploy/cli/command_line.h"
 #include "deploy/run_config.h"
-#include "learner/algorithms/algorithm.h"
+#include "learner/algorithms/algorithm_config.h"
 #include "learner/exploration/ex2_config.h"
 
 // Every default is ResolveRunConfig's (see RunFlagDefaults): a flag's own

@@ -7,8 +7,8 @@
 #include "absl/strings/str_join.h"
 #include "deploy/run_config.h"
 #include "deploy/run_directory.h"
-#include "learner/algorithms/algorithm.h"
-#include "learner/checkpoint.h"
+#include "learner/algorithms/algorithm_config.h"
+#include "learner/checkpoint_files.h"
 
 namespace vantage {
 namespace {

@@ -10,7 +10,8 @@
 #include <vector>
 
 #include "absl/status/statusor.h"
-#include "deploy/local_training.h"
+#include "deploy/local_training_config.h"
+#include "deploy/progress_columns.h"
 #include "deploy/run_directory.h"
 #include "proto/run_config.pb.h"
 

@@ -1,6 +1,5 @@
 #include "deploy/cli/train_command.h"
 
-#include <ATen/Parallel.h>
 #include <unistd.h>
 
 #include <cmath>
@@ -12,7 +11,8 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_join.h"
 #include "actor/envs/env_registry.h"
-#include "common/nn/networks.h"
+#include "common/nn/compute_threads.h"
+#include "common/nn/network_config.h"
 #include "deploy/cli/run_flags.h"
 #include "deploy/cli/security_flags.h"
 #include "deploy/cli/shared_flags.h"
@@ -21,7 +21,7 @@
 #include "deploy/local_training.h"
 #include "deploy/run_config.h"
 #include "deploy/run_directory.h"
-#include "learner/algorithms/algorithm.h"
+#include "learner/algorithms/algorithm_config.h"
 
 namespace vantage {
 namespace {
@@ -81,7 +81,7 @@ int RunDistributed(const ResolvedRun& run) {
 int RunLocal(const ResolvedRun& run) {
   const pb::RunConfig& config = run.config;
   const LocalTrainingConfig& local = run.local;
-  at::set_num_threads(1);
+  SetComputeThreads(1);
   std::printf(
       "%s %s with %s, estimator %s (rho %g, ensemble %s), %ld steps, seed "
       "%lu%s%s\n",

@@ -10,6 +10,7 @@
 #include <random>
 
 #include "absl/status/status.h"
+#include "learner/algorithms/algorithm_stats.h"
 
 namespace torch::serialize {
 class InputArchive;
@@ -27,20 +28,6 @@ struct UpdateBatch {
   at::Tensor behaviour_log_probs;  // [T*N] of the policy that acted
   at::Tensor advantages;           // [T*N] rho-mixed: the policy's
   at::Tensor returns;              // [T*N] V + GAE: the critic's
-};
-
-// Means over the update's gradient steps. NaN where an algorithm has no
-// such quantity (A2C and TRPO clip nothing).
-struct AlgorithmStats {
-  double policy_loss = 0.0;
-  double value_loss = 0.0;
-  double entropy = 0.0;
-  double approx_kl = 0.0;  // between the policy before and after
-  double clip_fraction = 0.0;
-  // The largest global gradient norm (before clipping) of any gradient step
-  // of the policy; NaN where the algorithm takes none (TRPO's natural
-  // gradient step).
-  double max_gradient_norm = 0.0;
 };
 
 class PolicyUpdater {

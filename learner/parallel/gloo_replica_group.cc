@@ -13,6 +13,7 @@
 
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
+#include "learner/parallel/replica_group.h"
 
 namespace vantage {
 namespace {

@@ -10,9 +10,10 @@
 
 #include "absl/status/statusor.h"
 #include "absl/time/time.h"
-#include "learner/parallel/replica_group.h"
 
 namespace vantage {
+
+class ReplicaGroup;
 
 struct ReplicaGroupConfig {
   int rank = 0;

@@ -1,0 +1,136 @@
+#!/usr/bin/env bash
+# Measures a cold build of a clean clone against a reference compile made in
+# the same run, so that figures from different machines can be compared as
+# ratios. The clone (of HEAD: commit first) is configured in a temporary
+# directory and built with ccache off; the reference is one translation unit
+# that includes <torch/torch.h> and <grpcpp/grpcpp.h>, compiled with the
+# flags of the project's own LibTorch sources, before and after the build.
+# Prints the wall time, the serial CPU time (the sum of every edge's time in
+# .ninja_log), that sum in reference compiles, and the slowest edges.
+# Usage: bench/build_time.sh [--target T (vantage)] [--jobs N (nproc)]
+#          [--tests] [--touch FILE]... [--keep DIR] [-- CMAKE_ARGS...]
+#   --tests     configure as `deploy/setup.sh --tests` does (tests,
+#               benchmarks) instead of as the first command does
+#   --touch F   after the build, touch F (a path in the repository) and
+#               report how many translation units the full build then
+#               recompiles, and how long that takes (ccache off)
+#   --keep DIR  build in DIR (kept) instead of a temporary directory
+set -euo pipefail
+
+repo_root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+target=vantage
+jobs="$(nproc)"
+with_tests=0
+keep=""
+touches=()
+cmake_args=()
+while [[ $# -gt 0 ]]; do
+  case "$1" in
+    --target) target="$2"; shift 2 ;;
+    --jobs) jobs="$2"; shift 2 ;;
+    --tests) with_tests=1; shift ;;
+    --touch) touches+=("$2"); shift 2 ;;
+    --keep) keep="$2"; shift 2 ;;
+    --) shift; cmake_args+=("$@"); break ;;
+    -h|--help) sed -n '2,17p' "${BASH_SOURCE[0]}"; exit 0 ;;
+    *) echo "build_time.sh: unknown argument '$1' (see --help)" >&2; exit 2 ;;
+  esac
+done
+for f in "${touches[@]}"; do
+  [[ -f "${repo_root}/${f}" ]] || { echo "build_time.sh: --touch ${f}: no such file in the repository" >&2; exit 2; }
+done
+
+if [[ -n "${keep}" ]]; then
+  [[ ! -e "${keep}" ]] || { echo "build_time.sh: --keep ${keep} exists" >&2; exit 2; }
+  work="${keep}"
+  mkdir -p "${work}"
+else
+  work="$(mktemp -d)"
+  trap 'rm -rf "${work}"' EXIT
+fi
+export CCACHE_DISABLE=1
+git clone --quiet --no-hardlinks "${repo_root}" "${work}/src"
+if [[ "${with_tests}" -eq 1 ]]; then
+  cmake_args=(-DVANTAGE_BUILD_TESTS=ON -DVANTAGE_BUILD_BENCHMARKS=ON "${cmake_args[@]}")
+else
+  cmake_args=(-DVANTAGE_BUILD_TESTS=OFF -DVANTAGE_BUILD_BENCHMARKS=OFF "${cmake_args[@]}")
+fi
+cmake -S "${work}/src" -B "${work}/src/build" -G Ninja -DCMAKE_BUILD_TYPE=Release \
+  "${cmake_args[@]}" >"${work}/configure.log"
+
+# The reference compile uses the command line of a LibTorch source of the
+# project (compile_commands.json), with its source swapped for the reference.
+printf '#include <torch/torch.h>\n#include <grpcpp/grpcpp.h>\nint main() { return 0; }\n' \
+  >"${work}/reference.cc"
+reference_command() {
+  python3 - "${work}/src/build/compile_commands.json" "${work}/reference.cc" "${work}/reference.o" <<'EOF'
+import json, shlex, sys
+entries = json.load(open(sys.argv[1]))
+entry = next(e for e in entries if e["file"].endswith("common/nn/networks.cc"))
+words = shlex.split(entry["command"])
+# Drop a launcher (env ... ccache) before the compiler.
+while words and not words[0].endswith(("g++", "c++", "clang++", "clang++-14")):
+    words.pop(0)
+out = []
+skip = False
+for w in words:
+    if skip:
+        skip = False
+        continue
+    if w in ("-o", "-MF", "-MT", "-c"):
+        skip = True
+        continue
+    if w in ("-MD", "-MMD"):
+        continue
+    out.append(w)
+print(shlex.join(out + ["-c", sys.argv[2], "-o", sys.argv[3]]))
+EOF
+}
+ref_cmd="$(reference_command)"
+time_reference() {
+  local start end
+  start=$(date +%s.%N)
+  (cd "${work}/src/build" && eval "${ref_cmd}")
+  end=$(date +%s.%N)
+  python3 -c "print(f'{${end} - ${start}:.1f}')"
+}
+ref_before="$(time_reference)"
+
+start=$(date +%s)
+cmake --build "${work}/src/build" --target "${target}" -j "${jobs}" >"${work}/build.log"
+end=$(date +%s)
+ref_after="$(time_reference)"
+
+ninja_summary() {
+  python3 - "$1" "$2" "$3" <<'EOF'
+import sys
+log, ref, top = sys.argv[1], float(sys.argv[2]), int(sys.argv[3])
+edges = {}
+for line in open(log):
+    if line.startswith("#"):
+        continue
+    start, end, _, output, _ = line.rstrip("\n").split("\t")
+    edges[output] = (int(end) - int(start)) / 1000.0
+total = sum(edges.values())
+compiles = [o for o in edges if o.endswith(".o")]
+print(f"edges: {len(edges)} ({len(compiles)} compiles)")
+print(f"serial CPU time: {total / 60:.1f} min = {total / ref:.1f} reference compiles")
+for output, seconds in sorted(edges.items(), key=lambda e: -e[1])[:top]:
+    print(f"  {seconds:6.1f} s  {output}")
+EOF
+}
+ref_mean="$(python3 -c "print(f'{(${ref_before} + ${ref_after}) / 2:.1f}')")"
+echo "build_time.sh: target ${target}, ${jobs} jobs, $(git -C "${work}/src" rev-parse --short HEAD), $(nproc) cores ($(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | xargs))"
+echo "reference compile (<torch/torch.h> + <grpcpp/grpcpp.h>): ${ref_before} s before, ${ref_after} s after, mean ${ref_mean} s"
+echo "wall time: $(( (end - start) / 60 )) min $(( (end - start) % 60 )) s"
+ninja_summary "${work}/src/build/.ninja_log" "${ref_mean}" 12
+
+for f in "${touches[@]}"; do
+  total_tus="$(ninja -C "${work}/src/build" -t commands | grep -c ' -c ' || true)"
+  touch "${work}/src/${f}"
+  again="$(ninja -C "${work}/src/build" -n | grep -c 'Building CXX' || true)"
+  start=$(date +%s)
+  cmake --build "${work}/src/build" -j "${jobs}" >>"${work}/build.log"
+  end=$(date +%s)
+  echo "touch ${f}: ${again} of ${total_tus} translation units recompile (full build), $(( end - start )) s"
+done

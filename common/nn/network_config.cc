@@ -1,0 +1,98 @@
+#include "common/nn/network_config.h"
+
+#include <algorithm>
+
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_join.h"
+
+namespace vantage {
+namespace {
+
+const std::vector<ConvTorsoDesign>& Designs() {
+  static const auto* designs = new std::vector<ConvTorsoDesign>{
+      {Torso::kMinAtar, "minatar", {{16, 3, 1}}, 128},
+      {Torso::kNature, "nature", {{32, 8, 4}, {64, 4, 2}, {64, 3, 1}}, 512},
+  };
+  return *designs;
+}
+
+// The smallest side the design takes.
+int64_t SmallestSide(const ConvTorsoDesign& design) {
+  int64_t side = 1;
+  while (ConvOutputSide(design, side) < 1) ++side;
+  return side;
+}
+
+}  // namespace
+
+const ConvTorsoDesign* FindConvTorsoDesign(Torso torso) {
+  for (const ConvTorsoDesign& design : Designs()) {
+    if (design.torso == torso) return &design;
+  }
+  return nullptr;
+}
+
+int64_t ConvOutputSide(const ConvTorsoDesign& design, int64_t size) {
+  for (const ConvLayerDesign& layer : design.layers) {
+    if (size < layer.kernel) return 0;
+    size = (size - layer.kernel) / layer.stride + 1;
+  }
+  return size;
+}
+
+absl::StatusOr<Torso> ParseTorso(absl::string_view name) {
+  if (name == "auto") return Torso::kAuto;
+  if (name == "mlp") return Torso::kMlp;
+  for (const ConvTorsoDesign& design : Designs()) {
+    if (name == design.name) return design.torso;
+  }
+  return absl::InvalidArgumentError(absl::StrCat(
+      "unknown torso \"", name, "\"; valid: auto, mlp, minatar, nature"));
+}
+
+std::string TorsoName(Torso torso) {
+  if (torso == Torso::kAuto) return "auto";
+  if (torso == Torso::kMlp) return "mlp";
+  return FindConvTorsoDesign(torso)->name;
+}
+
+absl::StatusOr<Torso> ResolveTorso(Torso torso, const EnvSpec& spec) {
+  const std::vector<int64_t>& shape = spec.observation_shape;
+  if (torso == Torso::kAuto) {
+    if (shape.size() != 3) return Torso::kMlp;
+    const int64_t side = std::min(shape[1], shape[2]);
+    return side >= SmallestSide(*FindConvTorsoDesign(Torso::kNature))
+               ? Torso::kNature
+               : Torso::kMinAtar;
+  }
+  if (torso == Torso::kMlp) return torso;
+  const ConvTorsoDesign& design = *FindConvTorsoDesign(torso);
+  if (shape.size() != 3) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "torso ", design.name, " needs image observations; ", spec.name,
+        " has vectors of ", spec.observation_size, " (use --torso=mlp)"));
+  }
+  if (ConvOutputSide(design, shape[1]) < 1 ||
+      ConvOutputSide(design, shape[2]) < 1) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "torso ", design.name, " needs frames of at least ",
+        SmallestSide(design), "x", SmallestSide(design), " pixels; ", spec.name,
+        " has ", absl::StrJoin(shape, "x"), " (use --torso=minatar)"));
+  }
+  return torso;
+}
+
+absl::Status CheckNetworkConfig(const NetworkConfig& config,
+                                const EnvSpec& spec) {
+  const absl::StatusOr<Torso> torso = ResolveTorso(config.torso, spec);
+  if (!torso.ok()) return torso.status();
+  if (config.shared_torso && *torso == Torso::kMlp) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "a shared torso needs a convolutional one, but '", spec.name,
+        "' gets the mlp torso (--torso=", TorsoName(config.torso),
+        "); share with --torso=minatar or nature on image observations"));
+  }
+  return absl::OkStatus();
+}
+
+}  // namespace vantage

@@ -1,0 +1,57 @@
+#ifndef VANTAGE_LEARNER_ALGORITHMS_ALGORITHM_CONFIG_H_
+#define VANTAGE_LEARNER_ALGORITHMS_ALGORITHM_CONFIG_H_
+
+// The algorithms' settings and how a run config names them, without
+// LibTorch (the updaters are in learner/algorithms/algorithm.h).
+
+#include <string>
+#include <vector>
+
+#include "absl/status/status.h"
+#include "learner/algorithms/a2c/a2c_config.h"
+#include "learner/algorithms/ppo/ppo_config.h"
+#include "learner/algorithms/run_defaults.h"
+#include "learner/algorithms/trpo/trpo_config.h"
+
+namespace vantage {
+namespace pb {
+class RunConfig;
+}  // namespace pb
+
+// Which algorithm updates the networks, with every algorithm's settings
+// (only the named one's are used).
+struct AlgorithmConfig {
+  std::string name = "ppo";  // see AlgorithmNames()
+  PpoConfig ppo;
+  A2cConfig a2c;
+  TrpoConfig trpo;
+
+  // An unknown name lists the valid ones.
+  absl::Status Validate() const;
+};
+
+std::vector<std::string> AlgorithmNames();
+
+// Whether the named algorithm steps the policy and the value network with
+// one optimiser (PPO, A2C), which parameters shared by both need; TRPO
+// fits its value network on its own.
+bool AlgorithmStepsBothNetworksAtOnce(const AlgorithmConfig& config);
+
+// What the named algorithm's defaults choose outside its own section.
+AlgorithmRunDefaults RunDefaultsOf(const AlgorithmConfig& config);
+
+// The algorithm section of a run config (its `algorithm` oneof, one field
+// per algorithm, named as the algorithm).
+// The algorithm a run config names; "ppo" when it names none.
+std::string AlgorithmNameOf(const pb::RunConfig& run);
+// Names `name` with no settings of its own; an unknown name lists the
+// valid ones.
+absl::Status SelectAlgorithm(const std::string& name, pb::RunConfig& run);
+// The named algorithm's section over its defaults (not yet validated).
+AlgorithmConfig AlgorithmConfigOf(const pb::RunConfig& run);
+// Every field of the named algorithm's settings, into its section.
+void SetAlgorithmSettings(const AlgorithmConfig& config, pb::RunConfig& run);
+
+}  // namespace vantage
+
+#endif  // VANTAGE_LEARNER_ALGORITHMS_ALGORITHM_CONFIG_H_
