@@ -115,6 +115,8 @@ source_uri() {  # the first URI of the stanza whose Suites list holds $1
 
 mkdir -p "${cache_dir}"
 cache_dir="$(cd "${cache_dir}" && pwd)"
+# A build or test that was killed may have left its mounts behind.
+"${repo_root}/deploy/docker/unmount_cache.sh" "${cache_dir}"
 mkdir -p "${cache_dir}/tmp"
 
 # The storage driver: a store keeps the one it was made with; a new one

@@ -1,7 +1,8 @@
 #!/usr/bin/python3
 """Which of the project's files reach LibTorch's headers, and through what.
 
-  tests/build/include_boundaries.py [--root DIR] [--allowed FILE] [--explain PATH]
+  tests/build/include_boundaries.py [--root DIR] [--allowed FILE]
+      [--explain PATH | --list LEVEL]
 
 Follows the project's own #include graph (quoted and <...> includes that
 name a file of the tree; proto/X.pb.h stands for the generated header of
@@ -18,7 +19,8 @@ Every file may reach at most the level its first matching pattern in the
 allowed list grants (fnmatch patterns over paths relative to the root;
 unlisted files: none). Exits 1 listing each file over its level with the
 include chain that brings the header in; --explain PATH prints the chain of
-one file.
+one file; --list LEVEL prints the .cc files that reach LEVEL, one per line
+(the build precompiles LibTorch's headers for those that reach torch).
 """
 
 import argparse
@@ -153,7 +155,14 @@ def main():
     parser.add_argument("--allowed",
                         default=os.path.join(here, "torch_users.txt"))
     parser.add_argument("--explain", metavar="PATH")
+    parser.add_argument("--list", choices=sorted(LEVELS), metavar="LEVEL")
     args = parser.parse_args()
+    if args.list:
+        graph = IncludeGraph(args.root)
+        for path in graph.files:
+            if path.endswith(".cc") and graph.reach(path)[0] >= LEVELS[args.list]:
+                print(path)
+        return 0
     rules = read_allowed(args.allowed)
     if args.explain:
         graph = IncludeGraph(args.root)

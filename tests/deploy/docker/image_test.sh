@@ -58,6 +58,7 @@ cleanup() {
   for c in "${containers[@]}"; do
     buildah rm "${c}" >/dev/null 2>&1 || echo "image_test: could not remove container ${c}" >&2
   done
+  "${repo_root}/deploy/docker/unmount_cache.sh" "${cache_dir}" || true
 }
 trap cleanup EXIT
 
