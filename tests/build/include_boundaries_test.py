@@ -100,6 +100,17 @@ class CheckerTest(unittest.TestCase):
         self.assertEqual(result.returncode, 1)
         self.assertIn("common/a.h: reaches tensor", result.stdout)
 
+    def test_list_names_the_sources_that_reach_a_level(self):
+        self.write("common/ops.h", "#include <ATen/ATen.h>\n")
+        self.write("common/ops.cc", '#include "common/ops.h"\n')
+        self.write("common/tensor.cc", "#include <ATen/core/Tensor.h>\n")
+        self.write("deploy/plain.cc", "#include <string>\n")
+        torch = run("--root", self.root, "--list", "torch")
+        self.assertEqual(torch.stdout.split(), ["common/ops.cc"])
+        tensor = run("--root", self.root, "--list", "tensor")
+        self.assertEqual(tensor.stdout.split(),
+                         ["common/ops.cc", "common/tensor.cc"])
+
     def test_a_malformed_allowed_list_is_refused_with_its_line(self):
         self.write("common/a.h", "\n")
         result = self.check("common/* everything\n")
