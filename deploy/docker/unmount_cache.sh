@@ -9,6 +9,12 @@ set -euo pipefail
 [[ $# -eq 1 && -n "$1" ]] || { echo "unmount_cache.sh: usage: unmount_cache.sh CACHE_DIR" >&2; exit 2; }
 [[ -d "$1" ]] || exit 0
 cache_dir="$(cd "$1" && pwd -P)"
+# Through buildah first where it can, so that its store records no mount
+# that is gone; what it does not know of is unmounted directly.
+if [[ -f "${cache_dir}/storage.conf" ]] && command -v buildah >/dev/null; then
+  CONTAINERS_STORAGE_CONF="${cache_dir}/storage.conf" TMPDIR="${cache_dir}/tmp" \
+    buildah unmount --all >/dev/null 2>&1 || true
+fi
 # /proc/self/mounts escapes spaces and the like as octal (\040).
 mapfile -t targets < <(awk -v dir="${cache_dir}/" \
   'index($2, dir) == 1 { print $2 }' /proc/self/mounts | sort -r)
