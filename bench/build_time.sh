@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Measures a cold build of a clean clone against a reference compile made in
 # the same run, so that figures from different machines can be compared as
-# ratios. The clone (of HEAD: commit first) is configured in a temporary
+# ratios. HEAD's tree (commit first) is configured in a temporary
 # directory and built with ccache off; the reference is one translation unit
 # that includes <torch/torch.h> and <grpcpp/grpcpp.h>, compiled with the
 # flags of the project's own LibTorch sources, twice before and twice after
@@ -50,7 +50,9 @@ else
   trap 'rm -rf "${work}"' EXIT
 fi
 export CCACHE_DISABLE=1
-git clone --quiet --no-hardlinks "${repo_root}" "${work}/src"
+# HEAD's files alone, as a clean checkout has them.
+mkdir -p "${work}/src"
+git -C "${repo_root}" archive HEAD | tar -x -C "${work}/src"
 if [[ "${with_tests}" -eq 1 ]]; then
   cmake_args=(-DVANTAGE_BUILD_TESTS=ON -DVANTAGE_BUILD_BENCHMARKS=ON "${cmake_args[@]}")
 else
@@ -123,7 +125,7 @@ for output, seconds in sorted(edges.items(), key=lambda e: -e[1])[:top]:
 EOF
 }
 ref_mean="$(python3 -c "import statistics; print(f'{statistics.median([${ref_before}, ${ref_before2}, ${ref_after}, ${ref_after2}]):.1f}')")"
-echo "build_time.sh: target ${target}, ${jobs} jobs, $(git -C "${work}/src" rev-parse --short HEAD), $(nproc) cores ($(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | xargs))"
+echo "build_time.sh: target ${target}, ${jobs} jobs, $(git -C "${repo_root}" rev-parse --short HEAD), $(nproc) cores ($(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | xargs))"
 echo "reference compile (<torch/torch.h> + <grpcpp/grpcpp.h>): ${ref_before} and ${ref_before2} s before, ${ref_after} and ${ref_after2} s after, median ${ref_mean} s"
 echo "wall time: $(( (end - start) / 60 )) min $(( (end - start) % 60 )) s"
 ninja_summary "${work}/src/build/.ninja_log" "${ref_mean}" 12
