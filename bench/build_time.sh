@@ -5,7 +5,7 @@
 # directory and built with ccache off; the reference is one translation unit
 # that includes <torch/torch.h> and <grpcpp/grpcpp.h>, compiled with the
 # flags of the project's own LibTorch sources, twice before and twice after
-# the build (the median counts).
+# the build (the median counts), without the precompiled header.
 # Prints the wall time, the serial CPU time (the sum of every edge's time in
 # .ninja_log), that sum in reference compiles, and the slowest edges.
 # Usage: bench/build_time.sh [--target T (vantage)] [--jobs N (nproc)]
@@ -58,8 +58,9 @@ if [[ "${with_tests}" -eq 1 ]]; then
 else
   cmake_args=(-DVANTAGE_BUILD_TESTS=OFF -DVANTAGE_BUILD_BENCHMARKS=OFF "${cmake_args[@]}")
 fi
+# The compiler deploy/setup.sh gives a new tree, unless CXX names another.
 cmake -S "${work}/src" -B "${work}/src/build" -G Ninja -DCMAKE_BUILD_TYPE=Release \
-  "${cmake_args[@]}" >"${work}/configure.log"
+  -DCMAKE_CXX_COMPILER="${CXX:-clang++-14}" "${cmake_args[@]}" >"${work}/configure.log"
 
 # The reference compile uses the command line of a LibTorch source of the
 # project (compile_commands.json), with its source swapped for the reference.
@@ -74,18 +75,24 @@ words = shlex.split(entry["command"])
 # Drop a launcher (env ... ccache) before the compiler.
 while words and not words[0].endswith(("g++", "c++", "clang++", "clang++-14")):
     words.pop(0)
+# Drop the outputs, and the precompiled header: the reference parses the
+# headers itself (g++ would pick the header's .gch up from `-include`
+# once the build has made it; clang names it with -Xclang -include-pch).
 out = []
-skip = False
-for w in words:
-    if skip:
-        skip = False
-        continue
-    if w in ("-o", "-MF", "-MT", "-c"):
-        skip = True
-        continue
-    if w in ("-MD", "-MMD"):
-        continue
-    out.append(w)
+i = 0
+while i < len(words):
+    w = words[i]
+    if w == "-Xclang" and i + 1 < len(words) and words[i + 1] in ("-include-pch", "-include"):
+        i += 4
+    elif w == "-include" and "cmake_pch" in words[i + 1]:
+        i += 2
+    elif w in ("-o", "-MF", "-MT", "-c"):
+        i += 2
+    elif w in ("-MD", "-MMD", "-Winvalid-pch"):
+        i += 1
+    else:
+        out.append(w)
+        i += 1
 print(shlex.join(out + ["-c", sys.argv[2], "-o", sys.argv[3]]))
 EOF
 }

@@ -46,9 +46,12 @@ done
 # libraries (libav*-dev, libswscale-dev). libbenchmark-dev: the container
 # image's build stage, which installs this list, builds `vantage bench`.
 # ccache keeps compiled objects for the next build of any clone, the fuzz
-# build and the container image's (CMakeLists.txt).
+# build and the container image's (CMakeLists.txt). clang-14 compiles: it
+# parses LibTorch's headers faster than g++ and loads them precompiled in a
+# fraction of g++'s time (docs/development.md#build-times); build-essential
+# still brings the C++ library and the linker.
 packages=(
-  build-essential cmake ninja-build ccache pkgconf openssl
+  build-essential clang-14 cmake ninja-build ccache pkgconf openssl
   libtorch-dev libgloo-dev libopenblas0-serial
   libmujoco-dev libqhull-dev libgl-dev libopengl-dev
   libbullet-dev
@@ -82,6 +85,12 @@ wanted=("${packages[@]}")
 [[ "${packages_only}" -eq 1 ]] && exit 0
 
 configure=(-G Ninja -DCMAKE_BUILD_TYPE="${build_type}")
+# A build tree keeps the compiler it was configured with (CMake would
+# discard the tree's settings to change it); a new one gets clang, or the
+# compiler named by CXX.
+if [[ ! -f "${build_dir}/CMakeCache.txt" ]]; then
+  configure+=(-DCMAKE_CXX_COMPILER="${CXX:-clang++-14}")
+fi
 if [[ "${with_tests}" -eq 1 ]]; then
   configure+=(-DVANTAGE_BUILD_TESTS=ON -DVANTAGE_BUILD_BENCHMARKS=ON)
 elif [[ ! -f "${build_dir}/CMakeCache.txt" ]]; then
