@@ -260,7 +260,6 @@ TEST(EnvRegistryTest, TwoDMazeRewardsThePocketBeyondTheWall) {
 
 TEST(EnvRegistryTest, SparseHalfCheetahIsSilentNearTheStart) {
   const auto env = Make("SparseHalfCheetah");
-  StepResult last;
   std::mt19937_64 rng(1);
   std::vector<double> observation(17);
   ASSERT_TRUE(env->Reset(1, absl::MakeSpan(observation)).ok());

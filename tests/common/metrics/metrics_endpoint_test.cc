@@ -73,7 +73,8 @@ TEST_F(MetricsEndpointServeTest, BeyondLoopbackTheTokenIsRequired) {
 
 TEST_F(MetricsEndpointServeTest, AnAddressThatCannotBeBoundIsNamed) {
   absl::StatusOr<std::unique_ptr<prometheus::Exposer>> exposer =
-      StartMetricsEndpoint({"not-an-address:x"}, registry_, "test");
+      StartMetricsEndpoint(MetricsEndpointOptions{"not-an-address:x", ""},
+                           registry_, "test");
   EXPECT_TRUE(absl::IsUnavailable(exposer.status())) << exposer.status();
   EXPECT_THAT(exposer.status().message(),
               HasSubstr("cannot serve test metrics on \"not-an-address:x\""));

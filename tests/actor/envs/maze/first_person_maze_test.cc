@@ -133,7 +133,6 @@ TEST(FirstPersonMazeTest, WalkingAndTurningFollowDoomsPhysics) {
 // Follows the shortest path's cell centres: turns until roughly facing the
 // next one, walks otherwise.
 TEST(FirstPersonMazeTest, FollowingTheWayFromEveryStartReachesTheGoal) {
-  int rooms_seen = 0;
   std::map<std::pair<int, int>, bool> starts;
   for (uint64_t seed = 0; seed < 40; ++seed) {
     FirstPersonMaze env;

@@ -80,12 +80,6 @@ TEST(BreakoutTest, APaddleTrackingTheBallKeepsItInPlayAndClearsTheBricks) {
   }
 }
 
-A TrackBall(const Breakout& game) {
-  return game.ball_x() < game.paddle()   ? A::kLeft
-         : game.ball_x() > game.paddle() ? A::kRight
-                                         : A::kNoop;
-}
-
 // MinAtar's two paddle hits: under the ball's column the ball's vertical
 // direction flips; under the column it is about to enter (the paddle moved
 // there this step) the ball goes back the way it came. The paddle leads
@@ -539,7 +533,6 @@ TEST(MinAtarEnvTest, EpisodesStopAtTheirLimitUnwrapped) {
   ASSERT_TRUE(env.ok());
   std::vector<double> observation(1000);
   ASSERT_TRUE((*env)->Reset(1, absl::MakeSpan(observation)).ok());
-  StepResult last;
   for (int t = 0; t < 10000; ++t) {
     absl::StatusOr<StepResult> step =
         (*env)->Step({0.0}, absl::MakeSpan(observation));
