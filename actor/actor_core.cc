@@ -7,11 +7,13 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdio>
 #include <cstring>
 #include <mutex>
 #include <utility>
 
 #include "absl/strings/str_cat.h"
+#include "absl/types/span.h"
 #include "common/util/state_bytes.h"
 
 namespace vantage {
@@ -27,6 +29,24 @@ std::string GeneratorState(at::Generator generator) {
   const at::Tensor state = generator.get_state().contiguous();
   return std::string(reinterpret_cast<const char*>(state.data_ptr<uint8_t>()),
                      state.numel());
+}
+
+// The environments' observations (doubles) into `row` [m, obs] of a
+// segment's observations, in its dtype (float32, or uint8 for byte
+// observations, whose values are integers in range): plain stores, as
+// ObservationTensor converts.
+void StoreObservations(absl::Span<const double> values, at::Tensor row) {
+  if (row.scalar_type() == at::kByte) {
+    uint8_t* out = row.data_ptr<uint8_t>();
+    for (size_t i = 0; i < values.size(); ++i) {
+      out[i] = static_cast<uint8_t>(values[i]);
+    }
+  } else {
+    float* out = row.data_ptr<float>();
+    for (size_t i = 0; i < values.size(); ++i) {
+      out[i] = static_cast<float>(values[i]);
+    }
+  }
 }
 
 }  // namespace
@@ -80,11 +100,39 @@ absl::Status ActorCore::SetWeights(const PolicyWeights& weights) {
   }
   version_ = weights.version;
   has_weights_ = true;
+  absl::StatusOr<MlpPolicyKernel> kernel = MlpPolicyKernel::Create(
+      spec(), *policy_, normalizer_, config_.observation_clip);
+  if (kernel.ok()) {
+    kernel_ = std::move(*kernel);
+  } else {
+    kernel_.reset();
+    if (!told_libtorch_) {
+      std::fprintf(stderr, "actor %ld (%s): acting on LibTorch: %s\n",
+                   static_cast<long>(config_.actor_id), config_.env.c_str(),
+                   std::string(kernel.status().message()).c_str());
+      told_libtorch_ = true;
+    }
+  }
   return absl::OkStatus();
 }
 
-at::Tensor ActorCore::CurrentObservations() const {
-  return ObservationTensor(spec(), envs_->observations().data(), envs_->size());
+void ActorCore::Act(const at::Tensor& observations_row, float* actions,
+                    float* log_probs) {
+  const int64_t m = envs_->size();
+  const int64_t width = spec().discrete ? 1 : spec().action_size;
+  if (kernel_) {
+    kernel_outputs_.resize(m * kernel_->output_size());
+    kernel_->Forward(envs_->observations().data(), m, kernel_outputs_.data());
+    kernel_->Act(kernel_outputs_.data(), m, generator_, actions, log_probs);
+  } else {
+    const at::Tensor output = policy_->forward(ObservationsForNetwork(
+        spec(), normalizer_, observations_row, config_.observation_clip));
+    const at::Tensor action = policy_->Act(output, false, generator_);
+    const at::Tensor log_prob = policy_->LogProb(output, action);
+    std::copy_n(action.contiguous().data_ptr<float>(), m * width, actions);
+    std::copy_n(log_prob.contiguous().data_ptr<float>(), m, log_probs);
+  }
+  actions_.assign(actions, actions + m * width);
 }
 
 absl::Status ActorCore::CollectSegments(SegmentSink& sink) {
@@ -108,17 +156,11 @@ absl::Status ActorCore::CollectSegments(SegmentSink& sink) {
   std::vector<Segment> segments(m);
 
   at::NoGradGuard no_grad;
-  observations[0].copy_(CurrentObservations());
+  StoreObservations(envs_->observations(), observations[0]);
   for (int64_t t = 0; t < steps; ++t) {
     const auto inference_start = std::chrono::steady_clock::now();
-    const at::Tensor output = policy_->forward(ObservationsForNetwork(
-        spec(), normalizer_, observations[t], config_.observation_clip));
-    const at::Tensor action = policy_->Act(output, false, generator_);
-    actions[t].copy_(action);
-    log_probs[t].copy_(policy_->LogProb(output, action));
-    const at::Tensor as_double = action.to(at::kDouble).contiguous();
-    actions_.assign(as_double.data_ptr<double>(),
-                    as_double.data_ptr<double>() + as_double.numel());
+    Act(observations[t], actions.data_ptr<float>() + t * m * act,
+        log_probs.data_ptr<float>() + t * m);
     const auto env_start = std::chrono::steady_clock::now();
     if (absl::Status status = envs_->Step(actions_); !status.ok()) {
       return status;
@@ -148,7 +190,7 @@ absl::Status ActorCore::CollectSegments(SegmentSink& sink) {
                 .squeeze(0));
       }
     }
-    observations[t + 1].copy_(CurrentObservations());
+    StoreObservations(envs_->observations(), observations[t + 1]);
   }
   env_steps_ += m * steps;
 

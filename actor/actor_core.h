@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -12,6 +13,7 @@
 #include "absl/status/statusor.h"
 #include "absl/strings/string_view.h"
 #include "actor/vector_env.h"
+#include "common/nn/mlp_policy_kernel.h"
 #include "common/nn/networks.h"
 #include "common/nn/policy_weights.h"
 #include "common/nn/running_mean_std.h"
@@ -51,8 +53,12 @@ class ActorCore {
   double inference_seconds() const { return inference_seconds_; }
   double env_seconds() const { return env_seconds_; }
 
-  // Takes effect from the next segment on.
+  // Takes effect from the next segment on. An MLP policy then acts through
+  // MlpPolicyKernel (a copy of these weights); any other on LibTorch, which
+  // the first SetWeights says on stderr.
   absl::Status SetWeights(const PolicyWeights& weights);
+  // Whether the current weights act through MlpPolicyKernel.
+  bool acts_without_libtorch() const { return kernel_.has_value(); }
 
   // Steps every environment segment_length times and sends one segment per
   // environment slot to `sink`. Acting needs weights from the learner
@@ -75,12 +81,19 @@ class ActorCore {
 
  private:
   ActorCore(const ActorConfig& config, std::unique_ptr<VectorEnv> envs);
-  at::Tensor CurrentObservations() const;
+  // The policy's actions [m, act] and their log-probabilities [m] for the
+  // environments' current observations (observations_row, as segments
+  // keep them, for LibTorch), into actions_ too.
+  void Act(const at::Tensor& observations_row, float* actions,
+           float* log_probs);
 
   const ActorConfig config_;
   std::unique_ptr<VectorEnv> envs_;
   PolicyNetwork policy_;
   RunningMeanStd normalizer_;
+  std::optional<MlpPolicyKernel> kernel_;
+  std::vector<float> kernel_outputs_;
+  bool told_libtorch_ = false;
   at::Generator generator_;
   int64_t version_ = 0;
   int64_t stream_actor_id_;

@@ -38,6 +38,8 @@ done
 # alternatives) over from the reference BLAS that LibTorch's GEMMs would
 # otherwise run on; serial, because every vantage process computes on one
 # thread of its own and several share the machine (docs/benchmarks.md).
+# libblas-dev: the C interface (cblas.h) the actors' MLP policies call
+# BLAS through, linked as libblas.so.3 and so run on OpenBLAS too.
 # prometheus (with promtool) serves deploy/prometheus/watch_runs.sh;
 # python3-matplotlib draws `vantage plot`'s figures and python3-scipy computes
 # the statistics of `vantage experiment report`. `vantage rollout
@@ -52,7 +54,7 @@ done
 # still brings the C++ library and the linker.
 packages=(
   build-essential clang-14 cmake ninja-build ccache pkgconf openssl
-  libtorch-dev libgloo-dev libopenblas0-serial
+  libtorch-dev libgloo-dev libopenblas0-serial libblas-dev
   libmujoco-dev libqhull-dev libgl-dev libopengl-dev
   libbullet-dev
   libgrpc++-dev protobuf-compiler-grpc libprotobuf-dev protobuf-compiler

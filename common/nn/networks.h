@@ -34,6 +34,8 @@ class TanhMlpImpl : public torch::nn::Module {
   TanhMlpImpl(int64_t inputs, const std::vector<int64_t>& hidden,
               int64_t outputs, double output_gain);
   at::Tensor forward(const at::Tensor& x);
+  // The Linear layers in order (for code that runs it without modules).
+  const torch::nn::ModuleList& layers() const { return layers_; }
 
  private:
   torch::nn::ModuleList layers_;
@@ -82,6 +84,8 @@ class PolicyNetworkImpl : public torch::nn::Module {
   const at::Tensor& log_std() const { return log_std_; }
   // Empty for the MLP torso.
   const ConvTorso& conv_torso() const { return conv_; }
+  // The MLP (for images, only the output layer after the torso).
+  const TanhMlp& body() const { return body_; }
 
  private:
   EnvSpec spec_;

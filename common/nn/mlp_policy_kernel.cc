@@ -1,0 +1,197 @@
+#include "common/nn/mlp_policy_kernel.h"
+
+#include <ATen/ATen.h>
+#include <cblas.h>
+#include <torch/nn/modules/linear.h>
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "absl/strings/str_cat.h"
+#include "common/nn/cpu_sampling.h"
+#include "common/nn/networks.h"
+#include "common/nn/running_mean_std.h"
+
+namespace vantage {
+namespace {
+
+constexpr float kLogSqrtTwoPi = 0.91893853320467274178f;  // log(sqrt(2 pi))
+
+std::vector<float> FloatVector(const at::Tensor& tensor) {
+  const at::Tensor flat = tensor.detach().to(at::kFloat).contiguous();
+  return std::vector<float>(flat.data_ptr<float>(),
+                            flat.data_ptr<float>() + flat.numel());
+}
+
+std::vector<double> DoubleVector(const at::Tensor& tensor) {
+  const at::Tensor flat = tensor.detach().to(at::kDouble).contiguous();
+  return std::vector<double>(flat.data_ptr<double>(),
+                             flat.data_ptr<double>() + flat.numel());
+}
+
+template <typename T>
+T* Grow(std::vector<T>& buffer, int64_t size) {
+  if (static_cast<int64_t>(buffer.size()) < size) buffer.resize(size);
+  return buffer.data();
+}
+
+}  // namespace
+
+absl::StatusOr<MlpPolicyKernel> MlpPolicyKernel::Create(
+    const EnvSpec& spec, PolicyNetworkImpl& policy,
+    const RunningMeanStd& normalizer, double observation_clip) {
+  if (!policy.conv_torso().is_empty()) {
+    return absl::UnimplementedError(
+        "the policy has a convolutional torso, which only LibTorch runs");
+  }
+  if (normalizer.size() != spec.observation_size) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("the normaliser is of size ", normalizer.size(),
+                     ", the observations of size ", spec.observation_size));
+  }
+  MlpPolicyKernel kernel;
+  kernel.spec_ = spec;
+  kernel.discrete_ = policy.discrete();
+  kernel.clip_ = observation_clip;
+  kernel.mean_ = DoubleVector(normalizer.mean());
+  kernel.scale_ = DoubleVector(at::sqrt(normalizer.var() + 1e-8));
+  const torch::nn::ModuleList& layers = policy.body()->layers();
+  int64_t width = spec.observation_size;
+  for (size_t i = 0; i < layers->size(); ++i) {
+    const auto& linear = layers->at<torch::nn::LinearImpl>(i);
+    Layer layer;
+    layer.outputs = linear.weight.size(0);
+    layer.inputs = linear.weight.size(1);
+    if (layer.inputs != width || !linear.bias.defined()) {
+      return absl::UnimplementedError(absl::StrCat(
+          "layer ", i, " of the policy is not a biased Linear layer on ", width,
+          " inputs"));
+    }
+    layer.weight = FloatVector(linear.weight);
+    layer.bias = FloatVector(linear.bias);
+    width = layer.outputs;
+    kernel.layers_.push_back(std::move(layer));
+  }
+  if (kernel.layers_.empty() || width != spec.action_size) {
+    return absl::UnimplementedError(absl::StrCat("the policy's MLP ends in ",
+                                                 width, " outputs, not ",
+                                                 spec.action_size));
+  }
+  kernel.output_size_ = width;
+  if (!kernel.discrete_) {
+    kernel.log_std_ = FloatVector(policy.log_std());
+    for (float log_std : kernel.log_std_) {
+      kernel.std_.push_back(std::exp(log_std));
+      kernel.inv_std_.push_back(std::exp(-log_std));
+    }
+  }
+  return kernel;
+}
+
+void MlpPolicyKernel::Inputs(const double* observations, int64_t rows,
+                             float* inputs) const {
+  const int64_t size = spec_.observation_size;
+  if (spec_.byte_observations()) {
+    // As NetworkInputs: the bytes as floats times 1 / observation_high.
+    const float scale =
+        static_cast<float>(1.0 / static_cast<double>(std::max<int64_t>(
+                                     spec_.observation_high, 1)));
+    for (int64_t i = 0; i < rows * size; ++i) {
+      inputs[i] =
+          static_cast<float>(static_cast<uint8_t>(observations[i])) * scale;
+    }
+    return;
+  }
+  // As RunningMeanStd::Normalize on the float32 copy segments keep: in
+  // double, clipped, then back to float.
+  for (int64_t r = 0; r < rows; ++r) {
+    const double* x = observations + r * size;
+    float* out = inputs + r * size;
+    for (int64_t j = 0; j < size; ++j) {
+      const double stored = static_cast<float>(x[j]);
+      const double normalized = (stored - mean_[j]) / scale_[j];
+      out[j] =
+          static_cast<float>(std::min(std::max(normalized, -clip_), clip_));
+    }
+  }
+}
+
+void MlpPolicyKernel::Forward(const double* observations, int64_t rows,
+                              float* outputs) {
+  int64_t widest = spec_.observation_size;
+  for (const Layer& layer : layers_) widest = std::max(widest, layer.outputs);
+  float* in = Grow(buffer_a_, rows * widest);
+  float* out = Grow(buffer_b_, rows * widest);
+  Inputs(observations, rows, in);
+  for (size_t l = 0; l < layers_.size(); ++l) {
+    const Layer& layer = layers_[l];
+    const bool last = l + 1 == layers_.size();
+    float* y = last ? outputs : out;
+    for (int64_t r = 0; r < rows; ++r) {
+      std::copy(layer.bias.begin(), layer.bias.end(), y + r * layer.outputs);
+    }
+    // y = x W^T + b: a matrix-vector product for one row.
+    if (rows == 1) {
+      cblas_sgemv(CblasRowMajor, CblasNoTrans, layer.outputs, layer.inputs,
+                  1.0f, layer.weight.data(), layer.inputs, in, 1, 1.0f, y, 1);
+    } else {
+      cblas_sgemm(CblasRowMajor, CblasNoTrans, CblasTrans, rows, layer.outputs,
+                  layer.inputs, 1.0f, in, layer.inputs, layer.weight.data(),
+                  layer.inputs, 1.0f, y, layer.outputs);
+    }
+    if (!last) {
+      for (int64_t i = 0; i < rows * layer.outputs; ++i) y[i] = std::tanh(y[i]);
+      std::swap(in, out);
+    }
+  }
+}
+
+void MlpPolicyKernel::Act(const float* outputs, int64_t rows,
+                          at::Generator& generator, float* actions,
+                          float* log_probs) {
+  const int64_t n = output_size_;
+  if (!discrete_) {
+    // mean + exp(log_std) * N(0, 1), and its Gaussian log-density.
+    float* noise = Grow(noise_, rows * n);
+    FillStandardNormal(generator, noise, rows * n);
+    for (int64_t r = 0; r < rows; ++r) {
+      float log_prob = 0.0f;
+      for (int64_t j = 0; j < n; ++j) {
+        const int64_t i = r * n + j;
+        const float spread = std_[j] * noise[i];
+        const float action = outputs[i] + spread;
+        actions[i] = action;
+        const float z = (action - outputs[i]) * inv_std_[j];
+        const float half_square = -0.5f * z * z;
+        log_prob += half_square - log_std_[j] - kLogSqrtTwoPi;
+      }
+      log_probs[r] = log_prob;
+    }
+    return;
+  }
+  // Softmax per row, a categorical draw, and the log-softmax at it.
+  float* probabilities = Grow(probabilities_, rows * n);
+  float* maxima = Grow(row_max_, rows);
+  float* log_sums = Grow(row_log_sum_, rows);
+  for (int64_t r = 0; r < rows; ++r) {
+    const float* logits = outputs + r * n;
+    const float top = *std::max_element(logits, logits + n);
+    float sum = 0.0f;
+    for (int64_t i = 0; i < n; ++i) {
+      probabilities[r * n + i] = std::exp(logits[i] - top);
+      sum += probabilities[r * n + i];
+    }
+    for (int64_t i = 0; i < n; ++i) probabilities[r * n + i] /= sum;
+    maxima[r] = top;
+    log_sums[r] = std::log(sum);
+  }
+  int64_t* indices = Grow(indices_, rows);
+  SampleCategorical(generator, probabilities, rows, n, indices);
+  for (int64_t r = 0; r < rows; ++r) {
+    actions[r] = static_cast<float>(indices[r]);
+    log_probs[r] = outputs[r * n + indices[r]] - maxima[r] - log_sums[r];
+  }
+}
+
+}  // namespace vantage

@@ -1,0 +1,194 @@
+#include "common/nn/mlp_policy_kernel.h"
+
+#include <ATen/ATen.h>
+#include <ATen/CPUGeneratorImpl.h>
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "common/nn/cpu_sampling.h"
+#include "common/nn/networks.h"
+#include "common/nn/running_mean_std.h"
+#include "gtest/gtest.h"
+
+namespace vantage {
+namespace {
+
+constexpr double kClip = 5.0;
+
+EnvSpec VectorSpec(bool discrete, int64_t observations, int64_t actions) {
+  EnvSpec spec;
+  spec.name = "test";
+  spec.observation_size = observations;
+  spec.discrete = discrete;
+  spec.action_size = actions;
+  if (!discrete) {
+    spec.action_low.assign(actions, -1.0);
+    spec.action_high.assign(actions, 1.0);
+  }
+  return spec;
+}
+
+// Random weights of the scale the initialisation gives hidden layers,
+// 1 / sqrt(inputs) per weight (the output layer too, whose initial gain of
+// 0.01 would leave every output near 0), random biases, log-std and
+// normaliser.
+void Randomise(PolicyNetworkImpl& policy, RunningMeanStd& normalizer,
+               const EnvSpec& spec) {
+  at::NoGradGuard no_grad;
+  for (at::Tensor& parameter : policy.parameters()) {
+    const double scale =
+        parameter.dim() == 2 ? 1.0 / std::sqrt(parameter.size(1)) : 0.5;
+    parameter.copy_(at::randn(parameter.sizes()) * scale);
+  }
+  if (!spec.byte_observations()) {
+    ASSERT_TRUE(
+        normalizer
+            .Restore(10.0, at::randn({spec.observation_size}, at::kDouble),
+                     at::rand({spec.observation_size}, at::kDouble) + 0.1)
+            .ok());
+  }
+}
+
+// Observations as environments write them: doubles, some far enough out
+// to be clipped; integers in range for byte observations.
+std::vector<double> Observations(const EnvSpec& spec, int64_t rows) {
+  at::Tensor values =
+      spec.byte_observations()
+          ? at::randint(0, spec.observation_high + 1,
+                        {rows, spec.observation_size}, at::kDouble)
+          : at::randn({rows, spec.observation_size}, at::kDouble) * 4.0;
+  return std::vector<double>(values.data_ptr<double>(),
+                             values.data_ptr<double>() + values.numel());
+}
+
+// |a - b| <= 1e-6 of b's scale (at least 1).
+void ExpectClose(const std::vector<float>& fast, const at::Tensor& reference,
+                 const std::string& what) {
+  const at::Tensor expected = reference.contiguous().to(at::kFloat).reshape(-1);
+  ASSERT_EQ(static_cast<int64_t>(fast.size()), expected.numel()) << what;
+  for (size_t i = 0; i < fast.size(); ++i) {
+    const float want = expected[i].item<float>();
+    EXPECT_LE(std::abs(fast[i] - want), 1e-6f * std::max(1.0f, std::abs(want)))
+        << what << " [" << i << "]: " << fast[i] << " vs " << want;
+  }
+}
+
+struct Case {
+  bool discrete;
+  int64_t observation_high;
+  std::vector<int64_t> hidden;
+  int64_t actions;
+};
+
+// Several steps of acting at each batch size, from generators that start
+// alike: outputs, actions and log-probabilities agree, and both generators
+// end in the same place.
+void CompareWithLibTorch(const Case& c) {
+  EnvSpec spec = VectorSpec(c.discrete, 7, c.actions);
+  spec.observation_high = c.observation_high;
+  NetworkConfig config;
+  config.hidden = c.hidden;
+  PolicyNetwork policy(spec, config);
+  RunningMeanStd normalizer(spec.observation_size);
+  Randomise(*policy, normalizer, spec);
+  absl::StatusOr<MlpPolicyKernel> kernel =
+      MlpPolicyKernel::Create(spec, *policy, normalizer, kClip);
+  ASSERT_TRUE(kernel.ok()) << kernel.status();
+  ASSERT_EQ(kernel->output_size(), c.actions);
+
+  at::Generator reference = at::make_generator<at::CPUGeneratorImpl>(11);
+  at::Generator fast = at::make_generator<at::CPUGeneratorImpl>(11);
+  at::NoGradGuard no_grad;
+  // 1 (a matrix-vector product), sizes below and above LibTorch's 16
+  // values for the normal fill, and one with a tail.
+  for (int64_t rows : {1, 1, 2, 3, 5, 16, 1}) {
+    const std::string what = "rows " + std::to_string(rows);
+    const std::vector<double> observations = Observations(spec, rows);
+    const at::Tensor output = policy->forward(ObservationsForNetwork(
+        spec, normalizer, ObservationTensor(spec, observations.data(), rows),
+        kClip));
+    std::vector<float> outputs(rows * c.actions);
+    kernel->Forward(observations.data(), rows, outputs.data());
+    ExpectClose(outputs, output, what + " outputs");
+
+    const at::Tensor action = policy->Act(output, false, reference);
+    const at::Tensor log_prob = policy->LogProb(output, action);
+    std::vector<float> actions(rows * kernel->action_width());
+    std::vector<float> log_probs(rows);
+    kernel->Act(outputs.data(), rows, fast, actions.data(), log_probs.data());
+    ExpectClose(actions, action, what + " actions");
+    ExpectClose(log_probs, log_prob, what + " log-probs");
+  }
+  EXPECT_TRUE(at::equal(at::randint(1 << 30, {8}, reference),
+                        at::randint(1 << 30, {8}, fast)))
+      << "the generators drew different amounts";
+}
+
+TEST(MlpPolicyKernelTest, GaussianTwoHiddenLayersAgreesWithLibTorch) {
+  CompareWithLibTorch({false, 0, {64, 64}, 6});
+}
+
+TEST(MlpPolicyKernelTest, GaussianOneHiddenLayerAgreesWithLibTorch) {
+  CompareWithLibTorch({false, 0, {32}, 3});
+}
+
+TEST(MlpPolicyKernelTest, LinearGaussianAgreesWithLibTorch) {
+  CompareWithLibTorch({false, 0, {}, 1});
+}
+
+TEST(MlpPolicyKernelTest, CategoricalAgreesWithLibTorch) {
+  CompareWithLibTorch({true, 0, {64, 64}, 5});
+}
+
+TEST(MlpPolicyKernelTest, ByteObservationsAgreeWithLibTorch) {
+  CompareWithLibTorch({true, 9, {16}, 4});
+  CompareWithLibTorch({false, 255, {16}, 2});
+}
+
+TEST(MlpPolicyKernelTest, StandardNormalsAreLibTorchs) {
+  for (int64_t n : {1, 5, 15, 16, 17, 40, 64}) {
+    at::Generator a = at::make_generator<at::CPUGeneratorImpl>(3);
+    at::Generator b = at::make_generator<at::CPUGeneratorImpl>(3);
+    // Twice, so the normal LibTorch keeps for the next draw is used too.
+    for (int round = 0; round < 2; ++round) {
+      const at::Tensor expected = at::normal(0.0, 1.0, {n}, a, at::kFloat);
+      std::vector<float> values(n);
+      FillStandardNormal(b, values.data(), n);
+      ExpectClose(values, expected, "n " + std::to_string(n));
+    }
+  }
+}
+
+TEST(MlpPolicyKernelTest, CategoricalDrawsAreLibTorchs) {
+  at::Generator a = at::make_generator<at::CPUGeneratorImpl>(5);
+  at::Generator b = at::make_generator<at::CPUGeneratorImpl>(5);
+  const at::Tensor probabilities = at::softmax(at::randn({64, 6}), -1);
+  const at::Tensor expected = at::multinomial(probabilities, 1, false, a);
+  std::vector<int64_t> indices(64);
+  SampleCategorical(b, probabilities.data_ptr<float>(), 64, 6, indices.data());
+  for (int64_t r = 0; r < 64; ++r) {
+    EXPECT_EQ(indices[r], expected[r][0].item<int64_t>()) << "row " << r;
+  }
+}
+
+TEST(MlpPolicyKernelTest, AConvolutionalTorsoIsLeftToLibTorch) {
+  EnvSpec spec = VectorSpec(true, 10 * 10 * 4, 3);
+  spec.observation_shape = {4, 10, 10};
+  spec.observation_high = 1;
+  NetworkConfig config;
+  config.torso = Torso::kMinAtar;
+  PolicyNetwork policy(spec, config);
+  RunningMeanStd normalizer(spec.observation_size);
+  absl::StatusOr<MlpPolicyKernel> kernel =
+      MlpPolicyKernel::Create(spec, *policy, normalizer, kClip);
+  ASSERT_FALSE(kernel.ok());
+  EXPECT_EQ(kernel.status().code(), absl::StatusCode::kUnimplemented);
+  EXPECT_NE(kernel.status().message().find("convolutional"), std::string::npos)
+      << kernel.status();
+}
+
+}  // namespace
+}  // namespace vantage
