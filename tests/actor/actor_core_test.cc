@@ -88,6 +88,26 @@ TEST(ActorCoreTest, BehaviourLogProbsAreThoseOfTheActingWeights) {
   }
 }
 
+TEST(ActorCoreTest, MlpPoliciesActWithoutLibTorchConvolutionalOnesWithIt) {
+  EXPECT_TRUE(MakeActor()->acts_without_libtorch());
+  ActorConfig config = Config();
+  config.env = "MinAtarBreakout";
+  config.network = NetworkConfig();  // the MinAtar torso
+  config.segment_length = 8;
+  auto actor = std::move(*ActorCore::Create(config));
+  at::manual_seed(11);
+  PolicyNetwork policy(actor->spec(), config.network);
+  ASSERT_TRUE(
+      actor
+          ->SetWeights(ExportPolicyWeights(
+              *policy, RunningMeanStd(actor->spec().observation_size), 0))
+          .ok());
+  EXPECT_FALSE(actor->acts_without_libtorch());
+  for (const Segment& s : Collect(*actor)) {
+    EXPECT_TRUE(ValidateSegment(s, actor->spec(), 8).ok());
+  }
+}
+
 TEST(ActorCoreTest, SameSeedSameSegments) {
   auto a = MakeActor();
   auto b = MakeActor();
