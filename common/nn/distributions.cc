@@ -5,11 +5,6 @@
 #include <cmath>
 
 namespace vantage {
-namespace {
-
-constexpr double kLogSqrtTwoPi = 0.91893853320467274178;  // log(sqrt(2 pi))
-
-}  // namespace
 
 at::Tensor DiagGaussianLogProb(const at::Tensor& mean,
                                const at::Tensor& log_std,

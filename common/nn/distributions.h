@@ -8,6 +8,9 @@
 
 namespace vantage {
 
+// log(sqrt(2 pi)), the Gaussian's normalising term per dimension.
+constexpr double kLogSqrtTwoPi = 0.91893853320467274178;
+
 // Diagonal Gaussian N(mean, exp(log_std)^2): mean and actions [B, k];
 // log_std [k] (state-independent) or [B, k]. Sums over the k dimensions.
 at::Tensor DiagGaussianLogProb(const at::Tensor& mean,

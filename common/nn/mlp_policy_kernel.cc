@@ -10,13 +10,12 @@
 
 #include "absl/strings/str_cat.h"
 #include "common/nn/cpu_sampling.h"
+#include "common/nn/distributions.h"
 #include "common/nn/networks.h"
 #include "common/nn/running_mean_std.h"
 
 namespace vantage {
 namespace {
-
-constexpr float kLogSqrtTwoPi = 0.91893853320467274178f;  // log(sqrt(2 pi))
 
 std::vector<float> FloatVector(const at::Tensor& tensor) {
   const at::Tensor flat = tensor.detach().to(at::kFloat).contiguous();
@@ -52,6 +51,7 @@ absl::StatusOr<MlpPolicyKernel> MlpPolicyKernel::Create(
   }
   MlpPolicyKernel kernel;
   kernel.spec_ = spec;
+  kernel.widest_ = spec.observation_size;
   kernel.discrete_ = policy.discrete();
   kernel.clip_ = observation_clip;
   kernel.mean_ = DoubleVector(normalizer.mean());
@@ -71,6 +71,7 @@ absl::StatusOr<MlpPolicyKernel> MlpPolicyKernel::Create(
     layer.weight = FloatVector(linear.weight);
     layer.bias = FloatVector(linear.bias);
     width = layer.outputs;
+    kernel.widest_ = std::max(kernel.widest_, width);
     kernel.layers_.push_back(std::move(layer));
   }
   if (kernel.layers_.empty() || width != spec.action_size) {
@@ -119,10 +120,8 @@ void MlpPolicyKernel::Inputs(const double* observations, int64_t rows,
 
 void MlpPolicyKernel::Forward(const double* observations, int64_t rows,
                               float* outputs) {
-  int64_t widest = spec_.observation_size;
-  for (const Layer& layer : layers_) widest = std::max(widest, layer.outputs);
-  float* in = Grow(buffer_a_, rows * widest);
-  float* out = Grow(buffer_b_, rows * widest);
+  float* in = Grow(buffer_a_, rows * widest_);
+  float* out = Grow(buffer_b_, rows * widest_);
   Inputs(observations, rows, in);
   for (size_t l = 0; l < layers_.size(); ++l) {
     const Layer& layer = layers_[l];
@@ -153,6 +152,8 @@ void MlpPolicyKernel::Act(const float* outputs, int64_t rows,
   const int64_t n = output_size_;
   if (!discrete_) {
     // mean + exp(log_std) * N(0, 1), and its Gaussian log-density.
+    // In float, as LibTorch subtracts the constant from a float tensor.
+    const float log_sqrt_two_pi = static_cast<float>(kLogSqrtTwoPi);
     float* noise = Grow(noise_, rows * n);
     FillStandardNormal(generator, noise, rows * n);
     for (int64_t r = 0; r < rows; ++r) {
@@ -164,7 +165,7 @@ void MlpPolicyKernel::Act(const float* outputs, int64_t rows,
         actions[i] = action;
         const float z = (action - outputs[i]) * inv_std_[j];
         const float half_square = -0.5f * z * z;
-        log_prob += half_square - log_std_[j] - kLogSqrtTwoPi;
+        log_prob += half_square - log_std_[j] - log_sqrt_two_pi;
       }
       log_probs[r] = log_prob;
     }

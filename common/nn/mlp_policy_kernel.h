@@ -65,6 +65,7 @@ class MlpPolicyKernel {
   std::vector<double> mean_;   // the normaliser's, [observation_size]
   std::vector<double> scale_;  // sqrt(var + 1e-8)
   std::vector<Layer> layers_;
+  int64_t widest_ = 0;  // the widest of the inputs and every layer's outputs
   std::vector<float> log_std_;  // continuous only
   std::vector<float> std_;      // exp(log_std)
   std::vector<float> inv_std_;  // exp(-log_std)
