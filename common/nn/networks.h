@@ -80,6 +80,7 @@ class PolicyNetworkImpl : public torch::nn::Module {
                  at::Generator generator);
 
   bool discrete() const { return discrete_; }
+  const EnvSpec& spec() const { return spec_; }
   // Undefined for discrete policies.
   const at::Tensor& log_std() const { return log_std_; }
   // Empty for the MLP torso.
@@ -106,6 +107,10 @@ class ValueNetworkImpl : public torch::nn::Module {
   ValueNetworkImpl(int64_t observation_size, const NetworkConfig& config);
   // V(s) [B].
   at::Tensor forward(const at::Tensor& observations);
+  // Empty for the MLP torso; a shared torso is the policy's.
+  const ConvTorso& conv_torso() const { return conv_; }
+  // The MLP (for images, only the output layer after the torso).
+  const TanhMlp& body() const { return body_; }
 
  private:
   EnvSpec spec_;

@@ -1,5 +1,6 @@
 #include "learner/algorithms/gradient_step.h"
 
+#include <ATen/ATen.h>
 #include <torch/nn/utils/clip_grad.h>
 #include <torch/optim/optimizer.h>
 #include <torch/serialize/archive.h>
@@ -28,6 +29,28 @@ double GradientStep(torch::optim::Optimizer& optimizer,
   const double norm =
       torch::nn::utils::clip_grad_norm_(parameters, max_grad_norm);
   optimizer.step();
+  return norm;
+}
+
+double AverageAndClipFlatGradient(float* gradients, int64_t size,
+                                  double max_grad_norm,
+                                  ReplicaGroup& replicas) {
+  if (replicas.world_size() > 1) {
+    std::vector<at::Tensor> flat = {at::from_blob(gradients, {size})};
+    replicas.AllReduceSum(flat);
+    flat[0].div_(replicas.world_size());
+  }
+  double squares = 0.0;
+  for (int64_t i = 0; i < size; ++i) {
+    squares += static_cast<double>(gradients[i]) * gradients[i];
+  }
+  const double norm = std::sqrt(squares);
+  // In float, as clip_grad_norm_ computes the coefficient on its float norm.
+  const float coefficient =
+      static_cast<float>(max_grad_norm / (static_cast<float>(norm) + 1e-6));
+  if (coefficient < 1.0f) {
+    for (int64_t i = 0; i < size; ++i) gradients[i] *= coefficient;
+  }
   return norm;
 }
 

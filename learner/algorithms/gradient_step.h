@@ -36,6 +36,13 @@ double GradientStep(torch::optim::Optimizer& optimizer,
                     const at::Tensor& loss, double max_grad_norm,
                     ReplicaGroup& replicas);
 
+// GradientStep's averaging and clipping for a flat gradient array of
+// `size` floats (FlatActorCritic's): the mean over `replicas` (one
+// collective), then scaled as clip_grad_norm_ scales to `max_grad_norm`.
+// Returns the norm before clipping.
+double AverageAndClipFlatGradient(float* gradients, int64_t size,
+                                  double max_grad_norm, ReplicaGroup& replicas);
+
 // Sets every parameter group's learning rate.
 void SetLearningRate(torch::optim::Optimizer& optimizer, double learning_rate);
 

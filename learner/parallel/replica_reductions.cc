@@ -90,6 +90,26 @@ at::Tensor PartsNormalizer::Normalize(size_t part,
   return (values - means_[part]) / (stds_[part] + 1e-8);
 }
 
+void PartsNormalizer::NormalizeInPlace(size_t part, float* values,
+                                       int64_t count) const {
+  double mean = 0.0;
+  double std = 0.0;
+  if (local_) {
+    for (int64_t i = 0; i < count; ++i) mean += values[i];
+    mean /= static_cast<double>(std::max<int64_t>(count, 1));
+    for (int64_t i = 0; i < count; ++i) {
+      std += (values[i] - mean) * (values[i] - mean);
+    }
+    std = std::sqrt(std / static_cast<double>(std::max<int64_t>(count - 1, 1)));
+  } else {
+    mean = means_[part];
+    std = stds_[part];
+  }
+  for (int64_t i = 0; i < count; ++i) {
+    values[i] = static_cast<float>((values[i] - mean) / (std + 1e-8));
+  }
+}
+
 absl::Status UpdateAcrossReplicas(ReplicaGroup& group, RunningMeanStd& stats,
                                   const at::Tensor& rows) {
   if (group.world_size() == 1) return stats.Update(rows);

@@ -45,6 +45,9 @@ class PartsNormalizer {
                   const std::vector<at::Tensor>& parts);
   // `values` (part `part` of x) normalised with that part's statistics.
   at::Tensor Normalize(size_t part, const at::Tensor& values) const;
+  // The same on `count` floats in place (one replica: their own
+  // statistics, computed in double).
+  void NormalizeInPlace(size_t part, float* values, int64_t count) const;
 
  private:
   bool local_;  // one replica: each part's own statistics, in its dtype

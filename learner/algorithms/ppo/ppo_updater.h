@@ -2,10 +2,13 @@
 #define VANTAGE_LEARNER_ALGORITHMS_PPO_PPO_UPDATER_H_
 
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include "absl/status/status.h"
 #include "common/nn/networks.h"
+#include "learner/algorithms/flat_actor_critic.h"
+#include "learner/algorithms/flat_adam.h"
 #include "learner/algorithms/policy_updater.h"
 #include "learner/algorithms/ppo/ppo_config.h"
 #include "learner/parallel/replica_group.h"
@@ -19,13 +22,17 @@ namespace vantage {
 // PPO: `epochs` passes of shuffled minibatches, one Adam (eps 1e-5) over
 // the policy and value parameters, the gradient norm clipped. The ratio's
 // denominator is the behaviour log-probability carried with the segment.
+// MLP networks train through FlatActorCritic and FlatAdam (the same
+// update without autograd, several times faster); convolutional ones, or
+// every network when `autograd_only`, through LibTorch's autograd.
 class PpoUpdater : public PolicyUpdater {
  public:
   static constexpr bool kOneOptimizer = true;
 
   // `replicas`: the data-parallel learners whose gradients are averaged.
   PpoUpdater(PolicyNetwork policy, ValueNetwork value, const PpoConfig& config,
-             std::shared_ptr<ReplicaGroup> replicas = SoloReplicaGroup());
+             std::shared_ptr<ReplicaGroup> replicas = SoloReplicaGroup(),
+             bool autograd_only = false);
   ~PpoUpdater() override;
 
   AlgorithmStats Update(const UpdateBatch& batch, double progress,
@@ -33,13 +40,24 @@ class PpoUpdater : public PolicyUpdater {
   void Save(torch::serialize::OutputArchive& archive) const override;
   absl::Status Load(torch::serialize::InputArchive& archive) override;
 
+  // Whether updates bypass autograd.
+  bool flat() const { return flat_.has_value(); }
+
  private:
+  AlgorithmStats AutogradUpdate(const UpdateBatch& batch, std::mt19937_64& rng);
+  AlgorithmStats FlatUpdate(const UpdateBatch& batch, std::mt19937_64& rng);
+
   PolicyNetwork policy_;
   ValueNetwork value_;
   PpoConfig config_;
   std::shared_ptr<ReplicaGroup> replicas_;
   std::vector<at::Tensor> parameters_;
   std::unique_ptr<torch::optim::Adam> optimizer_;
+  std::optional<FlatActorCritic> flat_;
+  std::optional<FlatAdam> flat_adam_;
+  // Scratch of FlatUpdate: one minibatch's rows.
+  std::vector<float> inputs_, actions_, behaviour_, advantages_, returns_,
+      d_log_probs_, d_values_;
 };
 
 }  // namespace vantage

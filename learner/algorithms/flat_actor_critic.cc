@@ -1,0 +1,291 @@
+#include "learner/algorithms/flat_actor_critic.h"
+
+#include <ATen/ATen.h>
+#include <cblas.h>
+#include <torch/nn/modules/linear.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <utility>
+
+#include "absl/strings/str_cat.h"
+#include "common/nn/distributions.h"
+#include "common/nn/networks.h"
+
+namespace vantage {
+namespace {
+
+template <typename T>
+T* Grow(std::vector<T>& buffer, int64_t size) {
+  if (static_cast<int64_t>(buffer.size()) < size) buffer.resize(size);
+  return buffer.data();
+}
+
+}  // namespace
+
+absl::StatusOr<FlatActorCritic> FlatActorCritic::Create(
+    PolicyNetworkImpl& policy, ValueNetworkImpl& value,
+    std::vector<at::Tensor> parameters) {
+  if (!policy.conv_torso().is_empty() || !value.conv_torso().is_empty()) {
+    return absl::UnimplementedError(
+        "the networks have a convolutional torso, which only autograd trains");
+  }
+  FlatActorCritic flat;
+  flat.spec_ = policy.spec();
+  flat.discrete_ = policy.discrete();
+  int64_t size = 0;
+  for (const at::Tensor& p : parameters) {
+    if (p.scalar_type() != at::kFloat || !p.is_contiguous() || !p.is_cpu()) {
+      return absl::UnimplementedError(
+          "a parameter is not a contiguous float tensor on the CPU");
+    }
+    flat.offsets_.push_back(size);
+    size += p.numel();
+  }
+  flat.tensors_ = std::move(parameters);
+  std::vector<bool> claimed(flat.tensors_.size(), false);
+  // The offset of the parameter that is `tensor`, claimed once.
+  auto offset_of = [&](const at::Tensor& tensor) -> int64_t {
+    for (size_t i = 0; i < flat.tensors_.size(); ++i) {
+      if (flat.tensors_[i].unsafeGetTensorImpl() ==
+              tensor.unsafeGetTensorImpl() &&
+          !claimed[i]) {
+        claimed[i] = true;
+        return flat.offsets_[i];
+      }
+    }
+    return -1;
+  };
+  auto layout = [&](const TanhMlp& body, int64_t outputs,
+                    Mlp& mlp) -> absl::Status {
+    const torch::nn::ModuleList& layers = body->layers();
+    int64_t width = flat.spec_.observation_size;
+    for (size_t i = 0; i < layers->size(); ++i) {
+      const auto& linear = layers->at<torch::nn::LinearImpl>(i);
+      Layer layer;
+      layer.outputs = linear.weight.size(0);
+      layer.inputs = linear.weight.size(1);
+      layer.weight = offset_of(linear.weight);
+      layer.bias = linear.bias.defined() ? offset_of(linear.bias) : -1;
+      if (layer.inputs != width || layer.weight < 0 || layer.bias < 0) {
+        return absl::UnimplementedError(
+            absl::StrCat("layer ", i, " is not a biased Linear layer on ",
+                         width, " inputs whose parameters are the given ones"));
+      }
+      width = layer.outputs;
+      mlp.layers.push_back(layer);
+    }
+    if (mlp.layers.empty() || width != outputs) {
+      return absl::UnimplementedError(
+          absl::StrCat("an MLP ends in ", width, " outputs, not ", outputs));
+    }
+    mlp.outputs.resize(mlp.layers.size());
+    return absl::OkStatus();
+  };
+  if (absl::Status status =
+          layout(policy.body(), flat.spec_.action_size, flat.policy_);
+      !status.ok()) {
+    return status;
+  }
+  if (absl::Status status = layout(value.body(), 1, flat.value_);
+      !status.ok()) {
+    return status;
+  }
+  if (!flat.discrete_) {
+    flat.log_std_ = offset_of(policy.log_std());
+    if (flat.log_std_ < 0) {
+      return absl::UnimplementedError("the log-std is not a given parameter");
+    }
+  }
+  if (std::find(claimed.begin(), claimed.end(), false) != claimed.end()) {
+    return absl::UnimplementedError(
+        "a parameter belongs to neither network's layers nor the log-std");
+  }
+  flat.parameters_.resize(size);
+  flat.gradients_.assign(size, 0.0f);
+  flat.Pull();
+  return flat;
+}
+
+void FlatActorCritic::Pull() {
+  for (size_t i = 0; i < tensors_.size(); ++i) {
+    std::memcpy(parameters_.data() + offsets_[i], tensors_[i].data_ptr<float>(),
+                sizeof(float) * tensors_[i].numel());
+  }
+}
+
+void FlatActorCritic::Push() {
+  for (size_t i = 0; i < tensors_.size(); ++i) {
+    std::memcpy(tensors_[i].data_ptr<float>(), parameters_.data() + offsets_[i],
+                sizeof(float) * tensors_[i].numel());
+  }
+}
+
+at::Tensor FlatActorCritic::Inputs(const at::Tensor& observations) const {
+  return ::vantage::NetworkInputs(spec_, observations)
+      .to(at::kFloat)
+      .contiguous();
+}
+
+void FlatActorCritic::MlpForward(Mlp& mlp, const float* inputs, int64_t rows) {
+  const float* x = inputs;
+  for (size_t l = 0; l < mlp.layers.size(); ++l) {
+    const Layer& layer = mlp.layers[l];
+    float* y = Grow(mlp.outputs[l], rows * layer.outputs);
+    const float* bias = parameters_.data() + layer.bias;
+    // As addmm: the bias, then the product added onto it.
+    for (int64_t r = 0; r < rows; ++r) {
+      std::memcpy(y + r * layer.outputs, bias, sizeof(float) * layer.outputs);
+    }
+    cblas_sgemm(CblasRowMajor, CblasNoTrans, CblasTrans, rows, layer.outputs,
+                layer.inputs, 1.0f, x, layer.inputs,
+                parameters_.data() + layer.weight, layer.inputs, 1.0f, y,
+                layer.outputs);
+    if (l + 1 < mlp.layers.size()) {
+      // LibTorch's vectorised tanh, the one the modules use: libm's scalar
+      // tanhf would take most of the step.
+      at::from_blob(y, {rows * layer.outputs}).tanh_();
+    }
+    x = y;
+  }
+}
+
+void FlatActorCritic::MlpBackward(Mlp& mlp, const float* inputs, int64_t rows,
+                                  std::vector<float>& gradient) {
+  for (size_t l = mlp.layers.size(); l-- > 0;) {
+    const Layer& layer = mlp.layers[l];
+    const float* x = l == 0 ? inputs : mlp.outputs[l - 1].data();
+    const float* dy = gradient.data();
+    cblas_sgemm(CblasRowMajor, CblasTrans, CblasNoTrans, layer.outputs,
+                layer.inputs, rows, 1.0f, dy, layer.outputs, x, layer.inputs,
+                0.0f, gradients_.data() + layer.weight, layer.inputs);
+    float* db = gradients_.data() + layer.bias;
+    std::fill(db, db + layer.outputs, 0.0f);
+    for (int64_t r = 0; r < rows; ++r) {
+      for (int64_t j = 0; j < layer.outputs; ++j) {
+        db[j] += dy[r * layer.outputs + j];
+      }
+    }
+    if (l == 0) break;
+    float* dx = Grow(scratch_, rows * layer.inputs);
+    cblas_sgemm(CblasRowMajor, CblasNoTrans, CblasNoTrans, rows, layer.inputs,
+                layer.outputs, 1.0f, dy, layer.outputs,
+                parameters_.data() + layer.weight, layer.inputs, 0.0f, dx,
+                layer.inputs);
+    // Through the tanh whose outputs x are.
+    for (int64_t i = 0; i < rows * layer.inputs; ++i) {
+      dx[i] *= 1.0f - x[i] * x[i];
+    }
+    std::swap(gradient, scratch_);
+  }
+}
+
+void FlatActorCritic::Forward(const float* inputs, const float* actions,
+                              int64_t rows) {
+  rows_ = rows;
+  inputs_ = inputs;
+  actions_ = actions;
+  MlpForward(policy_, inputs, rows);
+  MlpForward(value_, inputs, rows);
+  Grow(values_, rows);
+  std::memcpy(values_.data(), value_.outputs.back().data(),
+              sizeof(float) * rows);
+  Grow(log_probs_, rows);
+  if (discrete_) {
+    CategoricalHead(actions, rows);
+  } else {
+    GaussianHead(actions, rows);
+  }
+}
+
+void FlatActorCritic::GaussianHead(const float* actions, int64_t rows) {
+  const int64_t k = spec_.action_size;
+  const float* mean = policy_.outputs.back().data();
+  const float* log_std = parameters_.data() + log_std_;
+  float* z = Grow(head_, rows * k);
+  const float constant = static_cast<float>(kLogSqrtTwoPi);
+  for (int64_t r = 0; r < rows; ++r) {
+    float sum = 0.0f;
+    for (int64_t j = 0; j < k; ++j) {
+      const int64_t i = r * k + j;
+      z[i] = (actions[i] - mean[i]) * std::exp(-log_std[j]);
+      sum += -0.5f * z[i] * z[i] - log_std[j] - constant;
+    }
+    log_probs_[r] = sum;
+  }
+  double entropy = 0.0;
+  for (int64_t j = 0; j < k; ++j) entropy += log_std[j] + kLogSqrtTwoPi + 0.5;
+  mean_entropy_ = entropy;
+}
+
+void FlatActorCritic::CategoricalHead(const float* actions, int64_t rows) {
+  const int64_t n = spec_.action_size;
+  const float* logits = policy_.outputs.back().data();
+  float* log_p = Grow(head_, rows * n);
+  float* entropies = Grow(entropies_, rows);
+  double entropy_sum = 0.0;
+  for (int64_t r = 0; r < rows; ++r) {
+    const float* row = logits + r * n;
+    const float max = *std::max_element(row, row + n);
+    float sum = 0.0f;
+    for (int64_t j = 0; j < n; ++j) sum += std::exp(row[j] - max);
+    const float log_sum = std::log(sum) + max;
+    float entropy = 0.0f;
+    for (int64_t j = 0; j < n; ++j) {
+      log_p[r * n + j] = row[j] - log_sum;
+      entropy -= std::exp(log_p[r * n + j]) * log_p[r * n + j];
+    }
+    entropies[r] = entropy;
+    entropy_sum += entropy;
+    log_probs_[r] = log_p[r * n + static_cast<int64_t>(actions[r])];
+  }
+  mean_entropy_ = entropy_sum / static_cast<double>(std::max<int64_t>(rows, 1));
+}
+
+void FlatActorCritic::Backward(const float* d_log_probs, double entropy_weight,
+                               const float* d_values) {
+  const int64_t rows = rows_;
+  const int64_t k = spec_.action_size;
+  float* d_output = Grow(policy_gradient_, rows * k);
+  if (discrete_) {
+    const float* log_p = head_.data();
+    // d entropy_r / d logit_j = -p_j (log p_j + entropy_r).
+    const float per_row = static_cast<float>(
+        entropy_weight / static_cast<double>(std::max<int64_t>(rows, 1)));
+    for (int64_t r = 0; r < rows; ++r) {
+      const int64_t action = static_cast<int64_t>(actions_[r]);
+      for (int64_t j = 0; j < k; ++j) {
+        const int64_t i = r * k + j;
+        const float p = std::exp(log_p[i]);
+        d_output[i] = d_log_probs[r] * ((j == action ? 1.0f : 0.0f) - p) -
+                      per_row * p * (log_p[i] + entropies_[r]);
+      }
+    }
+  } else {
+    // d log_prob / d mean_j = z_j / std_j; d log_prob / d log_std_j =
+    // z_j^2 - 1; the mean entropy grows by one per unit of each log-std.
+    const float* z = head_.data();
+    const float* log_std = parameters_.data() + log_std_;
+    float* d_log_std = gradients_.data() + log_std_;
+    for (int64_t j = 0; j < k; ++j) {
+      d_log_std[j] = static_cast<float>(entropy_weight);
+    }
+    for (int64_t j = 0; j < k; ++j) {
+      const float inverse_std = std::exp(-log_std[j]);
+      float sum = 0.0f;
+      for (int64_t r = 0; r < rows; ++r) {
+        const float zi = z[r * k + j];
+        d_output[r * k + j] = d_log_probs[r] * zi * inverse_std;
+        sum += d_log_probs[r] * (zi * zi - 1.0f);
+      }
+      d_log_std[j] += sum;
+    }
+  }
+  MlpBackward(policy_, inputs_, rows, policy_gradient_);
+  float* d_value = Grow(value_gradient_, rows);
+  std::memcpy(d_value, d_values, sizeof(float) * rows);
+  MlpBackward(value_, inputs_, rows, value_gradient_);
+}
+
+}  // namespace vantage

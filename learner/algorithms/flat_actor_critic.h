@@ -1,0 +1,117 @@
+#ifndef VANTAGE_LEARNER_ALGORITHMS_FLAT_ACTOR_CRITIC_H_
+#define VANTAGE_LEARNER_ALGORITHMS_FLAT_ACTOR_CRITIC_H_
+
+// The MLP policy and value networks as the first-order algorithms train
+// them, without autograd: every parameter in one flat float array (the
+// order of NetworkParameters), the forward pass of a minibatch as one BLAS
+// call per layer keeping what the backward pass needs, the policy head's
+// log-probabilities and entropies, and the backward pass written out by
+// hand into one flat gradient array. A minibatch step on a 64x64 network
+// is a few dozen small kernels instead of LibTorch's hundreds of operator
+// dispatches and autograd nodes; tests/learner/algorithms/
+// flat_actor_critic_test.cc checks every gradient against autograd.
+
+#include <ATen/core/Tensor.h>
+
+#include <cstdint>
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "common/env/environment.h"
+
+namespace vantage {
+
+class PolicyNetworkImpl;
+class ValueNetworkImpl;
+
+class FlatActorCritic {
+ public:
+  // `parameters`: NetworkParameters(policy, value). Unimplemented for what
+  // it cannot run (a convolutional torso, a shared one); those networks
+  // train through autograd.
+  static absl::StatusOr<FlatActorCritic> Create(
+      PolicyNetworkImpl& policy, ValueNetworkImpl& value,
+      std::vector<at::Tensor> parameters);
+
+  int64_t size() const { return static_cast<int64_t>(parameters_.size()); }
+  float* parameters() { return parameters_.data(); }
+  const float* gradients() const { return gradients_.data(); }
+  float* gradients() { return gradients_.data(); }
+  // Where each parameter tensor's values begin in the flat arrays.
+  const std::vector<int64_t>& offsets() const { return offsets_; }
+  int64_t observation_size() const { return spec_.observation_size; }
+  int64_t action_width() const { return discrete_ ? 1 : spec_.action_size; }
+
+  // The modules' parameters into the flat array, and back.
+  void Pull();
+  void Push();
+
+  // The inputs of both networks [rows, observation_size] for observations
+  // as batches hold them (normalised floats, or bytes, which the networks
+  // divide by observation_high).
+  at::Tensor Inputs(const at::Tensor& observations) const;
+
+  // Both networks on `rows` inputs, and the policy's log-probabilities of
+  // `actions` ([rows, action_width()]; indices as floats when discrete).
+  // Both arrays must stay unchanged until Backward.
+  void Forward(const float* inputs, const float* actions, int64_t rows);
+  const float* log_probs() const { return log_probs_.data(); }  // [rows]
+  const float* values() const { return values_.data(); }        // [rows]
+  // The mean over the rows of the policy's entropy.
+  double mean_entropy() const { return mean_entropy_; }
+
+  // gradients() := the gradient of
+  //   sum_i d_log_probs[i] * log_prob_i + entropy_weight * mean_entropy
+  //   + sum_i d_values[i] * value_i
+  // for the rows of the last Forward.
+  void Backward(const float* d_log_probs, double entropy_weight,
+                const float* d_values);
+
+ private:
+  struct Layer {
+    int64_t inputs = 0;
+    int64_t outputs = 0;
+    int64_t weight = 0;  // offsets: [outputs, inputs] row-major
+    int64_t bias = 0;
+  };
+  struct Mlp {
+    std::vector<Layer> layers;
+    // Each layer's output of the last Forward (after tanh but the last).
+    std::vector<std::vector<float>> outputs;
+  };
+
+  FlatActorCritic() = default;
+  void MlpForward(Mlp& mlp, const float* inputs, int64_t rows);
+  // From d loss / d (the last layer's output) in `gradient` [rows, last
+  // outputs] (used as scratch).
+  void MlpBackward(Mlp& mlp, const float* inputs, int64_t rows,
+                   std::vector<float>& gradient);
+  void GaussianHead(const float* actions, int64_t rows);
+  void CategoricalHead(const float* actions, int64_t rows);
+
+  EnvSpec spec_;
+  bool discrete_ = false;
+  std::vector<at::Tensor> tensors_;
+  std::vector<int64_t> offsets_;
+  std::vector<float> parameters_;
+  std::vector<float> gradients_;
+  Mlp policy_;
+  Mlp value_;
+  int64_t log_std_ = -1;  // offset; continuous only
+
+  // The last Forward's rows and what Backward needs of them.
+  int64_t rows_ = 0;
+  const float* inputs_ = nullptr;
+  const float* actions_ = nullptr;
+  std::vector<float> log_probs_, values_;
+  double mean_entropy_ = 0.0;
+  // Per row and action: z = (action - mean) / std (Gaussian), or the
+  // log-softmax of the logits (categorical).
+  std::vector<float> head_;
+  std::vector<float> entropies_;  // per row (categorical)
+  std::vector<float> policy_gradient_, value_gradient_, scratch_;
+};
+
+}  // namespace vantage
+
+#endif  // VANTAGE_LEARNER_ALGORITHMS_FLAT_ACTOR_CRITIC_H_

@@ -1,0 +1,204 @@
+#include "learner/algorithms/flat_actor_critic.h"
+
+#include <ATen/ATen.h>
+#include <torch/optim/adam.h>
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "common/nn/networks.h"
+#include "gtest/gtest.h"
+#include "learner/algorithms/flat_adam.h"
+
+namespace vantage {
+namespace {
+
+EnvSpec VectorSpec(bool discrete, int64_t observations, int64_t actions) {
+  EnvSpec spec;
+  spec.name = "test";
+  spec.observation_size = observations;
+  spec.discrete = discrete;
+  spec.action_size = actions;
+  if (!discrete) {
+    spec.action_low.assign(actions, -1.0);
+    spec.action_high.assign(actions, 1.0);
+  }
+  return spec;
+}
+
+// Weights of the scale hidden layers start with (1 / sqrt(inputs)), for
+// every layer, so that the outputs and the log-std are far from their
+// initial zeros.
+void Randomise(const std::vector<at::Tensor>& parameters) {
+  at::NoGradGuard no_grad;
+  for (at::Tensor parameter : parameters) {
+    const double scale =
+        parameter.dim() == 2 ? 1.0 / std::sqrt(parameter.size(1)) : 0.5;
+    parameter.copy_(at::randn(parameter.sizes()) * scale);
+  }
+}
+
+// Every element within `tolerance` of the largest magnitude of `reference`.
+void ExpectClose(const float* fast, const at::Tensor& reference,
+                 double tolerance, const std::string& what) {
+  const at::Tensor expected = reference.detach().contiguous().reshape(-1);
+  const double scale = std::max(1e-12, expected.abs().max().item<double>());
+  double worst = 0.0;
+  for (int64_t i = 0; i < expected.numel(); ++i) {
+    worst = std::max(worst, std::abs(fast[i] - expected[i].item<double>()));
+  }
+  EXPECT_LE(worst / scale, tolerance) << what;
+}
+
+struct Case {
+  bool discrete;
+  int64_t observations;
+  int64_t actions;
+  std::vector<int64_t> hidden;
+  bool bytes;
+};
+
+class FlatActorCriticTest : public ::testing::TestWithParam<Case> {};
+
+TEST_P(FlatActorCriticTest, ForwardAndGradientsAreAutograds) {
+  const Case& c = GetParam();
+  at::manual_seed(3);
+  EnvSpec spec = VectorSpec(c.discrete, c.observations, c.actions);
+  if (c.bytes) {
+    spec.observation_shape = {c.observations};
+    spec.observation_high = 7;
+  }
+  NetworkConfig config;
+  config.hidden = c.hidden;
+  PolicyNetwork policy(spec, config);
+  ValueNetwork value = MakeValueNetwork(spec, config, *policy);
+  const std::vector<at::Tensor> parameters = NetworkParameters(*policy, *value);
+  Randomise(parameters);
+  absl::StatusOr<FlatActorCritic> flat =
+      FlatActorCritic::Create(*policy, *value, parameters);
+  ASSERT_TRUE(flat.ok()) << flat.status();
+
+  constexpr int64_t kRows = 37;
+  const at::Tensor observations =
+      c.bytes ? at::randint(0, 8, {kRows, c.observations}, at::kByte)
+              : at::randn({kRows, c.observations}) * 2.0;
+  const at::Tensor actions =
+      c.discrete ? at::randint(0, c.actions, {kRows, 1}).to(at::kFloat)
+                 : at::randn({kRows, c.actions});
+  const at::Tensor d_log_probs = at::randn({kRows});
+  const at::Tensor d_values = at::randn({kRows});
+  const double entropy_weight = -0.37;
+
+  const at::Tensor inputs = flat->Inputs(observations);
+  flat->Forward(inputs.data_ptr<float>(), actions.data_ptr<float>(), kRows);
+  flat->Backward(d_log_probs.data_ptr<float>(), entropy_weight,
+                 d_values.data_ptr<float>());
+
+  const at::Tensor output = policy->forward(observations);
+  const at::Tensor log_probs = policy->LogProb(output, actions);
+  const at::Tensor entropy = policy->Entropy(output).mean();
+  const at::Tensor values = value->forward(observations);
+  ExpectClose(flat->log_probs(), log_probs, 1e-6, "log-probabilities");
+  ExpectClose(flat->values(), values, 1e-6, "values");
+  EXPECT_NEAR(flat->mean_entropy(), entropy.item<double>(),
+              1e-6 * std::max(1.0, std::abs(entropy.item<double>())));
+
+  ((log_probs * d_log_probs).sum() + entropy_weight * entropy +
+   (values * d_values).sum())
+      .backward();
+  for (size_t i = 0; i < parameters.size(); ++i) {
+    ExpectClose(flat->gradients() + flat->offsets()[i], parameters[i].grad(),
+                1e-5, "the gradient of parameter " + std::to_string(i));
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Heads, FlatActorCriticTest,
+                         ::testing::Values(Case{false, 17, 6, {64, 64}, false},
+                                           Case{true, 11, 5, {32}, false},
+                                           Case{false, 3, 1, {}, false},
+                                           Case{true, 9, 4, {16, 8}, true}));
+
+TEST(FlatActorCriticTest, PushWritesTheModulesAndPullReadsThem) {
+  at::manual_seed(4);
+  const EnvSpec spec = VectorSpec(false, 5, 2);
+  NetworkConfig config;
+  PolicyNetwork policy(spec, config);
+  ValueNetwork value = MakeValueNetwork(spec, config, *policy);
+  const std::vector<at::Tensor> parameters = NetworkParameters(*policy, *value);
+  absl::StatusOr<FlatActorCritic> flat =
+      FlatActorCritic::Create(*policy, *value, parameters);
+  ASSERT_TRUE(flat.ok()) << flat.status();
+  for (int64_t i = 0; i < flat->size(); ++i) flat->parameters()[i] = i;
+  flat->Push();
+  for (size_t p = 0; p < parameters.size(); ++p) {
+    EXPECT_EQ(parameters[p].reshape(-1)[0].item<float>(),
+              static_cast<float>(flat->offsets()[p]));
+  }
+  Randomise(parameters);
+  flat->Pull();
+  for (size_t p = 0; p < parameters.size(); ++p) {
+    EXPECT_EQ(flat->parameters()[flat->offsets()[p]],
+              parameters[p].reshape(-1)[0].item<float>());
+  }
+}
+
+TEST(FlatActorCriticTest, AConvolutionalTorsoIsLeftToAutograd) {
+  EnvSpec spec = VectorSpec(true, 10 * 10 * 4, 3);
+  spec.observation_shape = {4, 10, 10};
+  spec.observation_high = 1;
+  for (bool shared : {false, true}) {
+    NetworkConfig config;
+    config.torso = Torso::kMinAtar;
+    config.shared_torso = shared;
+    PolicyNetwork policy(spec, config);
+    ValueNetwork value = MakeValueNetwork(spec, config, *policy);
+    absl::StatusOr<FlatActorCritic> flat = FlatActorCritic::Create(
+        *policy, *value, NetworkParameters(*policy, *value));
+    ASSERT_FALSE(flat.ok());
+    EXPECT_EQ(flat.status().code(), absl::StatusCode::kUnimplemented);
+    EXPECT_NE(flat.status().message().find("convolutional"), std::string::npos)
+        << flat.status();
+  }
+}
+
+TEST(FlatAdamTest, StepsAsTorchAdamAndCarriesItsState) {
+  at::manual_seed(6);
+  std::vector<at::Tensor> reference = {at::randn({4, 3}), at::randn({5})};
+  std::vector<at::Tensor> tensors = {reference[0].clone(),
+                                     reference[1].clone()};
+  for (at::Tensor& t : reference) t.set_requires_grad(true);
+  torch::optim::Adam torch_adam(reference,
+                                torch::optim::AdamOptions(3e-3).eps(1e-5));
+  torch::optim::Adam holder(tensors, torch::optim::AdamOptions(3e-3).eps(1e-5));
+  FlatAdam flat(tensors, {0, 12}, 17);
+  std::vector<float> values(17), gradients(17);
+  std::copy_n(tensors[0].data_ptr<float>(), 12, values.begin());
+  std::copy_n(tensors[1].data_ptr<float>(), 5, values.begin() + 12);
+  for (int step = 0; step < 25; ++step) {
+    const at::Tensor g0 = at::randn({4, 3}) * (step % 3 == 0 ? 1e-3 : 1.0);
+    const at::Tensor g1 = at::randn({5});
+    reference[0].mutable_grad() = g0.clone();
+    reference[1].mutable_grad() = g1.clone();
+    torch_adam.step();
+    std::copy_n(g0.data_ptr<float>(), 12, gradients.begin());
+    std::copy_n(g1.data_ptr<float>(), 5, gradients.begin() + 12);
+    flat.Step(holder, values.data(), gradients.data());
+  }
+  ExpectClose(values.data(), reference[0], 1e-6, "first tensor");
+  ExpectClose(values.data() + 12, reference[1], 1e-6, "second tensor");
+
+  // Through the torch optimiser's state and back, nothing changes.
+  flat.StoreInto(holder);
+  FlatAdam restored(tensors, {0, 12}, 17);
+  ASSERT_TRUE(restored.LoadFrom(holder).ok());
+  std::vector<float> a = values, b = values;
+  for (float& g : gradients) g = 0.25f;
+  flat.Step(holder, a.data(), gradients.data());
+  restored.Step(holder, b.data(), gradients.data());
+  EXPECT_EQ(a, b);
+}
+
+}  // namespace
+}  // namespace vantage

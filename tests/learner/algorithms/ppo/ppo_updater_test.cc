@@ -1,0 +1,180 @@
+#include "learner/algorithms/ppo/ppo_updater.h"
+
+#include <ATen/ATen.h>
+#include <torch/serialize/input-archive.h>
+#include <torch/serialize/output-archive.h>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "gtest/gtest.h"
+
+namespace vantage {
+namespace {
+
+EnvSpec Spec(bool discrete) {
+  EnvSpec spec;
+  spec.name = "test";
+  spec.observation_size = 17;
+  spec.discrete = discrete;
+  spec.action_size = discrete ? 5 : 6;
+  if (!discrete) {
+    spec.action_low.assign(6, -1.0);
+    spec.action_high.assign(6, 1.0);
+  }
+  return spec;
+}
+
+struct Networks {
+  PolicyNetwork policy{nullptr};
+  ValueNetwork value{nullptr};
+};
+
+Networks MakeNetworks(const EnvSpec& spec, uint64_t seed) {
+  at::manual_seed(seed);
+  NetworkConfig config;
+  Networks n;
+  n.policy = PolicyNetwork(spec, config);
+  n.value = MakeValueNetwork(spec, config, *n.policy);
+  return n;
+}
+
+// A batch acted by the policy (actions drawn from it) whose behaviour
+// log-probabilities are those of a slightly different policy, so that
+// ratios start near 1 and some leave the clipping range.
+UpdateBatch ActedBatch(Networks& n, int64_t rows) {
+  at::NoGradGuard no_grad;
+  UpdateBatch batch;
+  batch.horizon = rows;
+  batch.streams = 1;
+  batch.observations = at::randn({rows, 17});
+  const at::Tensor output = n.policy->forward(batch.observations);
+  batch.actions = n.policy->Act(output, false, at::Generator());
+  batch.behaviour_log_probs =
+      n.policy->LogProb(output, batch.actions) + 0.2 * at::randn({rows});
+  batch.advantages = at::randn({rows});
+  batch.returns = at::randn({rows});
+  return batch;
+}
+
+PpoConfig SmallConfig() {
+  PpoConfig config;
+  config.minibatches = 8;
+  config.epochs = 4;
+  config.max_grad_norm = 0.5;
+  return config;
+}
+
+std::string Saved(const PpoUpdater& updater) {
+  torch::serialize::OutputArchive archive;
+  updater.Save(archive);
+  std::ostringstream bytes;
+  archive.save_to(bytes);
+  return bytes.str();
+}
+
+absl::Status LoadInto(PpoUpdater& updater, const std::string& bytes) {
+  torch::serialize::InputArchive archive;
+  std::istringstream in(bytes);
+  archive.load_from(in);
+  return updater.Load(archive);
+}
+
+// Each parameter within 1e-5 of its tensor's largest magnitude.
+void ExpectSameParameters(Networks& a, Networks& b, double tolerance) {
+  const std::vector<at::Tensor> pa = NetworkParameters(*a.policy, *a.value);
+  const std::vector<at::Tensor> pb = NetworkParameters(*b.policy, *b.value);
+  ASSERT_EQ(pa.size(), pb.size());
+  for (size_t i = 0; i < pa.size(); ++i) {
+    const double scale = std::max(1e-12, pb[i].abs().max().item<double>());
+    EXPECT_LE((pa[i] - pb[i]).abs().max().item<double>() / scale, tolerance)
+        << "parameter " << i;
+  }
+}
+
+class PpoUpdaterTest : public ::testing::TestWithParam<bool> {};
+
+TEST_P(PpoUpdaterTest, TheFlatUpdateIsTheAutogradUpdate) {
+  const EnvSpec spec = Spec(GetParam());
+  Networks flat_nets = MakeNetworks(spec, 9);
+  Networks autograd_nets = MakeNetworks(spec, 9);
+  PpoUpdater flat(flat_nets.policy, flat_nets.value, SmallConfig());
+  PpoUpdater autograd(autograd_nets.policy, autograd_nets.value, SmallConfig(),
+                      SoloReplicaGroup(),
+                      /*autograd_only=*/true);
+  ASSERT_TRUE(flat.flat());
+  ASSERT_FALSE(autograd.flat());
+  at::manual_seed(10);
+  const UpdateBatch batch = ActedBatch(flat_nets, 512);
+  // Two updates: the second starts from Adam's state of the first.
+  for (int update = 0; update < 2; ++update) {
+    std::mt19937_64 rng_a(update), rng_b(update);
+    const AlgorithmStats a = flat.Update(batch, 0.25 * update, rng_a);
+    const AlgorithmStats b = autograd.Update(batch, 0.25 * update, rng_b);
+    ExpectSameParameters(flat_nets, autograd_nets, 1e-5);
+    for (auto [x, y, what] :
+         {std::tuple{a.policy_loss, b.policy_loss, "pi"},
+          {a.value_loss, b.value_loss, "value"},
+          {a.entropy, b.entropy, "entropy"},
+          {a.approx_kl, b.approx_kl, "kl"},
+          {a.clip_fraction, b.clip_fraction, "clip"},
+          {a.max_gradient_norm, b.max_gradient_norm, "norm"}}) {
+      EXPECT_NEAR(x, y, 1e-5 * std::max(1.0, std::abs(y))) << what;
+    }
+    EXPECT_GT(a.clip_fraction, 0.0);
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Heads, PpoUpdaterTest, ::testing::Bool());
+
+TEST(PpoUpdaterStateTest, CheckpointsResumeExactlyAndCrossBetweenPaths) {
+  const EnvSpec spec = Spec(false);
+  Networks first = MakeNetworks(spec, 11);
+  Networks second = MakeNetworks(spec, 11);
+  PpoUpdater a(first.policy, first.value, SmallConfig());
+  at::manual_seed(12);
+  const UpdateBatch batch = ActedBatch(first, 256);
+  std::mt19937_64 rng(1);
+  a.Update(batch, 0.0, rng);
+  const std::string state = Saved(a);
+  // The networks as the first update left them, and its optimiser state.
+  {
+    at::NoGradGuard no_grad;
+    const std::vector<at::Tensor> from =
+        NetworkParameters(*first.policy, *first.value);
+    const std::vector<at::Tensor> to =
+        NetworkParameters(*second.policy, *second.value);
+    for (size_t i = 0; i < from.size(); ++i) to[i].copy_(from[i]);
+  }
+  PpoUpdater b(second.policy, second.value, SmallConfig());
+  ASSERT_TRUE(LoadInto(b, state).ok());
+  std::mt19937_64 rng_a(2), rng_b(2);
+  a.Update(batch, 0.1, rng_a);
+  b.Update(batch, 0.1, rng_b);
+  ExpectSameParameters(first, second, 0.0);
+
+  // The same state read by the autograd path continues alike.
+  Networks third = MakeNetworks(spec, 11);
+  {
+    at::NoGradGuard no_grad;
+    const std::vector<at::Tensor> from =
+        NetworkParameters(*first.policy, *first.value);
+    const std::vector<at::Tensor> to =
+        NetworkParameters(*third.policy, *third.value);
+    for (size_t i = 0; i < from.size(); ++i) to[i].copy_(from[i]);
+  }
+  PpoUpdater c(third.policy, third.value, SmallConfig(), SoloReplicaGroup(),
+               /*autograd_only=*/true);
+  ASSERT_TRUE(LoadInto(c, Saved(a)).ok());
+  std::mt19937_64 rng_c(3), rng_d(3);
+  a.Update(batch, 0.2, rng_c);
+  c.Update(batch, 0.2, rng_d);
+  ExpectSameParameters(first, third, 1e-5);
+}
+
+}  // namespace
+}  // namespace vantage
