@@ -10,12 +10,19 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <optional>
+#include <string>
 #include <thread>
+#include <utility>
 #include <vector>
 
+#include "absl/strings/match.h"
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
+#include "absl/strings/str_replace.h"
 #include "absl/strings/str_split.h"
+#include "absl/strings/strip.h"
 #include "actor/envs/env_registry.h"
 #include "bench/raw_physics.h"
 #include "common/util/self_process.h"
@@ -93,6 +100,108 @@ std::vector<ProgressPoint> ReadProgress(const std::string& path) {
   return points;
 }
 
+// The mean shares of every "<who>: time split over W s: a X%, b Y%, ..."
+// line of `log` whose <who> does (learner) or does not (actors) start
+// with "learner", by phase name (spaces as underscores), in first-seen
+// order.
+struct TimeSplit {
+  std::vector<std::pair<std::string, double>> shares;
+  int processes = 0;
+};
+
+TimeSplit ReadTimeSplit(const std::string& log, bool learner) {
+  TimeSplit split;
+  std::ifstream file(log);
+  std::string line;
+  constexpr char kMarker[] = ": time split over ";
+  while (std::getline(file, line)) {
+    const size_t marker = line.find(kMarker);
+    if (marker == std::string::npos ||
+        absl::StartsWith(line, "learner") != learner) {
+      continue;
+    }
+    const size_t colon = line.find(": ", marker + sizeof(kMarker) - 1);
+    if (colon == std::string::npos) continue;
+    ++split.processes;
+    for (absl::string_view part :
+         absl::StrSplit(line.substr(colon + 2), ", ")) {
+      const size_t space = part.rfind(' ');
+      double share = 0.0;
+      if (space == absl::string_view::npos ||
+          !absl::SimpleAtod(absl::StripSuffix(part.substr(space + 1), "%"),
+                            &share)) {
+        continue;
+      }
+      const std::string name =
+          absl::StrReplaceAll(part.substr(0, space), {{" ", "_"}});
+      auto found = std::find_if(split.shares.begin(), split.shares.end(),
+                                [&](const auto& s) { return s.first == name; });
+      if (found == split.shares.end()) {
+        split.shares.emplace_back(name, share);
+      } else {
+        found->second += share;
+      }
+    }
+  }
+  for (auto& [name, share] : split.shares)
+    share /= std::max(1, split.processes);
+  return split;
+}
+
+// " prefix_a=1.0 prefix_b=2.0" of `split`.
+std::string SplitFields(const TimeSplit& split, const std::string& prefix) {
+  std::string fields;
+  for (const auto& [name, share] : split.shares) {
+    absl::StrAppendFormat(&fields, " %s_%s=%.1f", prefix, name, share);
+  }
+  return fields;
+}
+
+struct Measured {
+  double sps = 0.0;
+  TimeSplit learner, actors;
+};
+
+// Runs `run` as a child `vantage train` and reads its throughput and time
+// splits; nullopt (with the reason on stderr) if it failed.
+std::optional<Measured> TimeRun(const TrainBenchRun& run) {
+  std::error_code error;
+  const std::string run_dir =
+      absl::StrCat(std::filesystem::temp_directory_path().string(),
+                   "/vantage-bench-train-", ::getpid());
+  std::filesystem::remove_all(run_dir, error);
+  // The run's own output (its RESULT line among it) is not the bench's.
+  const std::string log = run_dir + ".log";
+  std::filesystem::remove(log, error);
+  absl::StatusOr<pid_t> train =
+      SpawnSelf({"train", "--config=" + run.config_path, "--run_dir=" + run_dir,
+                 "--checkpoint_every=1000000"},
+                log);
+  if (!train.ok()) return std::nullopt;
+  int status = 0;
+  waitpid(*train, &status, 0);
+  const std::vector<ProgressPoint> points =
+      ReadProgress(run_dir + "/progress.csv");
+  std::filesystem::remove_all(run_dir, error);
+  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0 || points.size() < 4) {
+    std::fprintf(stderr,
+                 "vantage bench train: the run failed or made fewer than 4 "
+                 "updates (%zu; its output is in %s); give it more --steps\n",
+                 points.size(), log.c_str());
+    return std::nullopt;
+  }
+  Measured measured;
+  // Start-up (process launch, the first batch's acting) is not throughput.
+  const ProgressPoint& first = points[1];
+  const ProgressPoint& last = points.back();
+  measured.sps =
+      (last.env_steps - first.env_steps) / (last.elapsed - first.elapsed);
+  measured.learner = ReadTimeSplit(log, /*learner=*/true);
+  measured.actors = ReadTimeSplit(log, /*learner=*/false);
+  std::filesystem::remove(log, error);
+  return measured;
+}
+
 }  // namespace
 
 int RunTrainBenchmark(const TrainBenchConfig& config) {
@@ -114,42 +223,37 @@ int RunTrainBenchmark(const TrainBenchConfig& config) {
       config.env.c_str(), *raw, bare, config.shape.epochs, cores, limit);
   std::fflush(stdout);
 
-  std::error_code error;
-  const std::string run_dir =
-      absl::StrCat(std::filesystem::temp_directory_path().string(),
-                   "/vantage-bench-train-", ::getpid());
-  std::filesystem::remove_all(run_dir, error);
-  // The run's own output (its RESULT line among it) is not the bench's.
-  const std::string log = run_dir + ".log";
-  absl::StatusOr<pid_t> train =
-      SpawnSelf({"train", "--config=" + config.config_path,
-                 "--run_dir=" + run_dir, "--checkpoint_every=1000000"},
-                log);
-  if (!train.ok()) return 1;
-  int status = 0;
-  waitpid(*train, &status, 0);
-  const std::vector<ProgressPoint> points =
-      ReadProgress(run_dir + "/progress.csv");
-  std::filesystem::remove_all(run_dir, error);
-  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0 || points.size() < 4) {
-    std::fprintf(stderr,
-                 "vantage bench train: the run failed or made fewer than 4 "
-                 "updates (%zu; its output is in %s); give it more --steps\n",
-                 points.size(), log.c_str());
-    return 1;
+  for (const TrainBenchRun& run : config.runs) {
+    const std::optional<Measured> measured = TimeRun(run);
+    if (!measured.has_value()) return 1;
+    const char* mode = run.sync ? "sync" : "async";
+    for (const auto& [who, split] : {std::pair<const char*, const TimeSplit*>{
+                                         "learner", &measured->learner},
+                                     std::pair<const char*, const TimeSplit*>{
+                                         "actor", &measured->actors}}) {
+      std::string shares;
+      for (const auto& [name, share] : split->shares) {
+        absl::StrAppendFormat(&shares, "%s%s %.1f%%",
+                              shares.empty() ? "" : ", ", name, share);
+      }
+      std::printf(
+          "train: %s (max_policy_lag %ld): %s time split (mean of %d): "
+          "%s\n",
+          mode, static_cast<long>(run.max_policy_lag), who, split->processes,
+          shares.c_str());
+    }
+    std::printf(
+        "RESULT train env=%s learners=%d actors=%d envs_per_actor=%d sync=%d "
+        "max_policy_lag=%ld sps=%.0f limit_sps=%.0f ratio=%.3f "
+        "raw_steps_per_s=%.0f bare_samples_per_s=%.0f cores=%d%s%s\n",
+        config.env.c_str(), config.learners, config.actors,
+        config.envs_per_actor, run.sync ? 1 : 0,
+        static_cast<long>(run.max_policy_lag), measured->sps, limit,
+        measured->sps / limit, *raw, bare, cores,
+        SplitFields(measured->learner, "learner").c_str(),
+        SplitFields(measured->actors, "actor").c_str());
+    std::fflush(stdout);
   }
-  std::filesystem::remove(log, error);
-  // Start-up (process launch, the first batch's acting) is not throughput.
-  const ProgressPoint& first = points[1];
-  const ProgressPoint& last = points.back();
-  const double sps =
-      (last.env_steps - first.env_steps) / (last.elapsed - first.elapsed);
-  std::printf(
-      "RESULT train env=%s learners=%d actors=%d envs_per_actor=%d sync=%d "
-      "sps=%.0f limit_sps=%.0f ratio=%.3f raw_steps_per_s=%.0f "
-      "bare_samples_per_s=%.0f cores=%d\n",
-      config.env.c_str(), config.learners, config.actors, config.envs_per_actor,
-      config.sync ? 1 : 0, sps, limit, sps / limit, *raw, bare, cores);
   return 0;
 }
 

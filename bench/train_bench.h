@@ -3,19 +3,28 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "bench/bare_ppo.h"
 
 namespace vantage {
 
-// A PPO run of `vantage train` to time end to end.
+// One configuration of the run to time: its resolved run config (a
+// --config file) and how it acts.
+struct TrainBenchRun {
+  std::string config_path;
+  bool sync = true;
+  int64_t max_policy_lag = 0;
+};
+
+// PPO runs of `vantage train` to time end to end, one per configuration,
+// all of the same env, shapes and batch.
 struct TrainBenchConfig {
-  std::string config_path;  // the resolved run config (a --config file)
+  std::vector<TrainBenchRun> runs;
   std::string env;
   int learners = 1;
   int actors = 1;
   int envs_per_actor = 1;
-  bool sync = true;
   int64_t batch = 0;   // env steps per update, all learners together
   BarePpoShape shape;  // the run's network and PPO epochs/minibatches
 };
@@ -23,12 +32,14 @@ struct TrainBenchConfig {
 // `vantage bench train`: in one run, measures this machine's raw physics
 // steps/s of the env (one core) and the bare LibTorch PPO update's
 // samples/s (one core, the run's shapes), then runs the distributed main
-// job (`vantage train`, a child process) and compares its steady-state env
-// steps/s (the first two updates, start-up, excluded) with the machine's
-// limit cores / (1/raw + epochs/bare): every env step costs its physics
-// and `epochs` sample passes of the update, and nothing else is free.
-// Ends with `RESULT train env=.. learners=.. actors=.. sps=.. limit_sps=..
-// ratio=..`.
+// job (`vantage train`, a child process) in each configuration and
+// compares its steady-state env steps/s (the first two updates, start-up,
+// excluded) with the machine's limit cores / (1/raw + epochs/bare): every
+// env step costs its physics and `epochs` sample passes of the update, and
+// nothing else is free. Each configuration ends with `RESULT train env=..
+// sync=.. max_policy_lag=.. sps=.. limit_sps=.. ratio=..` and the time
+// splits the run's learners and actors printed when they stopped (mean
+// shares in percent: learner_advantages=.., actor_physics=.., ...).
 int RunTrainBenchmark(const TrainBenchConfig& config);
 
 }  // namespace vantage

@@ -11,6 +11,7 @@
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "common/net/port_file.h"
+#include "common/util/phase_times.h"
 #include "deploy/progress_columns.h"
 #include "deploy/training_run.h"
 #include "learner/service/actor_gateway.h"
@@ -233,7 +234,12 @@ absl::Status RunLearnerServer(
     }
     queue.Close();
   });
+  // Where the learner's time goes, printed when it stops; the rest is
+  // waiting for a batch.
+  PhaseTimes times({"advantages", "optimisation", "bookkeeping", "publish"});
   auto finish = [&](absl::Status status) {
+    std::fprintf(stderr, "learner: %s\n",
+                 times.Summary("waiting for data").c_str());
     gateway.Close();
     queue.Close();
     server->server->Shutdown(std::chrono::system_clock::now() +
@@ -265,6 +271,14 @@ absl::Status RunLearnerServer(
         std::chrono::duration<double>(std::chrono::steady_clock::now() -
                                       publish_start)
             .count();
+    // Bookkeeping: the update's statistics and checks. Waiting is the rest:
+    // for a batch, and writing checkpoints.
+    const UpdateStats& update = row->stats;
+    times.Add(0, update.advantage_seconds);
+    times.Add(1, update.optimisation_seconds);
+    times.Add(2, update.update_seconds - update.advantage_seconds -
+                     update.optimisation_seconds);
+    times.Add(3, publish_seconds);
     {
       std::lock_guard<std::mutex> lock(expired_mutex);
       for (int64_t actor_id : expired) learner.ForgetActor(actor_id);

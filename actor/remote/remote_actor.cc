@@ -14,6 +14,7 @@
 #include "actor/remote/actor_metrics.h"
 #include "common/net/grpc_security.h"
 #include "common/net/port_file.h"
+#include "common/util/phase_times.h"
 #include "proto/vantage.grpc.pb.h"
 #include "proto/wire_format.h"
 
@@ -33,11 +34,17 @@ bool IsRefusal(const absl::Status& status) {
          absl::IsPermissionDenied(status);
 }
 
+// The phases of the actor's time split.
+constexpr size_t kInferencePhase = 0;
+constexpr size_t kPhysicsPhase = 1;
+constexpr size_t kSendPhase = 2;
+
 // Segments onto an open client stream.
 class StreamSink : public SegmentSink {
  public:
-  StreamSink(grpc::ClientWriter<pb::Segment>& writer, ActorMetrics* metrics)
-      : writer_(writer), metrics_(metrics) {}
+  StreamSink(grpc::ClientWriter<pb::Segment>& writer, ActorMetrics* metrics,
+             PhaseTimes& times)
+      : writer_(writer), metrics_(metrics), times_(times) {}
   absl::Status Send(Segment segment) override {
     const auto start = std::chrono::steady_clock::now();
     pb::Segment proto;
@@ -45,11 +52,13 @@ class StreamSink : public SegmentSink {
     if (!writer_.Write(proto)) {
       return absl::UnavailableError("the learner closed the segment stream");
     }
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
+            .count();
+    times_.Add(kSendPhase, seconds);
     if (metrics_ != nullptr) {
       metrics_->AddSegmentsSent(1);
-      metrics_->AddSendSeconds(std::chrono::duration<double>(
-                                   std::chrono::steady_clock::now() - start)
-                                   .count());
+      metrics_->AddSendSeconds(seconds);
     }
     return absl::OkStatus();
   }
@@ -57,6 +66,7 @@ class StreamSink : public SegmentSink {
  private:
   grpc::ClientWriter<pb::Segment>& writer_;
   ActorMetrics* metrics_;
+  PhaseTimes& times_;
 };
 
 // The newest weights a subscription delivered.
@@ -84,10 +94,12 @@ class WeightsSlot {
 class Session {
  public:
   Session(const RemoteActorConfig& config,
-          std::shared_ptr<grpc::Channel> channel, ActorMetrics* metrics)
+          std::shared_ptr<grpc::Channel> channel, ActorMetrics* metrics,
+          PhaseTimes& times)
       : config_(config),
         stub_(pb::Learner::NewStub(channel)),
-        metrics_(metrics) {}
+        metrics_(metrics),
+        times_(times) {}
 
   // Registers, then acts and streams until an error or `stop`.
   // `progressed` tells whether the learner accepted us at all.
@@ -166,7 +178,7 @@ class Session {
     pb::SegmentAck ack;
     std::unique_ptr<grpc::ClientWriter<pb::Segment>> writer =
         stub_->StreamSegments(&stream_context, &ack);
-    StreamSink sink(*writer, metrics_);
+    StreamSink sink(*writer, metrics_, times_);
     // Pacing: horizon h (counted from this registration) may start once
     // the learner has published h - ahead versions since then. A sync run
     // (ahead 0) acts one horizon per version, exactly on-policy; an async
@@ -211,11 +223,14 @@ class Session {
       const double env_before = actor->env_seconds();
       status = actor->CollectSegments(sink);
       ++rounds;
+      const double inference = actor->inference_seconds() - inference_before;
+      const double physics = actor->env_seconds() - env_before;
+      times_.Add(kInferencePhase, inference);
+      times_.Add(kPhysicsPhase, physics);
       if (metrics_ != nullptr) {
         metrics_->RecordEnvSteps(actor->env_steps());
-        metrics_->AddInferenceSeconds(actor->inference_seconds() -
-                                      inference_before);
-        metrics_->AddEnvSeconds(actor->env_seconds() - env_before);
+        metrics_->AddInferenceSeconds(inference);
+        metrics_->AddEnvSeconds(physics);
         metrics_->SetPolicyVersion(actor->policy_version());
       }
     }
@@ -237,6 +252,23 @@ class Session {
   const RemoteActorConfig& config_;
   std::unique_ptr<pb::Learner::Stub> stub_;
   ActorMetrics* metrics_;
+  PhaseTimes& times_;
+};
+
+// Prints the actor's time split when it stops, however it stops.
+class TimeSplitReport {
+ public:
+  explicit TimeSplitReport(const std::string& name)
+      : name_(name), times_({"inference", "physics", "send"}) {}
+  ~TimeSplitReport() {
+    std::fprintf(stderr, "%s: %s\n", name_.c_str(),
+                 times_.Summary("waiting").c_str());
+  }
+  PhaseTimes& times() { return times_; }
+
+ private:
+  std::string name_;
+  PhaseTimes times_;
 };
 
 }  // namespace
@@ -269,13 +301,14 @@ absl::Status RunRemoteActor(const RemoteActorConfig& config,
       }
     }
   }
+  TimeSplitReport report(config.name);
   std::unique_ptr<ActorCore> actor;  // kept across reconnects
   int failures = 0;
   absl::Duration backoff = config.initial_backoff;
   while (!stop) {
     const std::shared_ptr<grpc::Channel> channel =
         grpc::CreateCustomChannel(config.learner, *credentials, arguments);
-    Session session(config, channel, metrics.get());
+    Session session(config, channel, metrics.get(), report.times());
     bool progressed = false;
     const absl::Status status = session.Run(spec, actor, stop, progressed);
     if (stop) break;

@@ -9,6 +9,7 @@
 #include <functional>
 #include <map>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "absl/flags/flag.h"
@@ -70,40 +71,58 @@ int RunTrainBench() {
     return Usage("train: times the distributed main job (no --mode=local)");
   }
   request->flags.set_mode("distributed");
-  absl::StatusOr<ResolvedRun> run = ResolveRunRequest(*request);
-  if (!run.ok()) return Usage(std::string(run.status().message()).c_str());
-  const pb::RunConfig& config = run->config;
-  if (AlgorithmNameOf(config) != "ppo") {
-    return Usage("train: the limit counts PPO's epochs; use --algo=ppo");
-  }
-  absl::StatusOr<std::unique_ptr<Environment>> env =
-      MakeEnvironment(config.training().env(), EnvOptionsOf(config));
-  if (!env.ok()) return Usage(std::string(env.status().message()).c_str());
+  // Both ways the main job can act unless told one: synchronous, and
+  // asynchronous with a policy lag of one version.
+  std::vector<std::pair<bool, int64_t>> modes = {{true, 0}, {false, 1}};
+  const pb::DistributedSettings& given = request->flags.distributed();
+  if (given.has_sync() || given.has_max_policy_lag()) modes.resize(1);
   TrainBenchConfig bench;
-  bench.config_path =
-      absl::StrCat(std::filesystem::temp_directory_path().string(),
-                   "/vantage-bench-train-", ::getpid(), ".json");
-  {
-    std::ofstream file(bench.config_path, std::ios::trunc);
-    file << RunConfigToJson(config);
-    if (!file.flush()) return Usage("train: cannot write its run config");
+  for (const auto& [sync, lag] : modes) {
+    RunRequest mode_request = *request;
+    pb::DistributedSettings& d = *mode_request.flags.mutable_distributed();
+    if (!given.has_sync() && !given.has_max_policy_lag()) {
+      d.set_sync(sync);
+      d.set_max_policy_lag(lag);
+    }
+    absl::StatusOr<ResolvedRun> run = ResolveRunRequest(mode_request);
+    if (!run.ok()) return Usage(std::string(run.status().message()).c_str());
+    const pb::RunConfig& config = run->config;
+    if (AlgorithmNameOf(config) != "ppo") {
+      return Usage("train: the limit counts PPO's epochs; use --algo=ppo");
+    }
+    absl::StatusOr<std::unique_ptr<Environment>> env =
+        MakeEnvironment(config.training().env(), EnvOptionsOf(config));
+    if (!env.ok()) return Usage(std::string(env.status().message()).c_str());
+    TrainBenchRun timed;
+    timed.config_path = absl::StrCat(
+        std::filesystem::temp_directory_path().string(),
+        "/vantage-bench-train-", ::getpid(), "-", bench.runs.size(), ".json");
+    timed.sync = config.distributed().sync();
+    timed.max_policy_lag = config.distributed().max_policy_lag();
+    {
+      std::ofstream file(timed.config_path, std::ios::trunc);
+      file << RunConfigToJson(config);
+      if (!file.flush()) return Usage("train: cannot write its run config");
+    }
+    bench.runs.push_back(timed);
+    const pb::DistributedSettings& resolved = config.distributed();
+    bench.env = config.training().env();
+    bench.learners = resolved.learners();
+    bench.actors = resolved.actors();
+    bench.envs_per_actor = resolved.envs_per_actor();
+    bench.batch = config.training().horizon() * config.training().envs();
+    bench.shape.observations = (*env)->spec().observation_size;
+    bench.shape.actions = (*env)->spec().action_size;
+    bench.shape.hidden.assign(config.training().hidden().begin(),
+                              config.training().hidden().end());
+    bench.shape.epochs = config.ppo().epochs();
+    bench.shape.minibatches = config.ppo().minibatches();
   }
-  const pb::DistributedSettings& d = config.distributed();
-  bench.env = config.training().env();
-  bench.learners = d.learners();
-  bench.actors = d.actors();
-  bench.envs_per_actor = d.envs_per_actor();
-  bench.sync = d.sync();
-  bench.batch = config.training().horizon() * config.training().envs();
-  bench.shape.observations = (*env)->spec().observation_size;
-  bench.shape.actions = (*env)->spec().action_size;
-  bench.shape.hidden.assign(config.training().hidden().begin(),
-                            config.training().hidden().end());
-  bench.shape.epochs = config.ppo().epochs();
-  bench.shape.minibatches = config.ppo().minibatches();
   const int code = RunTrainBenchmark(bench);
   std::error_code error;
-  std::filesystem::remove(bench.config_path, error);
+  for (const TrainBenchRun& run : bench.runs) {
+    std::filesystem::remove(run.config_path, error);
+  }
   return code;
 }
 

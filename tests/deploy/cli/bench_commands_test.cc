@@ -4,6 +4,7 @@
 #include <cstdlib>
 #include <map>
 #include <string>
+#include <vector>
 
 #include "absl/strings/match.h"
 #include "absl/strings/numbers.h"
@@ -107,21 +108,48 @@ TEST(BenchCommandsTest, TrainTimesTheMainJobAgainstTheMachinesLimit) {
       "bench train --env=InvertedPendulum --steps=10240 --horizon=512 "
       "--learners=2");
   ASSERT_EQ(outcome.exit_code, 0) << outcome.err;
-  const auto fields = ResultFields(outcome.out, "RESULT train ");
-  EXPECT_EQ(fields.at("env"), "InvertedPendulum");
-  EXPECT_EQ(fields.at("learners"), "2");
-  EXPECT_EQ(fields.at("actors"), "2");
-  const double raw = Number(fields, "raw_steps_per_s");
-  const double bare = Number(fields, "bare_samples_per_s");
-  const double cores = Number(fields, "cores");
-  ASSERT_GT(raw, 0);
-  ASSERT_GT(bare, 0);
-  ASSERT_GE(cores, 1);
-  const double limit = Number(fields, "limit_sps");
-  EXPECT_NEAR(limit, cores / (1 / raw + 10 / bare), 0.01 * limit + 1);
-  EXPECT_GT(Number(fields, "sps"), 0);
-  EXPECT_NEAR(Number(fields, "ratio"), Number(fields, "sps") / limit, 0.002);
-  // Only the benchmark's RESULT line: the run's own went to its log.
+  // One RESULT line per configuration: sync, then async with lag 1.
+  std::vector<std::map<std::string, std::string>> results;
+  for (absl::string_view line : absl::StrSplit(outcome.out, '\n')) {
+    if (absl::StartsWith(line, "RESULT train ")) {
+      results.push_back(ResultFields(std::string(line), "RESULT train "));
+    }
+  }
+  ASSERT_EQ(results.size(), 2u) << outcome.out;
+  EXPECT_EQ(results[0].at("sync"), "1");
+  EXPECT_EQ(results[0].at("max_policy_lag"), "0");
+  EXPECT_EQ(results[1].at("sync"), "0");
+  EXPECT_EQ(results[1].at("max_policy_lag"), "1");
+  for (const auto& fields : results) {
+    EXPECT_EQ(fields.at("env"), "InvertedPendulum");
+    EXPECT_EQ(fields.at("learners"), "2");
+    EXPECT_EQ(fields.at("actors"), "2");
+    const double raw = Number(fields, "raw_steps_per_s");
+    const double bare = Number(fields, "bare_samples_per_s");
+    const double cores = Number(fields, "cores");
+    ASSERT_GT(raw, 0);
+    ASSERT_GT(bare, 0);
+    ASSERT_GE(cores, 1);
+    const double limit = Number(fields, "limit_sps");
+    EXPECT_NEAR(limit, cores / (1 / raw + 10 / bare), 0.01 * limit + 1);
+    EXPECT_GT(Number(fields, "sps"), 0);
+    EXPECT_NEAR(Number(fields, "ratio"), Number(fields, "sps") / limit, 0.002);
+    // The time splits the learners and actors printed: shares of their
+    // wall time that add up to all of it.
+    double learner = 0.0, actor = 0.0;
+    for (const char* phase : {"advantages", "optimisation", "bookkeeping",
+                              "publish", "waiting_for_data"}) {
+      learner += Number(fields, std::string("learner_") + phase);
+    }
+    for (const char* phase : {"inference", "physics", "send", "waiting"}) {
+      actor += Number(fields, std::string("actor_") + phase);
+    }
+    EXPECT_NEAR(learner, 100.0, 0.5);
+    EXPECT_NEAR(actor, 100.0, 0.5);
+    EXPECT_GT(Number(fields, "learner_optimisation"), 0.0);
+    EXPECT_GT(Number(fields, "actor_physics"), 0.0);
+  }
+  // Only the benchmark's RESULT lines: the run's own went to its log.
   EXPECT_THAT(outcome.out, Not(HasSubstr("mean_return=")));
 }
 
@@ -132,6 +160,11 @@ TEST(BenchCommandsTest, TrainRefusesWhatItCannotTime) {
   const Outcome trpo = RunVantage("bench train --algo=trpo");
   EXPECT_EQ(trpo.exit_code, 2);
   EXPECT_THAT(trpo.err, HasSubstr("--algo=ppo"));
+  const Outcome lagged_sync =
+      RunVantage("bench train --sync --max_policy_lag=1");
+  EXPECT_EQ(lagged_sync.exit_code, 2);
+  EXPECT_THAT(lagged_sync.err, HasSubstr("--max_policy_lag"));
+  EXPECT_THAT(lagged_sync.err, HasSubstr("--sync"));
 }
 
 // A real learner process with connected actors against its idle self: each
