@@ -262,10 +262,15 @@ absl::StatusOr<UpdateStats> LearnerCore::Update(std::vector<Rollout> rollouts) {
       return advantages.status();
     }
 
-    const UpdateBatch update =
+    UpdateBatch update =
         MakeUpdateBatch(*batch, *advantages, [&](const at::Tensor& raw) {
           return ObservationsForNetwork(config_.spec, normalizer_, raw, clip);
         });
+    for (const Rollout& rollout : rollouts) {
+      if (rollout.policy_versions.min().item<int64_t>() < version_) {
+        update.lagged = true;
+      }
+    }
     const int64_t samples = update.horizon * update.streams;
     const double progress =
         static_cast<double>(env_steps_) / config_.total_env_steps;

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <utility>
 
 #include "absl/strings/str_cat.h"
@@ -238,7 +239,12 @@ void FlatActorCritic::CategoricalHead(const float* actions, int64_t rows) {
     }
     entropies[r] = entropy;
     entropy_sum += entropy;
-    log_probs_[r] = log_p[r * n + static_cast<int64_t>(actions[r])];
+    // Ingest refuses such actions; should one slip through, the update's
+    // loss turns non-finite and the learner's guard undoes it.
+    const int64_t action = static_cast<int64_t>(actions[r]);
+    log_probs_[r] = action >= 0 && action < n
+                        ? log_p[r * n + action]
+                        : std::numeric_limits<float>::quiet_NaN();
   }
   mean_entropy_ = entropy_sum / static_cast<double>(std::max<int64_t>(rows, 1));
 }

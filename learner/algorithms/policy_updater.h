@@ -28,6 +28,9 @@ struct UpdateBatch {
   at::Tensor behaviour_log_probs;  // [T*N] of the policy that acted
   at::Tensor advantages;           // [T*N] rho-mixed: the policy's
   at::Tensor returns;              // [T*N] V + GAE: the critic's
+  // Some steps were acted by an older version than the one updating (an
+  // asynchronous run's lag).
+  bool lagged = false;
 };
 
 class PolicyUpdater {

@@ -84,12 +84,26 @@ AlgorithmStats PpoUpdater::Update(const UpdateBatch& batch, double progress,
                                   std::mt19937_64& rng) {
   SetLearningRate(*optimizer_,
                   config_.learning_rate * std::max(0.0, 1.0 - progress));
-  return flat_.has_value() ? FlatUpdate(batch, rng)
-                           : AutogradUpdate(batch, rng);
+  const Decoupled decoupled = Decouple(batch);
+  return flat_.has_value() ? FlatUpdate(decoupled, rng)
+                           : AutogradUpdate(decoupled, rng);
 }
 
-AlgorithmStats PpoUpdater::FlatUpdate(const UpdateBatch& batch,
+PpoUpdater::Decoupled PpoUpdater::Decouple(const UpdateBatch& batch) {
+  Decoupled out{batch, at::Tensor()};
+  if (!batch.lagged) return out;
+  at::NoGradGuard no_grad;
+  const at::Tensor proximal =
+      policy_->LogProb(policy_->forward(batch.observations), batch.actions);
+  out.weights =
+      at::exp(proximal - batch.behaviour_log_probs.to(proximal.dtype()));
+  out.batch.behaviour_log_probs = proximal;
+  return out;
+}
+
+AlgorithmStats PpoUpdater::FlatUpdate(const Decoupled& decoupled,
                                       std::mt19937_64& rng) {
+  const UpdateBatch& batch = decoupled.batch;
   FlatActorCritic& net = *flat_;
   // The modules may have been rolled back or loaded since the last update.
   net.Pull();
@@ -100,6 +114,9 @@ AlgorithmStats PpoUpdater::FlatUpdate(const UpdateBatch& batch,
   const at::Tensor behaviour = FloatRows(batch.behaviour_log_probs, size);
   const at::Tensor advantages = FloatRows(batch.advantages, size);
   const at::Tensor returns = FloatRows(batch.returns, size);
+  const at::Tensor weights = decoupled.weights.defined()
+                                 ? FloatRows(decoupled.weights, size)
+                                 : at::Tensor();
   const int64_t observation_size = inputs.size(1);
   const int64_t action_width = actions.size(1);
   d_log_probs_.resize(minibatch);
@@ -134,6 +151,10 @@ AlgorithmStats PpoUpdater::FlatUpdate(const UpdateBatch& batch,
       GatherRows(returns.data_ptr<float>(), 1, index, minibatch, returns_);
       if (normalizer.has_value()) {
         normalizer->NormalizeInPlace(part, advantages_.data(), minibatch);
+      }
+      if (weights.defined()) {
+        GatherRows(weights.data_ptr<float>(), 1, index, minibatch, weights_);
+        for (int64_t i = 0; i < minibatch; ++i) advantages_[i] *= weights_[i];
       }
       net.Forward(inputs_.data(), actions_.data(), minibatch);
       const float* log_probs = net.log_probs();
@@ -177,8 +198,9 @@ AlgorithmStats PpoUpdater::FlatUpdate(const UpdateBatch& batch,
   return stats.Mean();
 }
 
-AlgorithmStats PpoUpdater::AutogradUpdate(const UpdateBatch& batch,
+AlgorithmStats PpoUpdater::AutogradUpdate(const Decoupled& decoupled,
                                           std::mt19937_64& rng) {
+  const UpdateBatch& batch = decoupled.batch;
   const int64_t size = batch.observations.size(0);
   const int64_t minibatch = std::max<int64_t>(1, size / config_.minibatches);
   std::vector<int64_t> order(size);
@@ -197,6 +219,9 @@ AlgorithmStats PpoUpdater::AutogradUpdate(const UpdateBatch& batch,
       const at::Tensor obs = batch.observations.index_select(0, index);
       at::Tensor adv = batch.advantages.index_select(0, index);
       if (normalizer.has_value()) adv = normalizer->Normalize(part, adv);
+      if (decoupled.weights.defined()) {
+        adv = adv * decoupled.weights.index_select(0, index);
+      }
       const at::Tensor output = policy_->forward(obs);
       const at::Tensor log_prob =
           policy_->LogProb(output, batch.actions.index_select(0, index));

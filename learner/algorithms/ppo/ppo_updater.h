@@ -21,8 +21,13 @@ namespace vantage {
 
 // PPO: `epochs` passes of shuffled minibatches, one Adam (eps 1e-5) over
 // the policy and value parameters, the gradient norm clipped. The ratio's
-// denominator is the behaviour log-probability carried with the segment.
-// MLP networks train through FlatActorCritic and FlatAdam (the same
+// denominator is the behaviour log-probability carried with the segment;
+// for a lagged batch, PPO's decoupled objective (Hilton, Cobbe & Schulman
+// 2021, "Batch size-invariance for policy optimization"): the ratio and its
+// clipping against the policy as the update starts (the proximal policy),
+// each advantage weighted by proximal / behaviour probability, so that a
+// batch one version old gets the trust region a fresh one gets. MLP
+// networks train through FlatActorCritic and FlatAdam (the same
 // update without autograd, several times faster); convolutional ones, or
 // every network when `autograd_only`, through LibTorch's autograd.
 class PpoUpdater : public PolicyUpdater {
@@ -44,8 +49,16 @@ class PpoUpdater : public PolicyUpdater {
   bool flat() const { return flat_.has_value(); }
 
  private:
-  AlgorithmStats AutogradUpdate(const UpdateBatch& batch, std::mt19937_64& rng);
-  AlgorithmStats FlatUpdate(const UpdateBatch& batch, std::mt19937_64& rng);
+  // The batch with the proximal policy's log-probabilities as the ratio's
+  // denominator and the advantages' importance weights (proximal over
+  // behaviour probability); `batch` itself if it is not lagged.
+  struct Decoupled {
+    UpdateBatch batch;
+    at::Tensor weights;  // [T*N], undefined when not lagged
+  };
+  Decoupled Decouple(const UpdateBatch& batch);
+  AlgorithmStats AutogradUpdate(const Decoupled& batch, std::mt19937_64& rng);
+  AlgorithmStats FlatUpdate(const Decoupled& batch, std::mt19937_64& rng);
 
   PolicyNetwork policy_;
   ValueNetwork value_;
@@ -57,7 +70,7 @@ class PpoUpdater : public PolicyUpdater {
   std::optional<FlatAdam> flat_adam_;
   // Scratch of FlatUpdate: one minibatch's rows.
   std::vector<float> inputs_, actions_, behaviour_, advantages_, returns_,
-      d_log_probs_, d_values_;
+      weights_, d_log_probs_, d_values_;
 };
 
 }  // namespace vantage
