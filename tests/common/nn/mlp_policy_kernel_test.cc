@@ -12,24 +12,12 @@
 #include "common/nn/networks.h"
 #include "common/nn/running_mean_std.h"
 #include "gtest/gtest.h"
+#include "tests/fakes/vector_spec.h"
 
 namespace vantage {
 namespace {
 
 constexpr double kClip = 5.0;
-
-EnvSpec VectorSpec(bool discrete, int64_t observations, int64_t actions) {
-  EnvSpec spec;
-  spec.name = "test";
-  spec.observation_size = observations;
-  spec.discrete = discrete;
-  spec.action_size = actions;
-  if (!discrete) {
-    spec.action_low.assign(actions, -1.0);
-    spec.action_high.assign(actions, 1.0);
-  }
-  return spec;
-}
 
 // Random weights of the scale the initialisation gives hidden layers,
 // 1 / sqrt(inputs) per weight (the output layer too, whose initial gain of

@@ -11,22 +11,10 @@
 #include "common/nn/networks.h"
 #include "gtest/gtest.h"
 #include "learner/algorithms/flat_adam.h"
+#include "tests/fakes/vector_spec.h"
 
 namespace vantage {
 namespace {
-
-EnvSpec VectorSpec(bool discrete, int64_t observations, int64_t actions) {
-  EnvSpec spec;
-  spec.name = "test";
-  spec.observation_size = observations;
-  spec.discrete = discrete;
-  spec.action_size = actions;
-  if (!discrete) {
-    spec.action_low.assign(actions, -1.0);
-    spec.action_high.assign(actions, 1.0);
-  }
-  return spec;
-}
 
 // Weights of the scale hidden layers start with (1 / sqrt(inputs)), for
 // every layer, so that the outputs and the log-std are far from their

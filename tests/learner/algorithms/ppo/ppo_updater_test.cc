@@ -12,21 +12,13 @@
 #include <vector>
 
 #include "gtest/gtest.h"
+#include "tests/fakes/vector_spec.h"
 
 namespace vantage {
 namespace {
 
 EnvSpec Spec(bool discrete) {
-  EnvSpec spec;
-  spec.name = "test";
-  spec.observation_size = 17;
-  spec.discrete = discrete;
-  spec.action_size = discrete ? 5 : 6;
-  if (!discrete) {
-    spec.action_low.assign(6, -1.0);
-    spec.action_high.assign(6, 1.0);
-  }
-  return spec;
+  return VectorSpec(discrete, 17, discrete ? 5 : 6);
 }
 
 struct Networks {
