@@ -358,9 +358,12 @@ TEST_F(AdversarialTest, EpisodeFloodsAndScalarTensorsAreRefused) {
   flood.mutable_episode_lengths()->Resize(12600000, 1);
   status = Stream(attacker.session, {flood});
   EXPECT_NE(status.error_code(), grpc::StatusCode::OK);
-  pb::Segment scalar = HonestSegment(attacker.actor_id, attacker.version, 0);
+  // Sending the flood can outlast the registration's 2 s expiry on a busy
+  // machine: the next refusal is asked of a fresh registration.
+  const Registered again = RegisterAttacker();
+  pb::Segment scalar = HonestSegment(again.actor_id, again.version, 0);
   *scalar.mutable_rewards() = FloatTensor({}, 1.0f);
-  status = Stream(attacker.session, {scalar});
+  status = Stream(again.session, {scalar});
   EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
   EXPECT_THAT(status.error_message(), HasSubstr("0 steps"));
   ExpectTrainingGoesOn();
