@@ -1,7 +1,6 @@
 #include "bench/advantage_bench.h"
 
 #include <ATen/ATen.h>
-#include <ATen/Parallel.h>
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
@@ -16,6 +15,7 @@
 #include "common/advantage/advantage.h"
 #include "common/advantage/advantage_config.h"
 #include "common/advantage/estimator_kernels_isa.h"
+#include "common/nn/compute_threads.h"
 
 namespace vantage {
 namespace {
@@ -44,7 +44,7 @@ std::vector<int64_t> PowersOfTwo(int count) {
 
 int RunAdvantageBenchmark(int64_t steps, int64_t streams) {
   // Every timed call is single-threaded, as in the learner's estimator.
-  at::set_num_threads(1);
+  SetComputeThreads(1);
   const AdvantageInputs inputs = RandomRollout(steps, streams);
   const double gamma = 0.99;
   const double lambda = 0.95;

@@ -1,7 +1,6 @@
 #include "bench/learner_bench.h"
 
 #include <ATen/ATen.h>
-#include <ATen/Parallel.h>
 #include <benchmark/benchmark.h>
 #include <sys/wait.h>
 
@@ -18,6 +17,7 @@
 #include "bench/blas_library.h"
 #include "bench/fastest.h"
 #include "common/net/loopback_port.h"
+#include "common/nn/compute_threads.h"
 #include "common/util/self_process.h"
 #include "learner/algorithms/ppo/ppo_updater.h"
 #include "learner/parallel/gloo_replica_group.h"
@@ -154,7 +154,7 @@ absl::StatusOr<DataParallelFigures> MeasureTwoReplicas(
 }  // namespace
 
 int RunLearnerBenchmarkReplica(const std::string& rendezvous) {
-  at::set_num_threads(1);
+  SetComputeThreads(1);
   at::manual_seed(0);
   const UpdateBatch batch = SyntheticBatch();
   RunReplica(1, rendezvous, batch);
@@ -162,7 +162,7 @@ int RunLearnerBenchmarkReplica(const std::string& rendezvous) {
 }
 
 int RunLearnerBenchmark() {
-  at::set_num_threads(1);
+  SetComputeThreads(1);
   at::manual_seed(0);
   const UpdateBatch batch = SyntheticBatch();
 

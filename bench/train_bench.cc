@@ -1,7 +1,6 @@
 #include "bench/train_bench.h"
 
 #include <ATen/ATen.h>
-#include <ATen/Parallel.h>
 #include <sys/wait.h>
 
 #include <algorithm>
@@ -25,6 +24,7 @@
 #include "absl/strings/strip.h"
 #include "actor/envs/env_registry.h"
 #include "bench/raw_physics.h"
+#include "common/nn/compute_threads.h"
 #include "common/util/self_process.h"
 
 namespace vantage {
@@ -205,7 +205,7 @@ std::optional<Measured> TimeRun(const TrainBenchRun& run) {
 }  // namespace
 
 int RunTrainBenchmark(const TrainBenchConfig& config) {
-  at::set_num_threads(1);
+  SetComputeThreads(1);
   const int cores =
       std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
   absl::StatusOr<double> raw = RawStepsPerSecond(config.env);

@@ -1,6 +1,5 @@
 #include "bench/transport_bench.h"
 
-#include <ATen/Parallel.h>
 #include <benchmark/benchmark.h>
 #include <grpcpp/grpcpp.h>
 #include <signal.h>
@@ -24,6 +23,7 @@
 #include "bench/fastest.h"
 #include "bench/raw_physics.h"
 #include "common/net/port_file.h"
+#include "common/nn/compute_threads.h"
 #include "common/nn/networks.h"
 #include "common/util/self_process.h"
 #include "proto/vantage.grpc.pb.h"
@@ -198,7 +198,7 @@ absl::Status StreamCopies(int port, int client, const EnvSpec& spec,
 }  // namespace
 
 int RunIngestBenchmark(int clients, double seconds) {
-  at::set_num_threads(1);
+  SetComputeThreads(1);
   absl::StatusOr<std::unique_ptr<Environment>> probe = MakeEnvironment(kEnv);
   if (!probe.ok()) return Fail("ingest", probe.status());
   const EnvSpec spec = (*probe)->spec();
@@ -382,7 +382,7 @@ int RunConnectionsBenchmark(int max_actors) {
 }
 
 int RunActorBenchmark(const std::string& env_name, int envs, double seconds) {
-  at::set_num_threads(1);
+  SetComputeThreads(1);
   absl::StatusOr<std::unique_ptr<Environment>> probe =
       MakeEnvironment(env_name);
   if (!probe.ok()) return Fail("actor", probe.status());

@@ -34,10 +34,13 @@ done
 # The mujoco CMake config calls find_dependency(OpenGL) and needs Qhull's
 # config, hence libgl-dev, libopengl-dev and libqhull-dev. libgloo-dev holds
 # the headers of the Gloo engine that LibTorch's c10d runs data-parallel
-# learners on. libopenblas0-serial takes libblas.so.3 (Debian's
+# learners on. libopenblas0-pthread takes libblas.so.3 (Debian's
 # alternatives) over from the reference BLAS that LibTorch's GEMMs would
-# otherwise run on; serial, because every vantage process computes on one
-# thread of its own and several share the machine (docs/benchmarks.md).
+# otherwise run on. The pthread build, not the serial one: Debian builds
+# the serial one without locking, so two threads of one process calling it
+# at once get wrong products (tests run two learner replicas as threads);
+# SetComputeThreads keeps the pthread build's GEMMs in the calling thread,
+# as the serial one computes (docs/benchmarks.md).
 # libblas-dev: the C interface (cblas.h) the actors' MLP policies call
 # BLAS through, linked as libblas.so.3 and so run on OpenBLAS too.
 # prometheus (with promtool) serves deploy/prometheus/watch_runs.sh;
@@ -54,7 +57,7 @@ done
 # still brings the C++ library and the linker.
 packages=(
   build-essential clang-14 cmake ninja-build ccache pkgconf openssl
-  libtorch-dev libgloo-dev libopenblas0-serial libblas-dev
+  libtorch-dev libgloo-dev libopenblas0-pthread libblas-dev
   libmujoco-dev libqhull-dev libgl-dev libopengl-dev
   libbullet-dev
   libgrpc++-dev protobuf-compiler-grpc libprotobuf-dev protobuf-compiler
