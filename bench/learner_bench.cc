@@ -19,6 +19,7 @@
 #include "common/net/loopback_port.h"
 #include "common/nn/compute_threads.h"
 #include "common/util/self_process.h"
+#include "learner/algorithms/a2c/a2c_updater.h"
 #include "learner/algorithms/ppo/ppo_updater.h"
 #include "learner/parallel/gloo_replica_group.h"
 #include "learner/update_guard.h"
@@ -192,6 +193,31 @@ int RunLearnerBenchmark() {
     }
   })->Apply([](auto* b) { UseFastestOfSingleRuns(b, kRepetitions); });
 
+  // A2C's update (defaults: 4 consecutive minibatches of 5 steps) of 16
+  // envs, on the flat path and on autograd: the same steps, which
+  // a2c_updater_test compares.
+  constexpr int64_t kA2cStreams = 16;
+  const A2cConfig a2c_config;
+  UpdateBatch a2c_batch =
+      SyntheticBatch(BenchShape(), a2c_config.horizon() * kA2cStreams);
+  a2c_batch.horizon = a2c_config.horizon();
+  a2c_batch.streams = kA2cStreams;
+  A2cUpdater a2c_flat(policy, value, a2c_config);
+  A2cUpdater a2c_autograd(policy, value, a2c_config, SoloReplicaGroup(),
+                          /*autograd_only=*/true);
+  constexpr int kA2cUpdates = 100;  // per repetition: each is ~0.1 ms
+  for (auto [name, updater] : {std::pair{"a2c_flat_update", &a2c_flat},
+                               {"a2c_autograd_update", &a2c_autograd}}) {
+    benchmark::RegisterBenchmark(name, [&, updater = updater](
+                                           benchmark::State& state) {
+      for (auto _ : state) {
+        for (int i = 0; i < kA2cUpdates; ++i) {
+          benchmark::DoNotOptimize(updater->Update(a2c_batch, progress, rng));
+        }
+      }
+    })->Apply([](auto* b) { UseFastestOfSingleRuns(b, kRepetitions); });
+  }
+
   BarePpo bare(BenchShape());
   benchmark::RegisterBenchmark("bare_update", [&](benchmark::State& state) {
     for (auto _ : state) bare.Update(batch);
@@ -208,6 +234,12 @@ int RunLearnerBenchmark() {
   const double ppo_rate = samples / collector.Seconds("ppo_update");
   const double bare_rate = samples / collector.Seconds("bare_update");
   const double guarded_rate = samples / collector.Seconds("guarded_ppo_update");
+  const double a2c_samples =
+      static_cast<double>(a2c_batch.observations.size(0)) * kA2cUpdates;
+  const double a2c_flat_rate =
+      a2c_samples / collector.Seconds("a2c_flat_update");
+  const double a2c_autograd_rate =
+      a2c_samples / collector.Seconds("a2c_autograd_update");
   absl::StatusOr<DataParallelFigures> measured = MeasureTwoReplicas(batch);
   if (!measured.ok()) {
     std::fprintf(stderr, "bench learner: %s\n",
@@ -233,10 +265,12 @@ int RunLearnerBenchmark() {
       "RESULT learner ppo_samples_per_s=%.0f bare_samples_per_s=%.0f "
       "ratio=%.3f guarded_samples_per_s=%.0f guard_ratio=%.3f "
       "two_replicas_samples_per_s=%.0f two_replicas_speedup=%.2f "
-      "allreduce_us=%.1f allreduce_share=%.3f blas=%s\n",
+      "allreduce_us=%.1f allreduce_share=%.3f a2c_flat_samples_per_s=%.0f "
+      "a2c_autograd_samples_per_s=%.0f a2c_speedup=%.2f blas=%s\n",
       ppo_rate, bare_rate, ppo_rate / bare_rate, guarded_rate,
       guarded_rate / ppo_rate, dp_rate, dp_rate / ppo_rate,
-      two.allreduce_seconds * 1e6, allreduce_share, blas.kind.c_str());
+      two.allreduce_seconds * 1e6, allreduce_share, a2c_flat_rate,
+      a2c_autograd_rate, a2c_flat_rate / a2c_autograd_rate, blas.kind.c_str());
   return 0;
 }
 

@@ -5,23 +5,14 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstring>
 #include <memory>
 #include <string>
 #include <tuple>
 #include <utility>
 
-#include "absl/strings/str_cat.h"
+#include "learner/algorithms/flat_optimizer_state.h"
 
 namespace vantage {
-namespace {
-
-// torch::optim's key for a parameter's state.
-std::string StateKey(const at::Tensor& parameter) {
-  return c10::guts::to_string(parameter.unsafeGetTensorImpl());
-}
-
-}  // namespace
 
 FlatAdam::FlatAdam(std::vector<at::Tensor> parameters,
                    std::vector<int64_t> offsets, int64_t size)
@@ -63,22 +54,17 @@ void FlatAdam::Step(const torch::optim::Adam& adam, float* parameters,
 void FlatAdam::StoreInto(torch::optim::Adam& adam) const {
   auto& state = adam.state();
   for (size_t i = 0; i < parameters_.size(); ++i) {
-    const std::string key = StateKey(parameters_[i]);
+    const std::string key = OptimizerStateKey(parameters_[i]);
     if (step_ == 0) {
       state.erase(key);
       continue;
     }
-    const int64_t n = parameters_[i].numel();
-    auto moment = [&](const std::vector<float>& flat) {
-      at::Tensor tensor = at::empty_like(parameters_[i].detach());
-      std::memcpy(tensor.data_ptr<float>(), flat.data() + offsets_[i],
-                  sizeof(float) * n);
-      return tensor;
-    };
     auto param_state = std::make_unique<torch::optim::AdamParamState>();
     param_state->step(step_);
-    param_state->exp_avg(moment(exp_avg_));
-    param_state->exp_avg_sq(moment(exp_avg_sq_));
+    param_state->exp_avg(
+        FlatStateTensor(exp_avg_, offsets_[i], parameters_[i]));
+    param_state->exp_avg_sq(
+        FlatStateTensor(exp_avg_sq_, offsets_[i], parameters_[i]));
     state[key] = std::move(param_state);
   }
 }
@@ -89,32 +75,25 @@ absl::Status FlatAdam::LoadFrom(const torch::optim::Adam& adam) {
   std::vector<float> exp_avg(exp_avg_.size(), 0.0f);
   std::vector<float> exp_avg_sq(exp_avg_sq_.size(), 0.0f);
   for (size_t i = 0; i < parameters_.size(); ++i) {
-    const auto found = state.find(StateKey(parameters_[i]));
+    const auto found = state.find(OptimizerStateKey(parameters_[i]));
     const auto* param_state =
         found == state.end() ? nullptr
                              : static_cast<const torch::optim::AdamParamState*>(
                                    found->second.get());
-    const int64_t parameter_step =
-        param_state == nullptr ? 0 : param_state->step();
-    if (step >= 0 && parameter_step != step) {
-      return absl::InvalidArgumentError(absl::StrCat(
-          "the Adam state's parameters took different numbers of steps (", step,
-          " and ", parameter_step, ")"));
+    if (absl::Status status = CheckSameStep(
+            param_state == nullptr ? 0 : param_state->step(), "Adam", step);
+        !status.ok()) {
+      return status;
     }
-    step = parameter_step;
     if (param_state == nullptr) continue;
-    const int64_t n = parameters_[i].numel();
     for (auto [source, target] :
          {std::pair{&param_state->exp_avg(), &exp_avg},
           std::pair{&param_state->exp_avg_sq(), &exp_avg_sq}}) {
-      if (!source->defined() || source->numel() != n) {
-        return absl::InvalidArgumentError(
-            absl::StrCat("the Adam state of parameter ", i,
-                         " does not fit its ", n, " values"));
+      if (absl::Status status = CopyStateToFlat(
+              *source, offsets_[i], parameters_[i].numel(), *target, "Adam", i);
+          !status.ok()) {
+        return status;
       }
-      const at::Tensor values = source->to(at::kFloat).contiguous();
-      std::memcpy(target->data() + offsets_[i], values.data_ptr<float>(),
-                  sizeof(float) * n);
     }
   }
   step_ = std::max<int64_t>(step, 0);

@@ -6,6 +6,7 @@
 #include <torch/serialize/archive.h>
 
 #include <cmath>
+#include <cstdio>
 
 #include "absl/strings/str_cat.h"
 #include "learner/archive_io.h"
@@ -52,6 +53,25 @@ double AverageAndClipFlatGradient(float* gradients, int64_t size,
     for (int64_t i = 0; i < size; ++i) gradients[i] *= coefficient;
   }
   return norm;
+}
+
+std::optional<FlatActorCritic> MakeFlatActorCritic(
+    PolicyNetworkImpl& policy, ValueNetworkImpl& value,
+    const std::vector<at::Tensor>& parameters, const char* algorithm,
+    bool autograd_only) {
+  if (autograd_only) return std::nullopt;
+  absl::StatusOr<FlatActorCritic> flat =
+      FlatActorCritic::Create(policy, value, parameters);
+  if (!flat.ok()) {
+    std::fprintf(stderr, "learner: %s updates run on autograd: %s\n", algorithm,
+                 std::string(flat.status().message()).c_str());
+    return std::nullopt;
+  }
+  return std::move(*flat);
+}
+
+at::Tensor FloatRows(const at::Tensor& values, int64_t rows) {
+  return values.detach().to(at::kFloat).contiguous().reshape({rows, -1});
 }
 
 void SetLearningRate(torch::optim::Optimizer& optimizer, double learning_rate) {

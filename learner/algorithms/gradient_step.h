@@ -5,11 +5,13 @@
 
 #include <ATen/core/Tensor.h>
 
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "absl/status/status.h"
 #include "common/nn/networks.h"
+#include "learner/algorithms/flat_actor_critic.h"
 #include "learner/algorithms/policy_updater.h"
 #include "learner/parallel/replica_group.h"
 
@@ -42,6 +44,17 @@ double GradientStep(torch::optim::Optimizer& optimizer,
 // Returns the norm before clipping.
 double AverageAndClipFlatGradient(float* gradients, int64_t size,
                                   double max_grad_norm, ReplicaGroup& replicas);
+
+// The flat networks `algorithm` (its name, for the log) trains `policy` and
+// `value` with, or none, after one line on stderr saying why, when they
+// cannot run there (or `autograd_only`).
+std::optional<FlatActorCritic> MakeFlatActorCritic(
+    PolicyNetworkImpl& policy, ValueNetworkImpl& value,
+    const std::vector<at::Tensor>& parameters, const char* algorithm,
+    bool autograd_only);
+
+// `values` as a contiguous float tensor of `rows` rows.
+at::Tensor FloatRows(const at::Tensor& values, int64_t rows);
 
 // Sets every parameter group's learning rate.
 void SetLearningRate(torch::optim::Optimizer& optimizer, double learning_rate);

@@ -4,6 +4,7 @@
 #include <torch/optim/rmsprop.h>
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 
 #include "learner/algorithms/a2c/tensorflow_rmsprop.h"
@@ -33,13 +34,23 @@ std::string OptimizerKey(const A2cConfig& config) {
 
 A2cUpdater::A2cUpdater(PolicyNetwork policy, ValueNetwork value,
                        const A2cConfig& config,
-                       std::shared_ptr<ReplicaGroup> replicas)
+                       std::shared_ptr<ReplicaGroup> replicas,
+                       bool autograd_only)
     : policy_(std::move(policy)),
       value_(std::move(value)),
       config_(config),
       replicas_(std::move(replicas)),
       parameters_(NetworkParameters(*policy_, *value_)),
-      optimizer_(MakeRmsprop(parameters_, config)) {}
+      optimizer_(MakeRmsprop(parameters_, config)),
+      flat_(MakeFlatActorCritic(*policy_, *value_, parameters_, "A2C",
+                                autograd_only)) {
+  if (flat_.has_value()) {
+    flat_rmsprop_.emplace(parameters_, flat_->offsets(), flat_->size(),
+                          config.rmsprop == "pytorch"
+                              ? RmspropArithmetic::kPytorch
+                              : RmspropArithmetic::kTensorflow);
+  }
+}
 
 A2cUpdater::~A2cUpdater() = default;
 
@@ -48,6 +59,61 @@ AlgorithmStats A2cUpdater::Update(const UpdateBatch& batch, double progress,
   SetLearningRate(*optimizer_,
                   config_.learning_rate * std::max(0.0, 1.0 - progress));
   const int64_t rows = config_.steps_per_minibatch * batch.streams;
+  return flat_.has_value() ? FlatUpdate(batch, rows)
+                           : AutogradUpdate(batch, rows);
+}
+
+AlgorithmStats A2cUpdater::FlatUpdate(const UpdateBatch& batch, int64_t rows) {
+  FlatActorCritic& net = *flat_;
+  // The modules may have been rolled back or loaded since the last update.
+  net.Pull();
+  const int64_t size = batch.observations.size(0);
+  const at::Tensor inputs = net.Inputs(batch.observations);
+  const at::Tensor actions = FloatRows(batch.actions, size);
+  const at::Tensor behaviour = FloatRows(batch.behaviour_log_probs, size);
+  const at::Tensor advantages = FloatRows(batch.advantages, size);
+  const at::Tensor returns = FloatRows(batch.returns, size);
+  d_log_probs_.resize(rows);
+  d_values_.resize(rows);
+  const double count = static_cast<double>(rows);
+  MeanStats stats;
+  // The minibatches are consecutive rows: no gathering.
+  for (int64_t begin = 0; begin + rows <= size; begin += rows) {
+    const float* adv = advantages.data_ptr<float>() + begin;
+    const float* old_log_prob = behaviour.data_ptr<float>() + begin;
+    const float* target = returns.data_ptr<float>() + begin;
+    net.Forward(inputs.data_ptr<float>() + begin * inputs.size(1),
+                actions.data_ptr<float>() + begin * actions.size(1), rows);
+    const float* log_probs = net.log_probs();
+    const float* values = net.values();
+    double policy_loss = 0.0, value_loss = 0.0, approx_kl = 0.0;
+    for (int64_t i = 0; i < rows; ++i) {
+      policy_loss -= static_cast<double>(log_probs[i]) * adv[i];
+      d_log_probs_[i] = static_cast<float>(-adv[i] / count);
+      const float error = values[i] - target[i];
+      value_loss += 0.5 * error * error;
+      d_values_[i] = static_cast<float>(config_.value_coef * error / count);
+      const float log_ratio = log_probs[i] - old_log_prob[i];
+      approx_kl += (std::exp(log_ratio) - 1.0f) - log_ratio;
+    }
+    net.Backward(d_log_probs_.data(), -config_.entropy_coef, d_values_.data());
+    AlgorithmStats step;
+    step.max_gradient_norm = AverageAndClipFlatGradient(
+        net.gradients(), net.size(), config_.max_grad_norm, *replicas_);
+    flat_rmsprop_->Step(*optimizer_, net.parameters(), net.gradients());
+    step.policy_loss = policy_loss / count;
+    step.value_loss = value_loss / count;
+    step.entropy = net.mean_entropy();
+    step.approx_kl = approx_kl / count;
+    step.clip_fraction = std::numeric_limits<double>::quiet_NaN();
+    stats.Add(step);
+  }
+  net.Push();
+  return stats.Mean();
+}
+
+AlgorithmStats A2cUpdater::AutogradUpdate(const UpdateBatch& batch,
+                                          int64_t rows) {
   const int64_t size = batch.observations.size(0);
   MeanStats stats;
   for (int64_t begin = 0; begin + rows <= size; begin += rows) {
@@ -84,11 +150,17 @@ AlgorithmStats A2cUpdater::Update(const UpdateBatch& batch, double progress,
 }
 
 void A2cUpdater::Save(torch::serialize::OutputArchive& archive) const {
+  if (flat_rmsprop_.has_value()) flat_rmsprop_->StoreInto(*optimizer_);
   SaveOptimizer(*optimizer_, OptimizerKey(config_), archive);
 }
 
 absl::Status A2cUpdater::Load(torch::serialize::InputArchive& archive) {
-  return LoadOptimizer(*optimizer_, OptimizerKey(config_), archive);
+  if (absl::Status status =
+          LoadOptimizer(*optimizer_, OptimizerKey(config_), archive);
+      !status.ok() || !flat_rmsprop_.has_value()) {
+    return status;
+  }
+  return flat_rmsprop_->LoadFrom(*optimizer_);
 }
 
 }  // namespace vantage

@@ -5,7 +5,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <numeric>
 #include <optional>
 #include <string>
@@ -48,10 +47,6 @@ void GatherRows(const float* source, int64_t width, const int64_t* index,
   }
 }
 
-at::Tensor FloatRows(const at::Tensor& values, int64_t rows) {
-  return values.detach().to(at::kFloat).contiguous().reshape({rows, -1});
-}
-
 }  // namespace
 
 PpoUpdater::PpoUpdater(PolicyNetwork policy, ValueNetwork value,
@@ -65,17 +60,12 @@ PpoUpdater::PpoUpdater(PolicyNetwork policy, ValueNetwork value,
       parameters_(NetworkParameters(*policy_, *value_)),
       optimizer_(std::make_unique<torch::optim::Adam>(
           parameters_,
-          torch::optim::AdamOptions(config.learning_rate).eps(1e-5))) {
-  if (autograd_only) return;
-  absl::StatusOr<FlatActorCritic> flat =
-      FlatActorCritic::Create(*policy_, *value_, parameters_);
-  if (!flat.ok()) {
-    std::fprintf(stderr, "learner: PPO updates run on autograd: %s\n",
-                 std::string(flat.status().message()).c_str());
-    return;
+          torch::optim::AdamOptions(config.learning_rate).eps(1e-5))),
+      flat_(MakeFlatActorCritic(*policy_, *value_, parameters_, "PPO",
+                                autograd_only)) {
+  if (flat_.has_value()) {
+    flat_adam_.emplace(parameters_, flat_->offsets(), flat_->size());
   }
-  flat_.emplace(std::move(*flat));
-  flat_adam_.emplace(parameters_, flat_->offsets(), flat_->size());
 }
 
 PpoUpdater::~PpoUpdater() = default;

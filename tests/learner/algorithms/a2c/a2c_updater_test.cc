@@ -6,108 +6,214 @@
 #include <torch/serialize/input-archive.h>
 #include <torch/serialize/output-archive.h>
 
+#include <algorithm>
+#include <cmath>
 #include <memory>
 #include <random>
 #include <sstream>
 #include <string>
+#include <tuple>
+#include <vector>
 
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
 #include "learner/algorithms/a2c/tensorflow_rmsprop.h"
+#include "tests/fakes/vector_spec.h"
 
 namespace vantage {
 namespace {
 
-EnvSpec Spec() {
-  EnvSpec spec;
-  spec.name = "continuous";
-  spec.observation_size = 4;
-  spec.action_size = 2;
-  spec.action_low.assign(2, -1.0);
-  spec.action_high.assign(2, 1.0);
-  return spec;
+EnvSpec Spec() { return VectorSpec(false, 4, 2); }
+
+struct Networks {
+  PolicyNetwork policy{nullptr};
+  ValueNetwork value{nullptr};
+  std::vector<at::Tensor> parameters() {
+    return NetworkParameters(*policy, *value);
+  }
+};
+
+Networks MakeNetworks(const EnvSpec& spec, uint64_t seed) {
+  at::manual_seed(seed);
+  NetworkConfig config;
+  Networks n;
+  n.policy = PolicyNetwork(spec, config);
+  n.value = MakeValueNetwork(spec, config, *n.policy);
+  return n;
+}
+
+// A 5n-step batch over `streams` streams acted by `n`'s policy, with the
+// behaviour log-probabilities of a slightly different one.
+UpdateBatch ActedBatch(const EnvSpec& spec, Networks& n, int64_t horizon,
+                       int64_t streams) {
+  at::NoGradGuard no_grad;
+  const int64_t samples = horizon * streams;
+  UpdateBatch batch;
+  batch.horizon = horizon;
+  batch.streams = streams;
+  batch.observations = at::randn({samples, spec.observation_size});
+  const at::Tensor output = n.policy->forward(batch.observations);
+  batch.actions = n.policy->Act(output, false, at::Generator());
+  batch.behaviour_log_probs =
+      n.policy->LogProb(output, batch.actions) + 0.2 * at::randn({samples});
+  batch.advantages = at::randn({samples});
+  batch.returns = at::randn({samples});
+  return batch;
+}
+
+std::unique_ptr<torch::optim::Optimizer> ReferenceRmsprop(
+    const std::vector<at::Tensor>& parameters, const std::string& arithmetic) {
+  const auto options = torch::optim::RMSpropOptions(7e-4).alpha(0.99).eps(1e-5);
+  if (arithmetic == "pytorch") {
+    return std::make_unique<torch::optim::RMSprop>(parameters, options);
+  }
+  return std::make_unique<TensorflowRmsprop>(parameters, options);
+}
+
+// Each parameter within `tolerance` of its tensor's largest magnitude.
+void ExpectSameParameters(const std::vector<at::Tensor>& got,
+                          const std::vector<at::Tensor>& want,
+                          double tolerance) {
+  ASSERT_EQ(got.size(), want.size());
+  for (size_t i = 0; i < got.size(); ++i) {
+    const double scale = std::max(1e-12, want[i].abs().max().item<double>());
+    EXPECT_LE((got[i] - want[i]).abs().max().item<double>() / scale, tolerance)
+        << "parameter " << i;
+  }
+}
+
+std::string Saved(const A2cUpdater& updater) {
+  torch::serialize::OutputArchive archive;
+  updater.Save(archive);
+  std::ostringstream bytes;
+  archive.save_to(bytes);
+  return bytes.str();
+}
+
+absl::Status LoadInto(A2cUpdater& updater, const std::string& bytes) {
+  torch::serialize::InputArchive archive;
+  std::istringstream in(bytes);
+  archive.load_from(in);
+  return updater.Load(archive);
 }
 
 // The paper's trick: a 5n-step batch is updated as n consecutive 5-step
 // minibatches, oldest first, each one RMSProp step on the A2C loss.
-// Checked against the same steps written out by hand, with each RMSProp
-// arithmetic.
-class A2cRmspropTest : public ::testing::TestWithParam<std::string> {};
+// Checked against the same steps written out by hand on autograd, for each
+// RMSProp arithmetic, head, and update path (flat or autograd), over two
+// updates (the second from the optimiser's state after the first).
+class A2cRmspropTest
+    : public ::testing::TestWithParam<std::tuple<std::string, bool, bool>> {};
 
 TEST_P(A2cRmspropTest, UpdatesConsecutiveFiveStepMinibatchesInOrder) {
+  const auto& [arithmetic, discrete, autograd_only] = GetParam();
   constexpr int64_t kStreams = 3;
   constexpr int64_t kHorizon = 15;  // n = 3
-  constexpr int64_t kSamples = kHorizon * kStreams;
-  NetworkConfig network;
-  at::manual_seed(5);
-  PolicyNetwork policy(Spec(), network);
-  ValueNetwork value(4, network);
-  at::manual_seed(5);
-  PolicyNetwork reference_policy(Spec(), network);
-  ValueNetwork reference_value(4, network);
-
-  UpdateBatch batch;
-  batch.horizon = kHorizon;
-  batch.streams = kStreams;
-  batch.observations = at::randn({kSamples, 4});
-  batch.actions = at::randn({kSamples, 2});
-  batch.behaviour_log_probs = at::randn({kSamples});
-  batch.advantages = at::randn({kSamples});
-  batch.returns = at::randn({kSamples});
+  const EnvSpec spec = VectorSpec(discrete, 4, discrete ? 3 : 2);
+  Networks nets = MakeNetworks(spec, 5);
+  Networks reference = MakeNetworks(spec, 5);
+  at::manual_seed(6);
+  const UpdateBatch batch = ActedBatch(spec, nets, kHorizon, kStreams);
 
   A2cConfig config;
   config.n = 3;
-  config.rmsprop = GetParam();
-  const at::Tensor initial = policy->parameters()[0].clone();
-  A2cUpdater a2c(policy, value, config);
-  std::mt19937_64 rng(1);
-  const double progress = 0.25;
-  const AlgorithmStats stats = a2c.Update(batch, progress, rng);
+  config.rmsprop = arithmetic;
+  const at::Tensor initial = nets.policy->parameters()[0].clone();
+  A2cUpdater a2c(nets.policy, nets.value, config, SoloReplicaGroup(),
+                 autograd_only);
+  EXPECT_EQ(a2c.flat(), !autograd_only);
 
-  std::vector<at::Tensor> parameters = reference_policy->parameters();
-  for (const at::Tensor& p : reference_value->parameters()) {
-    parameters.push_back(p);
+  std::vector<at::Tensor> parameters = reference.parameters();
+  std::unique_ptr<torch::optim::Optimizer> rmsprop =
+      ReferenceRmsprop(parameters, arithmetic);
+  for (const double progress : {0.25, 0.5}) {
+    std::mt19937_64 rng(1);
+    const AlgorithmStats stats = a2c.Update(batch, progress, rng);
+    for (auto& group : rmsprop->param_groups()) {
+      group.options().set_lr(config.learning_rate * (1 - progress));
+    }
+    double policy_loss = 0.0, value_loss = 0.0, entropy = 0.0, norm = 0.0;
+    for (int64_t begin = 0; begin < kHorizon * kStreams;
+         begin += 5 * kStreams) {
+      const int64_t end = begin + 5 * kStreams;
+      const at::Tensor obs = batch.observations.slice(0, begin, end);
+      const at::Tensor out = reference.policy->forward(obs);
+      const at::Tensor log_prob =
+          reference.policy->LogProb(out, batch.actions.slice(0, begin, end));
+      const at::Tensor pg =
+          -(log_prob * batch.advantages.slice(0, begin, end)).mean();
+      const at::Tensor v =
+          reference.value->forward(obs) - batch.returns.slice(0, begin, end);
+      const at::Tensor vf = 0.5 * (v * v).mean();
+      const at::Tensor h = reference.policy->Entropy(out).mean();
+      const at::Tensor loss = pg + 0.5 * vf - 0.01 * h;
+      rmsprop->zero_grad();
+      loss.backward();
+      norm = std::max(norm, torch::nn::utils::clip_grad_norm_(parameters, 0.5));
+      rmsprop->step();
+      policy_loss += pg.item<double>() / 3;
+      value_loss += vf.item<double>() / 3;
+      entropy += h.item<double>() / 3;
+    }
+    for (auto [got, want, what] :
+         {std::tuple{stats.policy_loss, policy_loss, "pi"},
+          {stats.value_loss, value_loss, "value"},
+          {stats.entropy, entropy, "entropy"},
+          {stats.max_gradient_norm, norm, "norm"}}) {
+      EXPECT_NEAR(got, want, 1e-5 * std::max(1.0, std::abs(want))) << what;
+    }
+    EXPECT_GT(stats.approx_kl, 0.0);
+    EXPECT_TRUE(std::isnan(stats.clip_fraction));
+    ExpectSameParameters(nets.parameters(), reference.parameters(), 1e-5);
   }
-  const auto options =
-      torch::optim::RMSpropOptions(config.learning_rate * (1 - progress))
-          .alpha(0.99)
-          .eps(1e-5);
-  std::unique_ptr<torch::optim::Optimizer> rmsprop;
-  if (GetParam() == "pytorch") {
-    rmsprop = std::make_unique<torch::optim::RMSprop>(parameters, options);
-  } else {
-    rmsprop = std::make_unique<TensorflowRmsprop>(parameters, options);
-  }
-  double policy_loss = 0.0;
-  for (int64_t begin = 0; begin < kSamples; begin += 5 * kStreams) {
-    const int64_t end = begin + 5 * kStreams;
-    const at::Tensor obs = batch.observations.slice(0, begin, end);
-    const at::Tensor out = reference_policy->forward(obs);
-    const at::Tensor log_prob =
-        reference_policy->LogProb(out, batch.actions.slice(0, begin, end));
-    const at::Tensor pg =
-        -(log_prob * batch.advantages.slice(0, begin, end)).mean();
-    const at::Tensor v =
-        reference_value->forward(obs) - batch.returns.slice(0, begin, end);
-    const at::Tensor loss = pg + 0.5 * (0.5 * (v * v).mean()) -
-                            0.01 * reference_policy->Entropy(out).mean();
-    rmsprop->zero_grad();
-    loss.backward();
-    torch::nn::utils::clip_grad_norm_(parameters, 0.5);
-    rmsprop->step();
-    policy_loss += pg.item<double>() / 3;
-  }
-  EXPECT_NEAR(stats.policy_loss, policy_loss, 1e-6);
-  const std::vector<at::Tensor> got = policy->parameters();
-  const std::vector<at::Tensor> want = reference_policy->parameters();
-  for (size_t i = 0; i < got.size(); ++i) {
-    EXPECT_TRUE(at::allclose(got[i], want[i], 1e-5, 1e-6)) << "parameter " << i;
-  }
-  EXPECT_FALSE(at::allclose(got[0], initial));
+  EXPECT_FALSE(at::allclose(nets.policy->parameters()[0], initial));
 }
 
-INSTANTIATE_TEST_SUITE_P(Arithmetics, A2cRmspropTest,
-                         ::testing::Values("tensorflow", "pytorch"));
+INSTANTIATE_TEST_SUITE_P(
+    ArithmeticsHeadsAndPaths, A2cRmspropTest,
+    ::testing::Combine(::testing::Values("tensorflow", "pytorch"),
+                       ::testing::Bool(), ::testing::Bool()));
+
+// A checkpoint of the flat path resumes on autograd and the other way
+// round: the next update is the same either way.
+TEST(A2cTest, CheckpointsCrossBetweenTheFlatAndAutogradPaths) {
+  for (const std::string arithmetic : {"tensorflow", "pytorch"}) {
+    const EnvSpec spec = Spec();
+    A2cConfig config;
+    config.rmsprop = arithmetic;
+    Networks a = MakeNetworks(spec, 7);
+    at::manual_seed(8);
+    const UpdateBatch batch = ActedBatch(spec, a, config.horizon(), 2);
+    A2cUpdater flat(a.policy, a.value, config);
+    std::mt19937_64 rng(0);
+    flat.Update(batch, 0.1, rng);
+    const std::string after_one = Saved(flat);
+
+    Networks b = MakeNetworks(spec, 7);
+    for (size_t i = 0; i < b.parameters().size(); ++i) {
+      at::NoGradGuard no_grad;
+      b.parameters()[i].copy_(a.parameters()[i]);
+    }
+    A2cUpdater autograd(b.policy, b.value, config, SoloReplicaGroup(),
+                        /*autograd_only=*/true);
+    ASSERT_TRUE(LoadInto(autograd, after_one).ok());
+    flat.Update(batch, 0.2, rng);
+    autograd.Update(batch, 0.2, rng);
+    ExpectSameParameters(a.parameters(), b.parameters(), 1e-5);
+
+    // And back: the autograd path's state into a fresh flat updater.
+    Networks c = MakeNetworks(spec, 7);
+    for (size_t i = 0; i < c.parameters().size(); ++i) {
+      at::NoGradGuard no_grad;
+      c.parameters()[i].copy_(b.parameters()[i]);
+    }
+    A2cUpdater resumed(c.policy, c.value, config);
+    ASSERT_TRUE(LoadInto(resumed, Saved(autograd)).ok());
+    autograd.Update(batch, 0.3, rng);
+    resumed.Update(batch, 0.3, rng);
+    ExpectSameParameters(c.parameters(), b.parameters(), 1e-5);
+  }
+}
 
 // Both arithmetics keep the same state; the checkpoint says which one made
 // it, so a run cannot continue under the other.
