@@ -21,6 +21,7 @@
 #include "common/util/self_process.h"
 #include "learner/algorithms/a2c/a2c_updater.h"
 #include "learner/algorithms/ppo/ppo_updater.h"
+#include "learner/exploration/ex2_bonus.h"
 #include "learner/parallel/gloo_replica_group.h"
 #include "learner/update_guard.h"
 
@@ -218,6 +219,41 @@ int RunLearnerBenchmark() {
     })->Apply([](auto* b) { UseFastestOfSingleRuns(b, kRepetitions); });
   }
 
+  // EX2's model fit (its reference code's settings but for fewer
+  // iterations) on HalfCheetah's states and actions, with the fused Adam
+  // and with torch's: the rest of each step (the model's forward and
+  // backward) is the same autograd.
+  Ex2Config ex2_config;
+  ex2_config.replay_min = 1;
+  ex2_config.first_train_iterations = 1;
+  constexpr int kEx2Iterations = 200;
+  ex2_config.train_iterations = kEx2Iterations;
+  Rollout ex2_rollout;
+  ex2_rollout.observations = at::randn({1001, kObservations});
+  ex2_rollout.actions = at::randn({1000, kActions});
+  ex2_rollout.rewards = at::zeros({1000});
+  Ex2Bonus ex2_fused(ex2_config, HalfCheetahSpec(), 1, SoloReplicaGroup());
+  Ex2Bonus ex2_torch(ex2_config, HalfCheetahSpec(), 1, SoloReplicaGroup(),
+                     /*torch_adam=*/true);
+  for (Ex2Bonus* ex2 : {&ex2_fused, &ex2_torch}) {
+    // The pool's first rows, then the first fit (of one iteration): the
+    // timed ones are all of kEx2Iterations.
+    for (int i = 0; i < 2; ++i) {
+      std::vector<Rollout> rollouts = {ex2_rollout};
+      ex2->ShapeRewards(rollouts);
+      ex2->Commit();
+    }
+  }
+  for (auto [name, ex2] : {std::pair{"ex2_fused_fit", &ex2_fused},
+                           {"ex2_torch_fit", &ex2_torch}}) {
+    benchmark::RegisterBenchmark(name, [&, ex2 = ex2](benchmark::State& state) {
+      for (auto _ : state) {
+        std::vector<Rollout> rollouts = {ex2_rollout};
+        benchmark::DoNotOptimize(ex2->ShapeRewards(rollouts));
+      }
+    })->Apply([](auto* b) { UseFastestOfSingleRuns(b, kRepetitions); });
+  }
+
   BarePpo bare(BenchShape());
   benchmark::RegisterBenchmark("bare_update", [&](benchmark::State& state) {
     for (auto _ : state) bare.Update(batch);
@@ -240,6 +276,10 @@ int RunLearnerBenchmark() {
       a2c_samples / collector.Seconds("a2c_flat_update");
   const double a2c_autograd_rate =
       a2c_samples / collector.Seconds("a2c_autograd_update");
+  const double ex2_fused_rate =
+      kEx2Iterations / collector.Seconds("ex2_fused_fit");
+  const double ex2_torch_rate =
+      kEx2Iterations / collector.Seconds("ex2_torch_fit");
   absl::StatusOr<DataParallelFigures> measured = MeasureTwoReplicas(batch);
   if (!measured.ok()) {
     std::fprintf(stderr, "bench learner: %s\n",
@@ -266,11 +306,14 @@ int RunLearnerBenchmark() {
       "ratio=%.3f guarded_samples_per_s=%.0f guard_ratio=%.3f "
       "two_replicas_samples_per_s=%.0f two_replicas_speedup=%.2f "
       "allreduce_us=%.1f allreduce_share=%.3f a2c_flat_samples_per_s=%.0f "
-      "a2c_autograd_samples_per_s=%.0f a2c_speedup=%.2f blas=%s\n",
+      "a2c_autograd_samples_per_s=%.0f a2c_speedup=%.2f "
+      "ex2_fused_steps_per_s=%.0f ex2_torch_steps_per_s=%.0f "
+      "ex2_speedup=%.2f blas=%s\n",
       ppo_rate, bare_rate, ppo_rate / bare_rate, guarded_rate,
       guarded_rate / ppo_rate, dp_rate, dp_rate / ppo_rate,
       two.allreduce_seconds * 1e6, allreduce_share, a2c_flat_rate,
-      a2c_autograd_rate, a2c_flat_rate / a2c_autograd_rate, blas.kind.c_str());
+      a2c_autograd_rate, a2c_flat_rate / a2c_autograd_rate, ex2_fused_rate,
+      ex2_torch_rate, ex2_fused_rate / ex2_torch_rate, blas.kind.c_str());
   return 0;
 }
 

@@ -5,7 +5,10 @@
 #include <torch/optim/adam.h>
 #include <torch/serialize/archive.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstring>
+#include <limits>
 #include <utility>
 
 #include "absl/strings/str_cat.h"
@@ -31,7 +34,7 @@ double Median(const at::Tensor& values) {
 }  // namespace
 
 Ex2Bonus::Ex2Bonus(const Ex2Config& config, const EnvSpec& spec, uint64_t seed,
-                   std::shared_ptr<ReplicaGroup> replicas)
+                   std::shared_ptr<ReplicaGroup> replicas, bool torch_adam)
     : config_(config),
       spec_(spec),
       replicas_(std::move(replicas)),
@@ -40,7 +43,29 @@ Ex2Bonus::Ex2Bonus(const Ex2Config& config, const EnvSpec& spec, uint64_t seed,
           model_->parameters(),
           torch::optim::AdamOptions(config.learning_rate))),
       generator_(at::make_generator<at::CPUGeneratorImpl>(seed)),
-      pool_(config.replay_size, InputWidth(config, spec)) {}
+      pool_(config.replay_size, InputWidth(config, spec)) {
+  if (torch_adam) return;
+  std::vector<at::Tensor> parameters = model_->parameters();
+  std::vector<int64_t> offsets;
+  int64_t size = 0;
+  for (const at::Tensor& p : parameters) {
+    offsets.push_back(size);
+    size += p.numel();
+  }
+  flat_parameters_ = at::empty({size}, at::kFloat);
+  at::NoGradGuard no_grad;
+  for (size_t i = 0; i < parameters.size(); ++i) {
+    at::Tensor view =
+        flat_parameters_.narrow(0, offsets[i], parameters[i].numel())
+            .view(parameters[i].sizes());
+    view.copy_(parameters[i]);
+    // The same tensors (the module's, the optimiser's state keys) on the
+    // flat storage, as Module::to moves parameters.
+    parameters[i].set_data(view);
+  }
+  flat_gradients_.assign(size, 0.0f);
+  flat_adam_.emplace(std::move(parameters), std::move(offsets), size);
+}
 
 Ex2Bonus::~Ex2Bonus() = default;
 
@@ -76,7 +101,6 @@ ExplorationStats Ex2Bonus::ShapeRewards(std::vector<Rollout>& rollouts) {
   if (pool_.total_added() >= config_.replay_min && pool_.size() > 0) {
     const int iterations =
         fitted_ ? config_.train_iterations : config_.first_train_iterations;
-    const std::vector<at::Tensor> parameters = model_->parameters();
     double loss_sum = 0.0, accuracy_sum = 0.0;
     for (int i = 0; i < iterations; ++i) {
       const at::Tensor positives = inputs.index_select(
@@ -85,8 +109,7 @@ ExplorationStats Ex2Bonus::ShapeRewards(std::vector<Rollout>& rollouts) {
       const at::Tensor negatives = pool_.Sample(config_.batch_size, generator_);
       const ExemplarLoss loss = ComputeExemplarLoss(
           *model_, positives, negatives, config_.kl_weight, generator_);
-      GradientStep(*optimizer_, parameters, loss.loss,
-                   std::numeric_limits<double>::infinity(), *replicas_);
+      FitStep(loss.loss);
       loss_sum += loss.loss.item<double>();
       accuracy_sum += loss.accuracy;
     }
@@ -123,6 +146,35 @@ ExplorationStats Ex2Bonus::ShapeRewards(std::vector<Rollout>& rollouts) {
   return stats;
 }
 
+void Ex2Bonus::FitStep(const at::Tensor& loss) {
+  const std::vector<at::Tensor> parameters = model_->parameters();
+  constexpr double kNoClipping = std::numeric_limits<double>::infinity();
+  if (!flat_adam_.has_value()) {
+    GradientStep(*optimizer_, parameters, loss, kNoClipping, *replicas_);
+    return;
+  }
+  // Undefined gradients are taken over by backward, not accumulated into.
+  for (const at::Tensor& p : parameters) p.mutable_grad().reset();
+  loss.backward();
+  int64_t offset = 0;
+  for (const at::Tensor& p : parameters) {
+    const at::Tensor& grad = p.grad();
+    float* target = flat_gradients_.data() + offset;
+    if (grad.defined()) {
+      const at::Tensor values = grad.contiguous();
+      std::memcpy(target, values.data_ptr<float>(),
+                  sizeof(float) * values.numel());
+    } else {
+      std::fill_n(target, p.numel(), 0.0f);
+    }
+    offset += p.numel();
+  }
+  AverageAndClipFlatGradient(flat_gradients_.data(), offset, kNoClipping,
+                             *replicas_);
+  flat_adam_->Step(*optimizer_, flat_parameters_.data_ptr<float>(),
+                   flat_gradients_.data());
+}
+
 void Ex2Bonus::Commit() {
   if (!pending_.defined()) return;
   pool_.Add(pending_);
@@ -132,6 +184,7 @@ void Ex2Bonus::Commit() {
 void Ex2Bonus::SaveModelState(torch::serialize::OutputArchive& archive,
                               const std::string& prefix) const {
   WriteModule(archive, prefix + ".model", *model_);
+  if (flat_adam_.has_value()) flat_adam_->StoreInto(*optimizer_);
   SaveOptimizer(*optimizer_, prefix + ".optimizer", archive);
   archive.write(prefix + ".generator", generator_.get_state());
   archive.write(prefix + ".fitted",
@@ -173,6 +226,11 @@ absl::Status Ex2Bonus::LoadModelState(torch::serialize::InputArchive& archive,
           LoadOptimizer(*optimizer_, prefix + ".optimizer", archive);
       !status.ok()) {
     return status;
+  }
+  if (flat_adam_.has_value()) {
+    if (absl::Status status = flat_adam_->LoadFrom(*optimizer_); !status.ok()) {
+      return status;
+    }
   }
   generator_ = restored;
   fitted_ = fitted.item<int64_t>() != 0;

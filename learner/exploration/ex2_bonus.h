@@ -15,11 +15,13 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "absl/status/status.h"
 #include "common/env/environment.h"
+#include "learner/algorithms/flat_adam.h"
 #include "learner/exploration/ex2_config.h"
 #include "learner/exploration/exemplar_model.h"
 #include "learner/exploration/exploration_stats.h"
@@ -42,9 +44,12 @@ class Ex2Bonus {
   // The model's initial weights come from LibTorch's global generator; its
   // sampling from its own, seeded by `seed`. With `replicas`, gradients
   // are averaged over them (every replica must start from the same
-  // weights, which the learner broadcasts).
+  // weights, which the learner broadcasts). The model's Adam steps are
+  // FlatAdam's, in one loop over every parameter, unless `torch_adam`
+  // (torch::optim::Adam's, the same arithmetic a dozen operators per
+  // parameter tensor at a time; for tests and benchmarks).
   Ex2Bonus(const Ex2Config& config, const EnvSpec& spec, uint64_t seed,
-           std::shared_ptr<ReplicaGroup> replicas);
+           std::shared_ptr<ReplicaGroup> replicas, bool torch_adam = false);
   ~Ex2Bonus();
 
   // Fits the model and adds the bonus to the rollouts' rewards (see
@@ -78,11 +83,21 @@ class Ex2Bonus {
   at::Tensor Inputs(const std::vector<Rollout>& rollouts) const;
 
  private:
+  // One Adam step of the model on `loss`'s gradients, averaged over the
+  // replicas.
+  void FitStep(const at::Tensor& loss);
+
   Ex2Config config_;
   EnvSpec spec_;
   std::shared_ptr<ReplicaGroup> replicas_;
   ExemplarModel model_{nullptr};
   std::unique_ptr<torch::optim::Adam> optimizer_;
+  // With FlatAdam, the model's parameters are views of one flat tensor,
+  // which it steps in place; their gradients are gathered into one array.
+  // optimizer_ then only carries the state into checkpoints.
+  at::Tensor flat_parameters_;
+  std::vector<float> flat_gradients_;
+  std::optional<FlatAdam> flat_adam_;
   at::Generator generator_;
   ReplayPool pool_;
   bool fitted_ = false;

@@ -4,6 +4,7 @@
 #include <ATen/CPUGeneratorImpl.h>
 #include <torch/serialize/archive.h>
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 #include <vector>
@@ -309,6 +310,66 @@ TEST(Ex2BonusTest, SameSeedSameBonusesAndASavedModelContinuesExactly) {
   const absl::Status status = other.Load(again, "ex2");
   EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument);
   EXPECT_THAT(std::string(status.message()), HasSubstr("replay pool"));
+}
+
+// The fused Adam (the default) fits the model as torch::optim::Adam does:
+// from the same weights, draws and batches, the same parameters to 1e-5
+// of each tensor's scale and the same bonuses; and a checkpoint of one
+// continues on the other.
+TEST(Ex2BonusTest, TheFusedAdamFitsAsTorchsAdam) {
+  Ex2Config config = SmallConfig();
+  config.replay_min = 500;
+  config.first_train_iterations = 60;
+  config.train_iterations = 30;
+  at::manual_seed(2);
+  Ex2Bonus fused(config, PlaneSpec(), 5, SoloReplicaGroup());
+  at::manual_seed(2);
+  Ex2Bonus reference(config, PlaneSpec(), 5, SoloReplicaGroup(),
+                     /*torch_adam=*/true);
+  const auto expect_same = [](Ex2Bonus& a, Ex2Bonus& b, const char* when) {
+    const std::vector<at::Tensor> pa = a.parameters();
+    const std::vector<at::Tensor> pb = b.parameters();
+    ASSERT_EQ(pa.size(), pb.size());
+    for (size_t i = 0; i < pa.size(); ++i) {
+      const double scale = std::max(1e-12, pb[i].abs().max().item<double>());
+      EXPECT_LE((pa[i] - pb[i]).abs().max().item<double>() / scale, 1e-5)
+          << when << ": parameter " << i;
+    }
+  };
+  at::Generator generator = at::make_generator<at::CPUGeneratorImpl>(6);
+  const at::Tensor initial = fused.parameters()[0].clone();
+  for (int batch = 0; batch < 4; ++batch) {
+    const at::Tensor states = at::randn({300, 2}, generator);
+    std::vector<Rollout> a = {RolloutOf(states)};
+    std::vector<Rollout> b = {RolloutOf(states)};
+    const ExplorationStats sa = fused.ShapeRewards(a);
+    const ExplorationStats sb = reference.ShapeRewards(b);
+    EXPECT_EQ(sa.fit_steps, sb.fit_steps);
+    EXPECT_TRUE(at::allclose(a[0].rewards, b[0].rewards, 1e-4, 1e-6))
+        << "batch " << batch;
+    fused.Commit();
+    reference.Commit();
+    expect_same(fused, reference, "fitted");
+  }
+  EXPECT_FALSE(at::allclose(fused.parameters()[0], initial));
+
+  // The fused one's checkpoint, continued by torch's Adam.
+  torch::serialize::OutputArchive out;
+  fused.Save(out, "ex2");
+  std::ostringstream bytes;
+  out.save_to(bytes);
+  Ex2Bonus resumed(config, PlaneSpec(), 77, SoloReplicaGroup(),
+                   /*torch_adam=*/true);
+  torch::serialize::InputArchive in;
+  std::istringstream stream(bytes.str());
+  in.load_from(stream);
+  ASSERT_TRUE(resumed.Load(in, "ex2").ok());
+  const at::Tensor states = at::randn({300, 2}, generator);
+  std::vector<Rollout> a = {RolloutOf(states)};
+  std::vector<Rollout> b = {RolloutOf(states)};
+  fused.ShapeRewards(a);
+  resumed.ShapeRewards(b);
+  expect_same(fused, resumed, "resumed");
 }
 
 TEST(Ex2ConfigTest, RulesNameTheirField) {
