@@ -10,6 +10,7 @@
 #include <fstream>
 #include <limits>
 #include <optional>
+#include <random>
 #include <string>
 #include <thread>
 #include <utility>
@@ -25,7 +26,9 @@
 #include "actor/envs/env_registry.h"
 #include "bench/raw_physics.h"
 #include "common/nn/compute_threads.h"
+#include "common/nn/networks.h"
 #include "common/util/self_process.h"
+#include "learner/algorithms/a2c/a2c_updater.h"
 
 namespace vantage {
 namespace {
@@ -76,6 +79,45 @@ double BareSamplesPerSecond(const BarePpoShape& shape, int64_t batch_size) {
     fastest = std::min(fastest, SecondsSince(start));
   }
   return static_cast<double>(batch_size) * shape.epochs / fastest;
+}
+
+// Sample passes per second of vantage's A2C update of `config` on the
+// run's networks, the fastest of three updates (after a warm-up) of a
+// synthetic batch of `streams` envs x its horizon.
+double A2cSamplesPerSecond(const TrainBenchConfig& config) {
+  at::manual_seed(0);
+  const A2cConfig& a2c = config.a2c_config;
+  const int64_t rows = a2c.horizon() * config.streams;
+  UpdateBatch batch;
+  batch.horizon = a2c.horizon();
+  batch.streams = config.streams;
+  const EnvSpec& spec = config.spec;
+  // Observations as batches hold them: bytes for image tasks.
+  batch.observations =
+      spec.byte_observations()
+          ? at::randint(0, spec.observation_high + 1,
+                        {rows, spec.observation_size}, at::kByte)
+          : at::randn({rows, spec.observation_size});
+  PolicyNetwork policy(spec, config.network);
+  ValueNetwork value = MakeValueNetwork(spec, config.network, *policy);
+  {
+    at::NoGradGuard no_grad;
+    batch.actions = policy->Act(policy->forward(batch.observations),
+                                /*deterministic=*/false, at::Generator());
+  }
+  batch.behaviour_log_probs = at::randn({rows}) - 2;
+  batch.advantages = at::randn({rows});
+  batch.returns = at::randn({rows});
+  A2cUpdater updater(policy, value, a2c);
+  std::mt19937_64 rng(0);
+  updater.Update(batch, 0.999, rng);  // warm-up
+  double fastest = std::numeric_limits<double>::infinity();
+  for (int i = 0; i < 3; ++i) {
+    const auto start = std::chrono::steady_clock::now();
+    updater.Update(batch, 0.999, rng);
+    fastest = std::min(fastest, SecondsSince(start));
+  }
+  return static_cast<double>(rows) / fastest;
 }
 
 struct ProgressPoint {
@@ -214,13 +256,19 @@ int RunTrainBenchmark(const TrainBenchConfig& config) {
                  std::string(raw.status().message()).c_str());
     return 2;
   }
-  const double bare = BareSamplesPerSecond(config.shape, config.batch);
+  // The update's samples/s and the passes each env step costs of it.
+  const double update = config.a2c
+                            ? A2cSamplesPerSecond(config)
+                            : BareSamplesPerSecond(config.shape, config.batch);
+  const int passes = config.a2c ? 1 : config.shape.epochs;
   const double limit =
-      cores / (1.0 / *raw + static_cast<double>(config.shape.epochs) / bare);
+      cores / (1.0 / *raw + static_cast<double>(passes) / update);
   std::printf(
-      "train: %s raw physics %.0f steps/s, bare PPO update %.0f samples/s "
-      "(%d epochs), %d cores: limit %.0f env steps/s\n",
-      config.env.c_str(), *raw, bare, config.shape.epochs, cores, limit);
+      "train: %s raw physics %.0f steps/s, %s %.0f samples/s "
+      "(%d passes), %d cores: limit %.0f env steps/s\n",
+      config.env.c_str(), *raw,
+      config.a2c ? "vantage's A2C update" : "bare PPO update", update, passes,
+      cores, limit);
   std::fflush(stdout);
 
   for (const TrainBenchRun& run : config.runs) {
@@ -243,14 +291,15 @@ int RunTrainBenchmark(const TrainBenchConfig& config) {
           shares.c_str());
     }
     std::printf(
-        "RESULT train env=%s learners=%d actors=%d envs_per_actor=%d sync=%d "
-        "max_policy_lag=%ld sps=%.0f limit_sps=%.0f ratio=%.3f "
-        "raw_steps_per_s=%.0f bare_samples_per_s=%.0f cores=%d%s%s\n",
-        config.env.c_str(), config.learners, config.actors,
-        config.envs_per_actor, run.sync ? 1 : 0,
+        "RESULT train env=%s algo=%s learners=%d actors=%d envs_per_actor=%d "
+        "sync=%d max_policy_lag=%ld sps=%.0f limit_sps=%.0f ratio=%.3f "
+        "raw_steps_per_s=%.0f %s=%.0f cores=%d%s%s\n",
+        config.env.c_str(), config.a2c ? "a2c" : "ppo", config.learners,
+        config.actors, config.envs_per_actor, run.sync ? 1 : 0,
         static_cast<long>(run.max_policy_lag), measured->sps, limit,
-        measured->sps / limit, *raw, bare, cores,
-        SplitFields(measured->learner, "learner").c_str(),
+        measured->sps / limit, *raw,
+        config.a2c ? "a2c_update_samples_per_s" : "bare_samples_per_s", update,
+        cores, SplitFields(measured->learner, "learner").c_str(),
         SplitFields(measured->actors, "actor").c_str());
     std::fflush(stdout);
   }

@@ -6,6 +6,9 @@
 #include <vector>
 
 #include "bench/bare_ppo.h"
+#include "common/env/environment.h"
+#include "common/nn/network_config.h"
+#include "learner/algorithms/a2c/a2c_config.h"
 
 namespace vantage {
 
@@ -17,8 +20,8 @@ struct TrainBenchRun {
   int64_t max_policy_lag = 0;
 };
 
-// PPO runs of `vantage train` to time end to end, one per configuration,
-// all of the same env, shapes and batch.
+// PPO or A2C runs of `vantage train` to time end to end, one per
+// configuration, all of the same env, shapes and batch.
 struct TrainBenchConfig {
   std::vector<TrainBenchRun> runs;
   std::string env;
@@ -26,17 +29,27 @@ struct TrainBenchConfig {
   int actors = 1;
   int envs_per_actor = 1;
   int64_t batch = 0;   // env steps per update, all learners together
-  BarePpoShape shape;  // the run's network and PPO epochs/minibatches
+  BarePpoShape shape;  // PPO: the run's network and epochs/minibatches
+  // A2C, which has no bare loop here: the update each env step costs is
+  // vantage's own A2cUpdater on the run's networks (a convolutional torso
+  // too) over a synthetic batch of the run's envs.
+  bool a2c = false;
+  EnvSpec spec;
+  NetworkConfig network;
+  A2cConfig a2c_config;
+  int64_t streams = 0;  // the run's envs, all actors together
 };
 
 // `vantage bench train`: in one run, measures this machine's raw physics
-// steps/s of the env (one core) and the bare LibTorch PPO update's
-// samples/s (one core, the run's shapes), then runs the distributed main
-// job (`vantage train`, a child process) in each configuration and
-// compares its steady-state env steps/s (the first two updates, start-up,
-// excluded) with the machine's limit cores / (1/raw + epochs/bare): every
-// env step costs its physics and `epochs` sample passes of the update, and
-// nothing else is free. Each configuration ends with `RESULT train env=..
+// steps/s of the env (one core; a MinAtar game's bare rules) and the bare
+// LibTorch PPO update's samples/s (one core, the run's shapes), then runs
+// the distributed main job (`vantage train`, a child process) in each
+// configuration and compares its steady-state env steps/s (the first two
+// updates, start-up, excluded) with the machine's limit
+// cores / (1/raw + epochs/bare): every env step costs its physics and
+// `epochs` sample passes of the update, and nothing else is free. For A2C
+// the update term is 1/a2c, a2c the samples/s of vantage's own A2C update
+// (one pass per sample). Each configuration ends with `RESULT train env=..
 // sync=.. max_policy_lag=.. sps=.. limit_sps=.. ratio=..` and the time
 // splits the run's learners and actors printed when they stopped (mean
 // shares in percent: learner_advantages=.., actor_physics=.., ...).

@@ -87,8 +87,11 @@ int RunTrainBench() {
     absl::StatusOr<ResolvedRun> run = ResolveRunRequest(mode_request);
     if (!run.ok()) return Usage(std::string(run.status().message()).c_str());
     const pb::RunConfig& config = run->config;
-    if (AlgorithmNameOf(config) != "ppo") {
-      return Usage("train: the limit counts PPO's epochs; use --algo=ppo");
+    const std::string algorithm = AlgorithmNameOf(config);
+    if (algorithm != "ppo" && algorithm != "a2c") {
+      return Usage(
+          "train: the limit counts PPO's epochs or A2C's update; use "
+          "--algo=ppo or --algo=a2c");
     }
     absl::StatusOr<std::unique_ptr<Environment>> env =
         MakeEnvironment(config.training().env(), EnvOptionsOf(config));
@@ -117,6 +120,11 @@ int RunTrainBench() {
                               config.training().hidden().end());
     bench.shape.epochs = config.ppo().epochs();
     bench.shape.minibatches = config.ppo().minibatches();
+    bench.a2c = algorithm == "a2c";
+    bench.spec = (*env)->spec();
+    bench.network = run->local.learner.network;
+    bench.a2c_config = run->local.learner.algorithm.a2c;
+    bench.streams = config.training().envs();
   }
   const int code = RunTrainBenchmark(bench);
   std::error_code error;

@@ -122,6 +122,7 @@ TEST(BenchCommandsTest, TrainTimesTheMainJobAgainstTheMachinesLimit) {
   EXPECT_EQ(results[1].at("max_policy_lag"), "1");
   for (const auto& fields : results) {
     EXPECT_EQ(fields.at("env"), "InvertedPendulum");
+    EXPECT_EQ(fields.at("algo"), "ppo");
     EXPECT_EQ(fields.at("learners"), "2");
     EXPECT_EQ(fields.at("actors"), "2");
     const double raw = Number(fields, "raw_steps_per_s");
@@ -151,6 +152,25 @@ TEST(BenchCommandsTest, TrainTimesTheMainJobAgainstTheMachinesLimit) {
   }
   // Only the benchmark's RESULT lines: the run's own went to its log.
   EXPECT_THAT(outcome.out, Not(HasSubstr("mean_return=")));
+}
+
+// A2C's limit counts one pass of vantage's own A2C update per env step.
+TEST(BenchCommandsTest, TrainTimesA2cAgainstItsOwnUpdate) {
+  const Outcome outcome = RunVantage(
+      "bench train --env=InvertedPendulum --algo=a2c --steps=20480 --sync");
+  ASSERT_EQ(outcome.exit_code, 0) << outcome.err;
+  const auto fields = ResultFields(outcome.out, "RESULT train ");
+  EXPECT_EQ(fields.at("algo"), "a2c");
+  EXPECT_EQ(fields.at("sync"), "1");
+  const double raw = Number(fields, "raw_steps_per_s");
+  const double update = Number(fields, "a2c_update_samples_per_s");
+  const double cores = Number(fields, "cores");
+  ASSERT_GT(raw, 0);
+  ASSERT_GT(update, 0);
+  const double limit = Number(fields, "limit_sps");
+  EXPECT_NEAR(limit, cores / (1 / raw + 1 / update), 0.01 * limit + 1);
+  EXPECT_GT(Number(fields, "sps"), 0);
+  EXPECT_EQ(fields.count("bare_samples_per_s"), 0u);
 }
 
 TEST(BenchCommandsTest, TrainRefusesWhatItCannotTime) {
