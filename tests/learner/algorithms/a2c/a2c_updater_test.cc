@@ -18,48 +18,13 @@
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
 #include "learner/algorithms/a2c/tensorflow_rmsprop.h"
+#include "tests/fakes/updater_fixtures.h"
 #include "tests/fakes/vector_spec.h"
 
 namespace vantage {
 namespace {
 
 EnvSpec Spec() { return VectorSpec(false, 4, 2); }
-
-struct Networks {
-  PolicyNetwork policy{nullptr};
-  ValueNetwork value{nullptr};
-  std::vector<at::Tensor> parameters() {
-    return NetworkParameters(*policy, *value);
-  }
-};
-
-Networks MakeNetworks(const EnvSpec& spec, uint64_t seed) {
-  at::manual_seed(seed);
-  NetworkConfig config;
-  Networks n;
-  n.policy = PolicyNetwork(spec, config);
-  n.value = MakeValueNetwork(spec, config, *n.policy);
-  return n;
-}
-
-// A 5n-step batch over `streams` streams acted by `n`'s policy, with the
-// behaviour log-probabilities of a slightly different one.
-UpdateBatch ActedBatch(const EnvSpec& spec, Networks& n, int64_t horizon,
-                       int64_t streams) {
-  at::NoGradGuard no_grad;
-  const int64_t samples = horizon * streams;
-  UpdateBatch batch;
-  batch.horizon = horizon;
-  batch.streams = streams;
-  batch.observations = at::randn({samples, spec.observation_size});
-  const at::Tensor output = n.policy->forward(batch.observations);
-  batch.actions = n.policy->Act(output, false, at::Generator());
-  batch.behaviour_log_probs =
-      n.policy->LogProb(output, batch.actions) + 0.2 * at::randn({samples});
-  batch.advantages = at::randn({samples});
-  batch.returns = at::randn({samples});
-  return batch;
-}
 
 std::unique_ptr<torch::optim::Optimizer> ReferenceRmsprop(
     const std::vector<at::Tensor>& parameters, const std::string& arithmetic) {
@@ -68,33 +33,6 @@ std::unique_ptr<torch::optim::Optimizer> ReferenceRmsprop(
     return std::make_unique<torch::optim::RMSprop>(parameters, options);
   }
   return std::make_unique<TensorflowRmsprop>(parameters, options);
-}
-
-// Each parameter within `tolerance` of its tensor's largest magnitude.
-void ExpectSameParameters(const std::vector<at::Tensor>& got,
-                          const std::vector<at::Tensor>& want,
-                          double tolerance) {
-  ASSERT_EQ(got.size(), want.size());
-  for (size_t i = 0; i < got.size(); ++i) {
-    const double scale = std::max(1e-12, want[i].abs().max().item<double>());
-    EXPECT_LE((got[i] - want[i]).abs().max().item<double>() / scale, tolerance)
-        << "parameter " << i;
-  }
-}
-
-std::string Saved(const A2cUpdater& updater) {
-  torch::serialize::OutputArchive archive;
-  updater.Save(archive);
-  std::ostringstream bytes;
-  archive.save_to(bytes);
-  return bytes.str();
-}
-
-absl::Status LoadInto(A2cUpdater& updater, const std::string& bytes) {
-  torch::serialize::InputArchive archive;
-  std::istringstream in(bytes);
-  archive.load_from(in);
-  return updater.Load(archive);
 }
 
 // The paper's trick: a 5n-step batch is updated as n consecutive 5-step

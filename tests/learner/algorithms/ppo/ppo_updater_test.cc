@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "gtest/gtest.h"
+#include "tests/fakes/updater_fixtures.h"
 #include "tests/fakes/vector_spec.h"
 
 namespace vantage {
@@ -19,38 +20,6 @@ namespace {
 
 EnvSpec Spec(bool discrete) {
   return VectorSpec(discrete, 17, discrete ? 5 : 6);
-}
-
-struct Networks {
-  PolicyNetwork policy{nullptr};
-  ValueNetwork value{nullptr};
-};
-
-Networks MakeNetworks(const EnvSpec& spec, uint64_t seed) {
-  at::manual_seed(seed);
-  NetworkConfig config;
-  Networks n;
-  n.policy = PolicyNetwork(spec, config);
-  n.value = MakeValueNetwork(spec, config, *n.policy);
-  return n;
-}
-
-// A batch acted by the policy (actions drawn from it) whose behaviour
-// log-probabilities are those of a slightly different policy, so that
-// ratios start near 1 and some leave the clipping range.
-UpdateBatch ActedBatch(Networks& n, int64_t rows) {
-  at::NoGradGuard no_grad;
-  UpdateBatch batch;
-  batch.horizon = rows;
-  batch.streams = 1;
-  batch.observations = at::randn({rows, 17});
-  const at::Tensor output = n.policy->forward(batch.observations);
-  batch.actions = n.policy->Act(output, false, at::Generator());
-  batch.behaviour_log_probs =
-      n.policy->LogProb(output, batch.actions) + 0.2 * at::randn({rows});
-  batch.advantages = at::randn({rows});
-  batch.returns = at::randn({rows});
-  return batch;
 }
 
 PpoConfig SmallConfig() {
@@ -61,31 +30,8 @@ PpoConfig SmallConfig() {
   return config;
 }
 
-std::string Saved(const PpoUpdater& updater) {
-  torch::serialize::OutputArchive archive;
-  updater.Save(archive);
-  std::ostringstream bytes;
-  archive.save_to(bytes);
-  return bytes.str();
-}
-
-absl::Status LoadInto(PpoUpdater& updater, const std::string& bytes) {
-  torch::serialize::InputArchive archive;
-  std::istringstream in(bytes);
-  archive.load_from(in);
-  return updater.Load(archive);
-}
-
-// Each parameter within 1e-5 of its tensor's largest magnitude.
-void ExpectSameParameters(Networks& a, Networks& b, double tolerance) {
-  const std::vector<at::Tensor> pa = NetworkParameters(*a.policy, *a.value);
-  const std::vector<at::Tensor> pb = NetworkParameters(*b.policy, *b.value);
-  ASSERT_EQ(pa.size(), pb.size());
-  for (size_t i = 0; i < pa.size(); ++i) {
-    const double scale = std::max(1e-12, pb[i].abs().max().item<double>());
-    EXPECT_LE((pa[i] - pb[i]).abs().max().item<double>() / scale, tolerance)
-        << "parameter " << i;
-  }
+void ExpectSameNetworks(Networks& a, Networks& b, double tolerance) {
+  ExpectSameParameters(a.parameters(), b.parameters(), tolerance);
 }
 
 class PpoUpdaterTest : public ::testing::TestWithParam<bool> {};
@@ -101,7 +47,7 @@ TEST_P(PpoUpdaterTest, TheFlatUpdateIsTheAutogradUpdate) {
   ASSERT_TRUE(flat.flat());
   ASSERT_FALSE(autograd.flat());
   at::manual_seed(10);
-  UpdateBatch batch = ActedBatch(flat_nets, 512);
+  UpdateBatch batch = ActedBatch(spec, flat_nets, 512, 1);
   // Two updates: the second starts from Adam's state of the first; the
   // third takes the batch as one acted by an older version.
   for (int update = 0; update < 3; ++update) {
@@ -109,7 +55,7 @@ TEST_P(PpoUpdaterTest, TheFlatUpdateIsTheAutogradUpdate) {
     std::mt19937_64 rng_a(update), rng_b(update);
     const AlgorithmStats a = flat.Update(batch, 0.25 * update, rng_a);
     const AlgorithmStats b = autograd.Update(batch, 0.25 * update, rng_b);
-    ExpectSameParameters(flat_nets, autograd_nets, 1e-5);
+    ExpectSameNetworks(flat_nets, autograd_nets, 1e-5);
     for (auto [x, y, what] :
          {std::tuple{a.policy_loss, b.policy_loss, "pi"},
           {a.value_loss, b.value_loss, "value"},
@@ -143,7 +89,7 @@ TEST_P(DecoupledPpoTest, ALaggedBatchIsClippedAgainstTheProximalPolicy) {
   for (bool lagged : {false, true}) {
     Networks n = MakeNetworks(spec, 13);
     at::manual_seed(14);
-    UpdateBatch batch = ActedBatch(n, 256);
+    UpdateBatch batch = ActedBatch(spec, n, 256, 1);
     {
       at::NoGradGuard no_grad;
       batch.behaviour_log_probs =
@@ -184,7 +130,7 @@ TEST_P(DecoupledPpoTest, WithoutLagItIsPpo) {
   Networks a = MakeNetworks(spec, 15);
   Networks b = MakeNetworks(spec, 15);
   at::manual_seed(16);
-  UpdateBatch batch = ActedBatch(a, 256);
+  UpdateBatch batch = ActedBatch(spec, a, 256, 1);
   {
     at::NoGradGuard no_grad;
     batch.behaviour_log_probs =
@@ -199,7 +145,7 @@ TEST_P(DecoupledPpoTest, WithoutLagItIsPpo) {
   std::mt19937_64 rng_a(5), rng_b(5);
   fresh.Update(batch, 0.0, rng_a);
   old.Update(lagged, 0.0, rng_b);
-  ExpectSameParameters(a, b, 0.0);
+  ExpectSameNetworks(a, b, 0.0);
 }
 
 INSTANTIATE_TEST_SUITE_P(Paths, DecoupledPpoTest, ::testing::Bool());
@@ -210,7 +156,7 @@ TEST(PpoUpdaterStateTest, CheckpointsResumeExactlyAndCrossBetweenPaths) {
   Networks second = MakeNetworks(spec, 11);
   PpoUpdater a(first.policy, first.value, SmallConfig());
   at::manual_seed(12);
-  const UpdateBatch batch = ActedBatch(first, 256);
+  const UpdateBatch batch = ActedBatch(spec, first, 256, 1);
   std::mt19937_64 rng(1);
   a.Update(batch, 0.0, rng);
   const std::string state = Saved(a);
@@ -228,7 +174,7 @@ TEST(PpoUpdaterStateTest, CheckpointsResumeExactlyAndCrossBetweenPaths) {
   std::mt19937_64 rng_a(2), rng_b(2);
   a.Update(batch, 0.1, rng_a);
   b.Update(batch, 0.1, rng_b);
-  ExpectSameParameters(first, second, 0.0);
+  ExpectSameNetworks(first, second, 0.0);
 
   // The same state read by the autograd path continues alike.
   Networks third = MakeNetworks(spec, 11);
@@ -246,7 +192,7 @@ TEST(PpoUpdaterStateTest, CheckpointsResumeExactlyAndCrossBetweenPaths) {
   std::mt19937_64 rng_c(3), rng_d(3);
   a.Update(batch, 0.2, rng_c);
   c.Update(batch, 0.2, rng_d);
-  ExpectSameParameters(first, third, 1e-5);
+  ExpectSameNetworks(first, third, 1e-5);
 }
 
 }  // namespace
