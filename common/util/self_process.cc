@@ -31,7 +31,11 @@ absl::StatusOr<pid_t> SpawnSelf(const std::vector<std::string>& args,
       dup2(fd, STDERR_FILENO);
       close(fd);
     }
-    execv(self.c_str(), argv.data());
+    // By /proc/self/exe rather than its path: the file this process runs,
+    // even when a rebuild has replaced or removed the one at the path, so
+    // the children of a long run (an experiment's cells, a distributed
+    // run's restarted actors) run the code it started with, or run at all.
+    execv("/proc/self/exe", argv.data());
     _exit(127);
   }
   return pid;

@@ -13,7 +13,8 @@
 
 namespace vantage {
 
-// Runs this binary with `args` (argv[1..]) as a child process; with
+// Runs this binary with `args` (argv[1..]) as a child process (the very
+// file this process runs, though the path now holds another); with
 // `output_path`, its stdout and stderr go to that file (truncated, or
 // appended to with `append`).
 absl::StatusOr<pid_t> SpawnSelf(const std::vector<std::string>& args,
