@@ -13,6 +13,7 @@
 #include "common/nn/distributions.h"
 #include "common/nn/networks.h"
 #include "common/nn/running_mean_std.h"
+#include "common/util/scratch_buffer.h"
 
 namespace vantage {
 namespace {
@@ -27,12 +28,6 @@ std::vector<double> DoubleVector(const at::Tensor& tensor) {
   const at::Tensor flat = tensor.detach().to(at::kDouble).contiguous();
   return std::vector<double>(flat.data_ptr<double>(),
                              flat.data_ptr<double>() + flat.numel());
-}
-
-template <typename T>
-T* Grow(std::vector<T>& buffer, int64_t size) {
-  if (static_cast<int64_t>(buffer.size()) < size) buffer.resize(size);
-  return buffer.data();
 }
 
 }  // namespace
@@ -120,8 +115,8 @@ void MlpPolicyKernel::Inputs(const double* observations, int64_t rows,
 
 void MlpPolicyKernel::Forward(const double* observations, int64_t rows,
                               float* outputs) {
-  float* in = Grow(buffer_a_, rows * widest_);
-  float* out = Grow(buffer_b_, rows * widest_);
+  float* in = GrowScratch(buffer_a_, rows * widest_);
+  float* out = GrowScratch(buffer_b_, rows * widest_);
   Inputs(observations, rows, in);
   for (size_t l = 0; l < layers_.size(); ++l) {
     const Layer& layer = layers_[l];
@@ -154,7 +149,7 @@ void MlpPolicyKernel::Act(const float* outputs, int64_t rows,
     // mean + exp(log_std) * N(0, 1), and its Gaussian log-density.
     // In float, as LibTorch subtracts the constant from a float tensor.
     const float log_sqrt_two_pi = static_cast<float>(kLogSqrtTwoPi);
-    float* noise = Grow(noise_, rows * n);
+    float* noise = GrowScratch(noise_, rows * n);
     FillStandardNormal(generator, noise, rows * n);
     for (int64_t r = 0; r < rows; ++r) {
       float log_prob = 0.0f;
@@ -172,9 +167,9 @@ void MlpPolicyKernel::Act(const float* outputs, int64_t rows,
     return;
   }
   // Softmax per row, a categorical draw, and the log-softmax at it.
-  float* probabilities = Grow(probabilities_, rows * n);
-  float* maxima = Grow(row_max_, rows);
-  float* log_sums = Grow(row_log_sum_, rows);
+  float* probabilities = GrowScratch(probabilities_, rows * n);
+  float* maxima = GrowScratch(row_max_, rows);
+  float* log_sums = GrowScratch(row_log_sum_, rows);
   for (int64_t r = 0; r < rows; ++r) {
     const float* logits = outputs + r * n;
     const float top = *std::max_element(logits, logits + n);
@@ -187,7 +182,7 @@ void MlpPolicyKernel::Act(const float* outputs, int64_t rows,
     maxima[r] = top;
     log_sums[r] = std::log(sum);
   }
-  int64_t* indices = Grow(indices_, rows);
+  int64_t* indices = GrowScratch(indices_, rows);
   SampleCategorical(generator, probabilities, rows, n, indices);
   for (int64_t r = 0; r < rows; ++r) {
     actions[r] = static_cast<float>(indices[r]);

@@ -13,17 +13,9 @@
 #include "absl/strings/str_cat.h"
 #include "common/nn/distributions.h"
 #include "common/nn/networks.h"
+#include "common/util/scratch_buffer.h"
 
 namespace vantage {
-namespace {
-
-template <typename T>
-T* Grow(std::vector<T>& buffer, int64_t size) {
-  if (static_cast<int64_t>(buffer.size()) < size) buffer.resize(size);
-  return buffer.data();
-}
-
-}  // namespace
 
 absl::StatusOr<FlatActorCritic> FlatActorCritic::Create(
     PolicyNetworkImpl& policy, ValueNetworkImpl& value,
@@ -133,7 +125,7 @@ void FlatActorCritic::MlpForward(Mlp& mlp, const float* inputs, int64_t rows) {
   const float* x = inputs;
   for (size_t l = 0; l < mlp.layers.size(); ++l) {
     const Layer& layer = mlp.layers[l];
-    float* y = Grow(mlp.outputs[l], rows * layer.outputs);
+    float* y = GrowScratch(mlp.outputs[l], rows * layer.outputs);
     const float* bias = parameters_.data() + layer.bias;
     // As addmm: the bias, then the product added onto it.
     for (int64_t r = 0; r < rows; ++r) {
@@ -169,7 +161,7 @@ void FlatActorCritic::MlpBackward(Mlp& mlp, const float* inputs, int64_t rows,
       }
     }
     if (l == 0) break;
-    float* dx = Grow(scratch_, rows * layer.inputs);
+    float* dx = GrowScratch(scratch_, rows * layer.inputs);
     cblas_sgemm(CblasRowMajor, CblasNoTrans, CblasNoTrans, rows, layer.inputs,
                 layer.outputs, 1.0f, dy, layer.outputs,
                 parameters_.data() + layer.weight, layer.inputs, 0.0f, dx,
@@ -189,10 +181,10 @@ void FlatActorCritic::Forward(const float* inputs, const float* actions,
   actions_ = actions;
   MlpForward(policy_, inputs, rows);
   MlpForward(value_, inputs, rows);
-  Grow(values_, rows);
+  GrowScratch(values_, rows);
   std::memcpy(values_.data(), value_.outputs.back().data(),
               sizeof(float) * rows);
-  Grow(log_probs_, rows);
+  GrowScratch(log_probs_, rows);
   if (discrete_) {
     CategoricalHead(actions, rows);
   } else {
@@ -204,7 +196,7 @@ void FlatActorCritic::GaussianHead(const float* actions, int64_t rows) {
   const int64_t k = spec_.action_size;
   const float* mean = policy_.outputs.back().data();
   const float* log_std = parameters_.data() + log_std_;
-  float* z = Grow(head_, rows * k);
+  float* z = GrowScratch(head_, rows * k);
   const float constant = static_cast<float>(kLogSqrtTwoPi);
   for (int64_t r = 0; r < rows; ++r) {
     float sum = 0.0f;
@@ -223,8 +215,8 @@ void FlatActorCritic::GaussianHead(const float* actions, int64_t rows) {
 void FlatActorCritic::CategoricalHead(const float* actions, int64_t rows) {
   const int64_t n = spec_.action_size;
   const float* logits = policy_.outputs.back().data();
-  float* log_p = Grow(head_, rows * n);
-  float* entropies = Grow(entropies_, rows);
+  float* log_p = GrowScratch(head_, rows * n);
+  float* entropies = GrowScratch(entropies_, rows);
   double entropy_sum = 0.0;
   for (int64_t r = 0; r < rows; ++r) {
     const float* row = logits + r * n;
@@ -253,7 +245,7 @@ void FlatActorCritic::Backward(const float* d_log_probs, double entropy_weight,
                                const float* d_values) {
   const int64_t rows = rows_;
   const int64_t k = spec_.action_size;
-  float* d_output = Grow(policy_gradient_, rows * k);
+  float* d_output = GrowScratch(policy_gradient_, rows * k);
   if (discrete_) {
     const float* log_p = head_.data();
     // d entropy_r / d logit_j = -p_j (log p_j + entropy_r).
@@ -289,7 +281,7 @@ void FlatActorCritic::Backward(const float* d_log_probs, double entropy_weight,
     }
   }
   MlpBackward(policy_, inputs_, rows, policy_gradient_);
-  float* d_value = Grow(value_gradient_, rows);
+  float* d_value = GrowScratch(value_gradient_, rows);
   std::memcpy(d_value, d_values, sizeof(float) * rows);
   MlpBackward(value_, inputs_, rows, value_gradient_);
 }

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "common/util/scratch_buffer.h"
 #include "learner/algorithms/gradient_step.h"
 #include "learner/algorithms/ppo/ppo_objective.h"
 #include "learner/parallel/replica_reductions.h"
@@ -38,12 +39,10 @@ std::vector<at::Tensor> MinibatchIndices(const std::vector<int64_t>& order,
 // `rows` rows of `width` floats of `source` picked by `index` into `out`.
 void GatherRows(const float* source, int64_t width, const int64_t* index,
                 int64_t rows, std::vector<float>& out) {
-  if (static_cast<int64_t>(out.size()) < rows * width) {
-    out.resize(rows * width);
-  }
+  float* target = GrowScratch(out, rows * width);
   for (int64_t r = 0; r < rows; ++r) {
     std::copy(source + index[r] * width, source + (index[r] + 1) * width,
-              out.data() + r * width);
+              target + r * width);
   }
 }
 
