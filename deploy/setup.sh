@@ -34,13 +34,15 @@ done
 # The mujoco CMake config calls find_dependency(OpenGL) and needs Qhull's
 # config, hence libgl-dev, libopengl-dev and libqhull-dev. libgloo-dev holds
 # the headers of the Gloo engine that LibTorch's c10d runs data-parallel
-# learners on. libopenblas0-pthread takes libblas.so.3 (Debian's
+# learners on. libopenblas0-serial takes libblas.so.3 (Debian's
 # alternatives) over from the reference BLAS that LibTorch's GEMMs would
-# otherwise run on. The pthread build, not the serial one: Debian builds
-# the serial one without locking, so two threads of one process calling it
-# at once get wrong products (tests run two learner replicas as threads);
-# SetComputeThreads keeps the pthread build's GEMMs in the calling thread,
-# as the serial one computes (docs/benchmarks.md).
+# otherwise run on; serial, because every vantage process computes on one
+# thread of its own and several share the machine. Not the pthread build:
+# its 60 KB of thread-local storage leaves no room in civetweb's 100 KB
+# thread stacks once LibTorch is loaded, so no metrics endpoint starts.
+# The serial build must not be called from two threads at once (Debian
+# builds it without locks), which no vantage process does
+# (docs/benchmarks.md).
 # libblas-dev: the C interface (cblas.h) the actors' MLP policies call
 # BLAS through, linked as libblas.so.3 and so run on OpenBLAS too.
 # prometheus (with promtool) serves deploy/prometheus/watch_runs.sh;
@@ -57,7 +59,7 @@ done
 # still brings the C++ library and the linker.
 packages=(
   build-essential clang-14 cmake ninja-build ccache pkgconf openssl
-  libtorch-dev libgloo-dev libopenblas0-pthread libblas-dev
+  libtorch-dev libgloo-dev libopenblas0-serial libblas-dev
   libmujoco-dev libqhull-dev libgl-dev libopengl-dev
   libbullet-dev
   libgrpc++-dev protobuf-compiler-grpc libprotobuf-dev protobuf-compiler
@@ -87,6 +89,18 @@ command -v npm >/dev/null || test_packages+=(nodejs npm)
 wanted=("${packages[@]}")
 [[ "${with_tests}" -eq 1 ]] && wanted+=("${test_packages[@]}")
 "${repo_root}/deploy/install_packages.sh" setup.sh "${wanted[@]}"
+# A machine that also has OpenBLAS's pthread build gets it by Debian's
+# priorities (100 against the serial build's 90); vantage needs the serial
+# one (above), so it is selected by name.
+serial_blas=/usr/lib/x86_64-linux-gnu/openblas-serial
+if [[ -e /usr/lib/x86_64-linux-gnu/openblas-pthread/libopenblas.so.0 ]]; then
+  as_root=()
+  [[ "$(id -u)" -eq 0 ]] || as_root=(sudo)
+  for link in libblas.so.3 liblapack.so.3 libopenblas.so.0; do
+    "${as_root[@]}" update-alternatives --quiet \
+      --set "${link}-x86_64-linux-gnu" "${serial_blas}/${link}"
+  done
+fi
 [[ "${packages_only}" -eq 1 ]] && exit 0
 
 configure=(-G Ninja -DCMAKE_BUILD_TYPE="${build_type}")
