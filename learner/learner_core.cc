@@ -266,11 +266,14 @@ absl::StatusOr<UpdateStats> LearnerCore::Update(std::vector<Rollout> rollouts) {
         MakeUpdateBatch(*batch, *advantages, [&](const at::Tensor& raw) {
           return ObservationsForNetwork(config_.spec, normalizer_, raw, clip);
         });
+    // How many versions behind the current one each rollout's oldest step
+    // was acted.
+    std::vector<int64_t> lags;
     for (const Rollout& rollout : rollouts) {
-      if (rollout.policy_versions.min().item<int64_t>() < version_) {
-        update.lagged = true;
-      }
+      lags.push_back(version_ - rollout.policy_versions.min().item<int64_t>());
     }
+    update.lagged = std::any_of(lags.begin(), lags.end(),
+                                [](int64_t lag) { return lag > 0; });
     const int64_t samples = update.horizon * update.streams;
     const double progress =
         static_cast<double>(env_steps_) / config_.total_env_steps;
@@ -360,10 +363,7 @@ absl::StatusOr<UpdateStats> LearnerCore::Update(std::vector<Rollout> rollouts) {
     stale_steps_ += static_cast<int64_t>(sums[4]);
     unreported_ = LocalCounts();
     stats.rolled_back_updates = rolled_back_updates_;
-    for (const Rollout& rollout : rollouts) {
-      stats.rollout_policy_lags.push_back(
-          version_ - rollout.policy_versions.min().item<int64_t>());
-    }
+    stats.rollout_policy_lags = std::move(lags);
     ++version_;
     stats.policy_version = version_;
     stats.env_steps = env_steps_;
