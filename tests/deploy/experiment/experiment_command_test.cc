@@ -9,6 +9,7 @@
 
 #include <chrono>
 #include <filesystem>
+#include <fstream>
 #include <string>
 #include <thread>
 #include <vector>
@@ -44,6 +45,10 @@ const std::vector<std::string> kCells = {
     "InvertedPendulum/max-rho0.4-E1-16-64-2048/seed-0",
     "InvertedPendulum/max-rho0.4-E1-16-64-2048/seed-1",
     "InvertedPendulum/gae/seed-0", "InvertedPendulum/gae/seed-1"};
+
+void Overwrite(const std::string& path, const std::string& text) {
+  std::ofstream(path, std::ios::trunc) << text;
+}
 
 int ProgressRows(const std::string& run_dir) {
   const std::vector<std::string> lines = DeterministicProgress(run_dir);
@@ -118,6 +123,72 @@ TEST(ExperimentCommandTest, StoppedAndResumedGridEqualsAnUninterruptedOne) {
               HasSubstr("holds a run made with other settings than this "
                         "experiment's cell"));
   EXPECT_THAT(changed.err, HasSubstr("steps"));
+}
+
+// What a repository holds of a grid (experiment.json, base.json, and per
+// cell config.json and progress.csv; no checkpoints or logs) on another
+// machine: the finished cells stay, a cell committed halfway starts over
+// and ends as it would have, and a cell whose config.json was edited is
+// refused by name.
+TEST(ExperimentCommandTest, AGridAsCommittedResumesOnAnotherMachine) {
+  const std::string file = TinyExperiment("committed.json", 4096);
+  const std::string source = FreshDirectory("committed_source");
+  const Outcome whole = RunVantage(
+      absl::StrCat("experiment run ", file, " --out=", source, " --jobs=2"));
+  ASSERT_EQ(whole.exit_code, 0) << whole.err;
+  const std::string clone = FreshDirectory("committed_clone");
+  namespace fs = std::filesystem;
+  for (const char* name : {"experiment.json", "base.json"}) {
+    fs::create_directories(clone);
+    fs::copy_file(absl::StrCat(source, "/", name),
+                  absl::StrCat(clone, "/", name));
+  }
+  for (const std::string& cell : kCells) {
+    fs::create_directories(absl::StrCat(clone, "/", cell));
+    for (const char* name : {"config.json", "progress.csv"}) {
+      fs::copy_file(absl::StrCat(source, "/", cell, "/", name),
+                    absl::StrCat(clone, "/", cell, "/", name));
+    }
+  }
+  // The last cell was committed after its third update.
+  const std::string halfway = absl::StrCat(clone, "/", kCells[3]);
+  std::vector<std::string> rows = DeterministicProgress(halfway);
+  ASSERT_EQ(rows.size(), 9u);  // the header and 8 updates
+  {
+    const std::string csv = ReadFile(halfway + "/progress.csv");
+    size_t end = 0;
+    for (int line = 0; line < 4; ++line) end = csv.find('\n', end) + 1;
+    Overwrite(halfway + "/progress.csv", csv.substr(0, end));
+  }
+  ASSERT_EQ(ProgressRows(halfway), 3);
+
+  const Outcome resumed = RunVantage(
+      absl::StrCat("experiment run ", file, " --out=", clone, " --jobs=2"));
+  ASSERT_EQ(resumed.exit_code, 0) << resumed.err;
+  EXPECT_THAT(resumed.out, HasSubstr("3 finished"));
+  EXPECT_THAT(resumed.out,
+              HasSubstr(absl::StrCat(kCells[3],
+                                     " stopped before its first "
+                                     "checkpoint; starting it again")));
+  for (const std::string& cell : kCells) {
+    EXPECT_EQ(DeterministicProgress(absl::StrCat(clone, "/", cell)),
+              DeterministicProgress(absl::StrCat(source, "/", cell)))
+        << cell;
+  }
+
+  // A config.json edited by hand no longer matches its cell.
+  const std::string edited = absl::StrCat(clone, "/", kCells[1]);
+  std::string config = ReadFile(edited + "/config.json");
+  const size_t at = config.find("\"horizon\": \"512\"");
+  ASSERT_NE(at, std::string::npos) << config;
+  config.replace(at, std::string("\"horizon\": \"512\"").size(),
+                 "\"horizon\": \"256\"");
+  Overwrite(edited + "/config.json", config);
+  const Outcome refused = RunVantage(
+      absl::StrCat("experiment run ", file, " --out=", clone, " --jobs=2"));
+  EXPECT_EQ(refused.exit_code, 2);
+  EXPECT_THAT(refused.err, HasSubstr(edited));
+  EXPECT_THAT(refused.err, HasSubstr("horizon"));
 }
 
 TEST(ExperimentCommandTest, AFailedCellIsReportedAndTheOthersGoOn) {
