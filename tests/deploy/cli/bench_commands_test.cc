@@ -101,6 +101,20 @@ TEST(BenchCommandsTest, ResultLinesCarryNoColourCodes) {
   EXPECT_THAT(outcome.out, Not(HasSubstr("\033[")));
 }
 
+// limit_sps as documented: cores / (1 / raw + passes / update), with the
+// update's samples/s in the field `update_field`.
+void ExpectTheLimitOf(const std::map<std::string, std::string>& fields,
+                      const std::string& update_field, int passes) {
+  const double raw = Number(fields, "raw_steps_per_s");
+  const double update = Number(fields, update_field);
+  const double cores = Number(fields, "cores");
+  ASSERT_GT(raw, 0);
+  ASSERT_GT(update, 0);
+  ASSERT_GE(cores, 1);
+  const double limit = Number(fields, "limit_sps");
+  EXPECT_NEAR(limit, cores / (1 / raw + passes / update), 0.01 * limit + 1);
+}
+
 // The distributed main job against the machine's limit, with two learners:
 // the limit is computed as documented from the figures it prints.
 TEST(BenchCommandsTest, TrainTimesTheMainJobAgainstTheMachinesLimit) {
@@ -125,14 +139,8 @@ TEST(BenchCommandsTest, TrainTimesTheMainJobAgainstTheMachinesLimit) {
     EXPECT_EQ(fields.at("algo"), "ppo");
     EXPECT_EQ(fields.at("learners"), "2");
     EXPECT_EQ(fields.at("actors"), "2");
-    const double raw = Number(fields, "raw_steps_per_s");
-    const double bare = Number(fields, "bare_samples_per_s");
-    const double cores = Number(fields, "cores");
-    ASSERT_GT(raw, 0);
-    ASSERT_GT(bare, 0);
-    ASSERT_GE(cores, 1);
+    ExpectTheLimitOf(fields, "bare_samples_per_s", 10);
     const double limit = Number(fields, "limit_sps");
-    EXPECT_NEAR(limit, cores / (1 / raw + 10 / bare), 0.01 * limit + 1);
     EXPECT_GT(Number(fields, "sps"), 0);
     EXPECT_NEAR(Number(fields, "ratio"), Number(fields, "sps") / limit, 0.002);
     // The time splits the learners and actors printed: shares of their
@@ -162,13 +170,7 @@ TEST(BenchCommandsTest, TrainTimesA2cAgainstItsOwnUpdate) {
   const auto fields = ResultFields(outcome.out, "RESULT train ");
   EXPECT_EQ(fields.at("algo"), "a2c");
   EXPECT_EQ(fields.at("sync"), "1");
-  const double raw = Number(fields, "raw_steps_per_s");
-  const double update = Number(fields, "a2c_update_samples_per_s");
-  const double cores = Number(fields, "cores");
-  ASSERT_GT(raw, 0);
-  ASSERT_GT(update, 0);
-  const double limit = Number(fields, "limit_sps");
-  EXPECT_NEAR(limit, cores / (1 / raw + 1 / update), 0.01 * limit + 1);
+  ExpectTheLimitOf(fields, "a2c_update_samples_per_s", 1);
   EXPECT_GT(Number(fields, "sps"), 0);
   EXPECT_EQ(fields.count("bare_samples_per_s"), 0u);
 }
