@@ -10,8 +10,6 @@ Exit codes follow the vantage CLI: 0 done, 2 a usage error (flags, the
 directory and the files in it), 1 a failure while running.
 """
 
-import argparse
-import csv
 import json
 import math
 import os
@@ -22,10 +20,9 @@ import warnings
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)),
                                 "..", "plot"))
 import plot_runs  # noqa: E402  (the figures; found beside this folder)
+import run_files  # noqa: E402  (progress.csv, errors and entry, shared)
 
 PROG = "vantage experiment report"
-USAGE_ERROR = 2
-RUNTIME_ERROR = 1
 CONFIDENCE = 0.95
 RESAMPLES = 10000
 # Flags that place a cell or that the comparison is about: a group's
@@ -74,24 +71,14 @@ example:
 """
 
 
-class ReportError(Exception):
-
-  def __init__(self, message, code=USAGE_ERROR):
-    super().__init__(message)
-    self.code = code
-
-
-class _ArgumentParser(argparse.ArgumentParser):
-
-  def error(self, message):
-    raise ReportError(message)
+ReportError = run_files.CommandError
 
 
 def parse_arguments(argv):
   if any(a in ("--help", "-h", "-help") for a in argv):
     print(USAGE, end="")
     sys.exit(0)
-  parser = _ArgumentParser(prog=PROG, add_help=False)
+  parser = run_files.ArgumentParser(prog=PROG)
   parser.add_argument("exp_dir", nargs="?")
   parser.add_argument("--out", default="")
   parser.add_argument("--baseline", default="")
@@ -148,28 +135,18 @@ def read_experiment(exp_dir):
 
 def read_curve(run_dir):
   """(env_steps, mean_return) pairs of the rows with a return, or None."""
-  path = os.path.join(run_dir, "progress.csv")
-  if not os.path.isfile(path):
+  if not os.path.isfile(os.path.join(run_dir, "progress.csv")):
     return None
-  with open(path, newline="", encoding="utf-8") as f:
-    lines = [row for row in csv.reader(f) if row]
-  if len(lines) < 2:
+  columns, rows = run_files.read_progress(run_dir)
+  if not rows:
     return []
-  columns = lines[0]
-  try:
-    xi, yi = columns.index("env_steps"), columns.index("mean_return")
-  except ValueError:
-    raise ReportError(f"{path}: no env_steps or mean_return column")
-  curve = []
-  for row in lines[1:]:
-    if len(row) != len(columns):
-      break  # a torn last line of a run that was killed
-    try:
-      x, y = float(row[xi]), float(row[yi]) if row[yi] else math.nan
-    except ValueError:
-      raise ReportError(f"{path}: a row with a non-number: {','.join(row)}")
-    curve.append((x, y))
-  return curve
+  for column in ("env_steps", "mean_return"):
+    if column not in columns:
+      raise ReportError(f"{os.path.join(run_dir, 'progress.csv')}: no "
+                        f"{column} column")
+  return list(zip(
+      run_files.column_values(run_dir, columns, rows, "env_steps"),
+      run_files.column_values(run_dir, columns, rows, "mean_return")))
 
 
 class RunResult:
@@ -357,7 +334,7 @@ def make_figure(exp_dir, results, path, env):
     return False
   try:
     plot_runs.main(run_dirs + [f"--out={path}", f"--title={env}"])
-  except plot_runs.PlotError as e:
+  except run_files.CommandError as e:
     return str(e)
   return True
 
@@ -422,16 +399,4 @@ def main(argv):
 
 
 if __name__ == "__main__":
-  try:
-    sys.exit(main(sys.argv[1:]))
-  except ReportError as e:
-    print(f"{PROG}: {e}", file=sys.stderr)
-    sys.exit(e.code)
-  except KeyboardInterrupt:
-    sys.exit(130)
-  except Exception as e:  # a bug: still one line, the details on request
-    if os.environ.get("VANTAGE_REPORT_DEBUG"):
-      raise
-    print(f"{PROG}: internal error: {type(e).__name__}: {e} (set "
-          f"VANTAGE_REPORT_DEBUG=1 for the traceback)", file=sys.stderr)
-    sys.exit(RUNTIME_ERROR)
+  run_files.run(PROG, main, "VANTAGE_REPORT_DEBUG")

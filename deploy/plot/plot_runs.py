@@ -10,7 +10,6 @@ the directories and files they name), 1 a failure while running.
 """
 
 import argparse
-import csv
 import json
 import math
 import os
@@ -18,9 +17,10 @@ import re
 import sys
 import warnings
 
+import run_files  # beside this file: what `vantage experiment report` shares
+from run_files import RUNTIME_ERROR
+
 PROG = "vantage plot"
-USAGE_ERROR = 2
-RUNTIME_ERROR = 1
 
 USAGE = """\
 usage: vantage plot RUN_DIR... --out=FILE.png [flags]
@@ -119,12 +119,9 @@ LINSPACE_POINTS = 1000
 OUTPUT_FORMATS = (".png", ".pdf", ".svg")
 
 
-class PlotError(Exception):
-  """A problem with the command line or the runs it names (exit 2)."""
-
-  def __init__(self, message, code=USAGE_ERROR):
-    super().__init__(message)
-    self.code = code
+# A problem with the command line or the runs it names (exit 2 unless
+# raised while drawing).
+PlotError = run_files.CommandError
 
 
 class _NotApplicable:
@@ -148,13 +145,6 @@ def warn(message):
 
 
 # ---------------------------------------------------------------- arguments
-
-
-class _ArgumentParser(argparse.ArgumentParser):
-  """argparse that reports a bad command line as one line, exit 2."""
-
-  def error(self, message):
-    raise PlotError(f"{message} (see --help)")
 
 
 def _positive_pixels(name):
@@ -194,7 +184,8 @@ def parse_arguments(argv):
   if any(a in ("--help", "-h", "--helpfull") for a in argv):
     sys.stdout.write(USAGE)
     sys.exit(0)
-  parser = _ArgumentParser(prog=PROG, add_help=False, allow_abbrev=False)
+  parser = run_files.ArgumentParser(prog=PROG, allow_abbrev=False,
+                                    hint=" (see --help)")
   parser.add_argument("run_dirs", nargs="*", metavar="RUN_DIR")
   parser.add_argument("--out", default="")
   parser.add_argument("--x", default="env_steps")
@@ -325,26 +316,10 @@ def read_config(directory):
 
 
 def read_progress(directory):
+  columns, rows = run_files.read_progress(directory)
   path = os.path.join(directory, "progress.csv")
-  try:
-    with open(path, newline="", encoding="utf-8") as f:
-      lines = list(csv.reader(f))
-  except (OSError, UnicodeDecodeError, csv.Error) as e:
-    raise PlotError(f"{path}: cannot read it ({e})")
-  if not lines or not any(lines[0]):
+  if not columns:
     raise PlotError(f"{path}: empty (no header, no rows)")
-  columns = [c.strip() for c in lines[0]]
-  rows = lines[1:]
-  while rows and not any(rows[-1]):
-    rows.pop()
-  # A run still writing may have a partial last line; any other short row is
-  # a damaged file.
-  if rows and len(rows[-1]) != len(columns):
-    rows.pop()
-  for number, row in enumerate(rows, start=2):
-    if len(row) != len(columns):
-      raise PlotError(f"{path} line {number}: {len(row)} fields, the header "
-                      f"has {len(columns)}")
   if not rows:
     raise PlotError(f"{path}: no rows (the run has made no update yet)")
   return columns, rows
@@ -394,19 +369,7 @@ def _default_like(value):
 
 
 def column_values(run, column):
-  index = run.columns.index(column)
-  values = []
-  for number, row in enumerate(run.rows, start=2):
-    text = row[index].strip()
-    if not text:
-      values.append(math.nan)
-      continue
-    try:
-      values.append(float(text))
-    except ValueError:
-      raise PlotError(f"{os.path.join(run.directory, 'progress.csv')} line "
-                      f"{number}: {column}={text!r} is not a number") from None
-  return values
+  return run_files.column_values(run.directory, run.columns, run.rows, column)
 
 
 # ------------------------------------------------------------------- fields
@@ -785,16 +748,4 @@ def main(argv):
 
 
 if __name__ == "__main__":
-  try:
-    sys.exit(main(sys.argv[1:]))
-  except PlotError as e:
-    print(f"{PROG}: {e}", file=sys.stderr)
-    sys.exit(e.code)
-  except KeyboardInterrupt:
-    sys.exit(130)
-  except Exception as e:  # a bug: still one line, the details on request
-    if os.environ.get("VANTAGE_PLOT_DEBUG"):
-      raise
-    print(f"{PROG}: internal error: {type(e).__name__}: {e} (set "
-          f"VANTAGE_PLOT_DEBUG=1 for the traceback)", file=sys.stderr)
-    sys.exit(RUNTIME_ERROR)
+  run_files.run(PROG, main, "VANTAGE_PLOT_DEBUG")

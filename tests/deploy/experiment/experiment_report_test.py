@@ -261,6 +261,38 @@ class ReportTest(unittest.TestCase):
       self.assertTrue(
           result.stderr.startswith("vantage experiment report: "))
 
+  def test_progress_files_read_as_vantage_plot_reads_them(self):
+    # A run killed while writing leaves a torn last line: dropped, so the
+    # cell counts as unfinished. A short row before the last, or a return
+    # that is not a number, is a damaged file: refused by its line.
+    exp = os.path.join(self.root, "damaged")
+    shutil.rmtree(exp, ignore_errors=True)
+    write_experiment(exp)
+    progress = os.path.join(exp, "Hopper", "gae", "seed-0", "progress.csv")
+    with open(progress) as f:
+      lines = f.read().splitlines()
+    with open(progress, "w") as f:
+      f.write("\n".join(lines[:-1] + [lines[-1][:4]]) + "\n")
+    result = subprocess.run([VANTAGE, "experiment", "report", exp,
+                             "--no_figures"],
+                            capture_output=True, text=True, timeout=60)
+    self.assertEqual(result.returncode, 0, result.stderr)
+    with open(os.path.join(exp, "report.md")) as f:
+      self.assertIn("Unfinished, not counted: Hopper/gae/seed-0", f.read())
+    for damaged, message in [
+        (lines[:2] + ["1000,1"] + lines[2:], "line 3: 2 fields, the header "
+         "has 5"),
+        (lines[:2] + ["2000,2,lots,1,1"] + lines[3:],
+         "line 3: mean_return='lots' is not a number")]:
+      with open(progress, "w") as f:
+        f.write("\n".join(damaged) + "\n")
+      result = subprocess.run([VANTAGE, "experiment", "report", exp,
+                               "--no_figures"],
+                              capture_output=True, text=True, timeout=60)
+      self.assertEqual(result.returncode, 2, result.stderr)
+      self.assertIn(f"{progress} {message}", result.stderr)
+      self.assertEqual(result.stderr.count("\n"), 1, result.stderr)
+
 
 if __name__ == "__main__":
   VANTAGE = take_vantage_flag(sys.argv) or VANTAGE
