@@ -47,8 +47,10 @@ usage: vantage experiment report EXP_DIR [flags]
   t-test p-value, and the difference of the areas with its interval (for
   tasks whose final returns all reach the maximum). A group beats (or trails) the baseline "with
   confidence" when the interval excludes 0 and p < 0.05; the report says
-  so in words. Unfinished cells are listed, not counted. One learning-
-  curve figure per env (`vantage plot`) goes beside the report.
+  so in words. Unfinished cells are listed, not counted. A summary table
+  before the envs gives every group's verdict, difference [CI] and p on
+  each env. One learning-curve figure per env (`vantage plot`) goes
+  beside the report.
   Ends with a line `wrote FILE: E envs, G groups, R finished runs`.
 
 flags:
@@ -234,8 +236,80 @@ def verdict(difference, low, high, p):
   return "unclear"
 
 
+class Comparison:
+  """One group's final return and area against its baseline group's."""
+
+  def __init__(self, group, base, runs, base_runs):
+    self.group, self.base = group, base
+    finals = [r.final for r in runs]
+    base_finals = [r.final for r in base_runs]
+    self.runs, self.base_runs = len(finals), len(base_finals)
+    self.difference, self.low, self.high, self.p = compare(finals,
+                                                           base_finals)
+    self.auc = compare([r.auc for r in runs], [r.auc for r in base_runs])
+    self.kind = verdict(self.difference, self.low, self.high, self.p)
+
+  def interval(self):
+    return (f"{signed(self.difference)} [{signed(self.low)}, "
+            f"{signed(self.high)}]")
+
+  def cells(self):
+    difference, low, high, _ = self.auc
+    return [self.interval(), number(self.p, 3),
+            f"{signed(difference)} [{signed(low)}, {signed(high)}]"]
+
+  def sentence(self):
+    group, base = f"`{self.group}`", f"`{self.base}`"
+    counts = f"{self.runs} vs {self.base_runs} runs"
+    stated = (f"{signed(self.difference)}, 95% CI [{signed(self.low)}, "
+              f"{signed(self.high)}], p = {number(self.p, 3)} ({counts}).")
+    if self.kind == "better":
+      return (f"{group} beats {base} with confidence: "
+              f"{signed(self.difference)} final return, 95% CI "
+              f"[{signed(self.low)}, {signed(self.high)}], p = "
+              f"{number(self.p, 3)} ({counts}).")
+    if self.kind == "worse":
+      return f"{group} is worse than {base} with confidence: {stated}"
+    if self.kind == "unclear":
+      return f"{group} is not distinguishable from {base}: {stated}"
+    if min(self.runs, self.base_runs) < 2:
+      return (f"{group} vs {base}: {signed(self.difference)}; too few runs "
+              f"for a confidence interval ({counts}).")
+    return (f"{group} vs {base}: {signed(self.difference)}; every run of "
+            f"both ended at the same return, so there is no test "
+            f"({counts}).")
+
+
+def table_header(baseline_name, threshold):
+  header = ["group", "runs", "final return", "AUC (mean return)"]
+  if threshold is not None:
+    header.append(f"steps to {number(threshold)}")
+  header += [f"final - {baseline_name} [95% CI]", "Welch p",
+             f"AUC - {baseline_name} [95% CI]"]
+  return ["| " + " | ".join(header) + " |",
+          "|" + "|".join(["---"] * len(header)) + "|"]
+
+
+def group_row(group, runs, total, threshold):
+  """The cells of a group's row before its comparison."""
+  mean, sd = mean_sd([r.final for r in runs])
+  auc_mean, auc_sd = mean_sd([r.auc for r in runs])
+  row = [f"`{group}`", f"{len(runs)}/{total}",
+         f"{number(mean)} ± {number(sd)}",
+         f"{number(auc_mean)} ± {number(auc_sd)}"]
+  if threshold is not None:
+    reached = [s for s in (r.steps_to(threshold) for r in runs)
+               if s is not None]
+    median = statistics.median(reached) if reached else None
+    row.append(f"{number(median, 0)} ({len(reached)}/{len(runs)} reached)"
+               if reached else f"not reached (0/{len(runs)})")
+  return row
+
+
 def env_section(env, results, baseline_name, threshold, figure,
                 figure_problem):
+  """The env's Markdown lines, its group and finished-run counts and its
+  comparisons with the baseline."""
   groups = {}
   for result in results:
     groups.setdefault(result.cell["group"], []).append(result)
@@ -244,13 +318,7 @@ def env_section(env, results, baseline_name, threshold, figure,
     lines += [f"![learning curves on {env}]({figure})", ""]
   elif figure_problem:
     lines += [f"(No figure: {figure_problem}.)", ""]
-  header = ["group", "runs", "final return", "AUC (mean return)"]
-  if threshold is not None:
-    header.append(f"steps to {number(threshold)}")
-  header += [f"final - {baseline_name} [95% CI]", "Welch p",
-             f"AUC - {baseline_name} [95% CI]"]
-  lines += ["| " + " | ".join(header) + " |",
-            "|" + "|".join(["---"] * len(header)) + "|"]
+  lines += table_header(baseline_name, threshold)
   finished = {g: [r for r in rs if r.finished and math.isfinite(r.final)]
               for g, rs in groups.items()}
   baselines = {}
@@ -258,72 +326,67 @@ def env_section(env, results, baseline_name, threshold, figure,
     cell = runs[0].cell
     if estimator_of(cell) == baseline_name:
       baselines.setdefault(group_key(cell), group)
-  words = []
-  unfinished = []
-  no_return = []
-  for group in sorted(groups, key=lambda g: (estimator_of(
-      groups[g][0].cell) != baseline_name, g)):
+  comparisons = []
+  order = sorted(groups, key=lambda g: (estimator_of(
+      groups[g][0].cell) != baseline_name, g))
+  for group in order:
     runs = finished[group]
-    unfinished += [r.cell["dir"] for r in groups[group] if not r.finished]
-    no_return += [r.cell["dir"] for r in groups[group]
-                  if r.finished and not math.isfinite(r.final)]
-    finals = [r.final for r in runs]
-    mean, sd = mean_sd(finals)
-    auc_mean, auc_sd = mean_sd([r.auc for r in runs])
-    row = [f"`{group}`", f"{len(runs)}/{len(groups[group])}",
-           f"{number(mean)} ± {number(sd)}",
-           f"{number(auc_mean)} ± {number(auc_sd)}"]
-    if threshold is not None:
-      reached = [s for s in (r.steps_to(threshold) for r in runs)
-                 if s is not None]
-      median = statistics.median(reached) if reached else None
-      row.append(f"{number(median, 0)} ({len(reached)}/{len(runs)} reached)"
-                 if reached else f"not reached (0/{len(runs)})")
+    row = group_row(group, runs, len(groups[group]), threshold)
     base = baselines.get(group_key(groups[group][0].cell))
     if base is None or base == group or not runs or not finished[base]:
       row += ["—" if base == group else "no baseline", "", ""]
     else:
-      base_finals = [r.final for r in finished[base]]
-      difference, low, high, p = compare(finals, base_finals)
-      auc_difference, auc_low, auc_high, _ = compare(
-          [r.auc for r in runs], [r.auc for r in finished[base]])
-      row += [f"{signed(difference)} [{signed(low)}, {signed(high)}]",
-              number(p, 3),
-              f"{signed(auc_difference)} [{signed(auc_low)}, "
-              f"{signed(auc_high)}]"]
-      kind = verdict(difference, low, high, p)
-      counts = f"{len(finals)} vs {len(base_finals)} runs"
-      if kind == "better":
-        words.append(f"`{group}` beats `{base}` with confidence: "
-                     f"{signed(difference)} final return, 95% CI "
-                     f"[{signed(low)}, {signed(high)}], p = {number(p, 3)} "
-                     f"({counts}).")
-      elif kind == "worse":
-        words.append(f"`{group}` is worse than `{base}` with confidence: "
-                     f"{signed(difference)}, 95% CI [{signed(low)}, "
-                     f"{signed(high)}], p = {number(p, 3)} ({counts}).")
-      elif kind == "unclear":
-        words.append(f"`{group}` is not distinguishable from `{base}`: "
-                     f"{signed(difference)}, 95% CI [{signed(low)}, "
-                     f"{signed(high)}], p = {number(p, 3)} ({counts}).")
-      elif min(len(finals), len(base_finals)) < 2:
-        words.append(f"`{group}` vs `{base}`: {signed(difference)}; too few "
-                     f"runs for a confidence interval ({counts}).")
-      else:
-        words.append(f"`{group}` vs `{base}`: {signed(difference)}; every "
-                     f"run of both ended at the same return, so there is "
-                     f"no test ({counts}).")
+      comparisons.append(Comparison(group, base, runs, finished[base]))
+      row += comparisons[-1].cells()
     lines.append("| " + " | ".join(row) + " |")
   lines.append("")
-  lines += [f"- {w}" for w in words] or ["- No group has a baseline to be "
-                                          "compared with."]
+  lines += [f"- {c.sentence()}" for c in comparisons] or [
+      "- No group has a baseline to be compared with."]
+  unfinished = [r.cell["dir"] for g in order for r in groups[g]
+                if not r.finished]
+  no_return = [r.cell["dir"] for g in order for r in groups[g]
+               if r.finished and not math.isfinite(r.final)]
   if unfinished:
     lines += ["", f"Unfinished, not counted: {', '.join(unfinished)}."]
   if no_return:
     lines += ["", f"Finished without a completed episode in their last 100 "
               f"(no final return), not counted: {', '.join(no_return)}."]
   lines.append("")
-  return lines, len(groups), sum(len(r) for r in finished.values())
+  return lines, len(groups), sum(len(r) for r in finished.values()), \
+      comparisons
+
+
+def summary_section(comparisons_by_env, baseline_name):
+  """One table of every comparison: a group per row, an env per column."""
+  envs = [env for env, c in comparisons_by_env.items() if c]
+  if not envs:
+    return []
+  groups = sorted({c.group for env in envs for c in comparisons_by_env[env]})
+  lines = [f"## Summary: final return against `{baseline_name}`", "",
+           "Each cell: the verdict, the difference of the final returns "
+           "[95% CI] and Welch's p (details in the env's section).", "",
+           "| group | " + " | ".join(envs) + " |",
+           "|" + "|".join(["---"] * (len(envs) + 1)) + "|"]
+  for group in groups:
+    row = [f"`{group}`"]
+    for env in envs:
+      match = [c for c in comparisons_by_env[env] if c.group == group]
+      row.append(f"{match[0].kind} {match[0].interval()}, p "
+                 f"{number(match[0].p, 3)}" if match else "")
+    lines.append("| " + " | ".join(row) + " |")
+  tally = {}
+  for env in envs:
+    for c in comparisons_by_env[env]:
+      tally.setdefault(c.group, []).append(c.kind)
+  lines.append("")
+  for group in groups:
+    kinds = tally[group]
+    counted = ", ".join(f"{kind} on {kinds.count(kind)}"
+                        for kind in ("better", "worse", "unclear", "unknown")
+                        if kind in kinds)
+    lines.append(f"- `{group}`: {counted} of {len(kinds)} envs.")
+  lines.append("")
+  return lines
 
 
 def make_figure(exp_dir, results, path, env):
@@ -376,6 +439,7 @@ def main(argv):
             f"seeds and Welch's t-test; \"with confidence\" means the "
             f"interval excludes 0 and p < 0.05.", ""]
   groups_total = runs_total = 0
+  sections, comparisons = [], {}
   for env in sorted(by_env):
     figure = problem = None
     if not args.no_figures:
@@ -386,11 +450,13 @@ def main(argv):
         figure = os.path.relpath(figure_path, out_dir)
       elif drawn:
         problem = drawn
-    section, groups, runs = env_section(env, by_env[env], baseline_name,
-                                        thresholds.get(env), figure, problem)
-    lines += section
+    section, groups, runs, comparisons[env] = env_section(
+        env, by_env[env], baseline_name, thresholds.get(env), figure,
+        problem)
+    sections += section
     groups_total += groups
     runs_total += runs
+  lines += summary_section(comparisons, baseline_name) + sections
   with open(out, "w", encoding="utf-8") as f:
     f.write("\n".join(lines))
   print(f"wrote {out}: {len(by_env)} envs, {groups_total} groups, "

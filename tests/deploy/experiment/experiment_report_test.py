@@ -220,6 +220,28 @@ class ReportTest(unittest.TestCase):
     self.assertIn("`min-rho0.4-E1-16-64-2048` beats `gae` with confidence: "
                   "+208.0 final return", section)
 
+  def test_a_summary_of_every_comparison_before_the_envs(self):
+    summary = self.report.split("## Summary: final return against `gae`\n",
+                                1)[1].split("\n## ", 1)[0]
+    self.assertLess(self.report.index("## Summary"),
+                    self.report.index("## Hopper"))
+    self.assertIn("| group | Hopper | InvertedPendulum |", summary)
+    p_max = welch_p([130, 150, 170], [100, 110, 120])
+    p_min = welch_p([300, 310], [95, 99])
+    rows = {line.split(" | ")[0]: line for line in summary.splitlines()
+            if line.startswith("| `")}
+    max_row = rows["| `max-rho0.4-E1-16-64-2048`"].split(" | ")
+    self.assertTrue(max_row[1].startswith("unclear +40.0 ["), max_row)
+    self.assertTrue(max_row[1].endswith(f", p {p_max:.3f}"), max_row)
+    self.assertEqual(max_row[2], " |")  # no such group on InvertedPendulum
+    self.assertEqual(rows["| `min-rho0.4-E1-16-64-2048`"],
+                     f"| `min-rho0.4-E1-16-64-2048` |  | better +208.0 "
+                     f"[+201.0, +215.0], p {p_min:.3f} |")
+    self.assertIn("- `max-rho0.4-E1-16-64-2048`: unclear on 1 of 1 envs.",
+                  summary)
+    self.assertIn("- `min-rho0.4-E1-16-64-2048`: better on 1 of 1 envs.",
+                  summary)
+
   def test_figures_beside_the_report(self):
     for env in CURVES:
       path = os.path.join(self.exp, "figures", f"{env}.png")
