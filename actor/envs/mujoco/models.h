@@ -3,7 +3,9 @@
 
 // MJCF models built into the binary, authored for vantage from the facts
 // (bodies, joint ranges, gears, masses, timesteps) of the Gymnasium v4
-// MuJoCo tasks; loaded through MuJoCo's virtual file system.
+// MuJoCo tasks; loaded through MuJoCo's virtual file system. Each is a file
+// in assets/ (snake_case.xml defines kSnakeCaseXml), embedded at build time
+// by assets/embed.cmake.
 
 namespace vantage {
 

@@ -1,0 +1,26 @@
+# Writes OUT, a C++ file defining `extern const char k<Name>Xml[]` for each
+# MJCF file in FILES (a ;-list): snake_case.xml becomes kSnakeCaseXml, each
+# the file's bytes as a raw string literal. Run at build time by
+# actor/CMakeLists.txt (cmake -P), so an edited model rebuilds the binary.
+set(body "// Generated from actor/envs/mujoco/assets/*.xml by embed.cmake.\n")
+string(APPEND body "#include \"actor/envs/mujoco/models.h\"\n\n")
+string(APPEND body "namespace vantage {\n")
+foreach(file IN LISTS FILES)
+  get_filename_component(stem "${file}" NAME_WE)
+  string(REPLACE "_" ";" words "${stem}")
+  set(symbol "k")
+  foreach(word IN LISTS words)
+    string(SUBSTRING "${word}" 0 1 first)
+    string(SUBSTRING "${word}" 1 -1 rest)
+    string(TOUPPER "${first}" first)
+    string(APPEND symbol "${first}${rest}")
+  endforeach()
+  file(READ "${file}" xml)
+  string(FIND "${xml}" ")mjcf\"" clash)
+  if(NOT clash EQUAL -1)
+    message(FATAL_ERROR "${file} contains the raw-string delimiter )mjcf\"")
+  endif()
+  string(APPEND body "\nextern const char ${symbol}Xml[] = R\"mjcf(${xml})mjcf\";\n")
+endforeach()
+string(APPEND body "\n}  // namespace vantage\n")
+file(WRITE "${OUT}" "${body}")
