@@ -2,11 +2,15 @@
 
 #include <ATen/ATen.h>
 #include <torch/nn/utils/clip_grad.h>
+#include <torch/optim/adam.h>
 #include <torch/optim/optimizer.h>
+#include <torch/optim/rmsprop.h>
 #include <torch/serialize/archive.h>
 
 #include <cmath>
 #include <cstdio>
+#include <sstream>
+#include <utility>
 
 #include "absl/strings/str_cat.h"
 #include "learner/archive_io.h"
@@ -112,16 +116,91 @@ void SaveOptimizer(const torch::optim::Optimizer& optimizer,
   archive.write(key, state);
 }
 
+namespace {
+
+// The tensors of one parameter's optimiser state that must have the
+// parameter's shape (those of the optimisers the learner uses; undefined
+// ones, such as Adam's max_exp_avg_sq without amsgrad, are skipped).
+std::vector<std::pair<const char*, at::Tensor>> ShapedState(
+    const torch::optim::OptimizerParamState& state) {
+  if (const auto* adam =
+          dynamic_cast<const torch::optim::AdamParamState*>(&state)) {
+    return {{"exp_avg", adam->exp_avg()},
+            {"exp_avg_sq", adam->exp_avg_sq()},
+            {"max_exp_avg_sq", adam->max_exp_avg_sq()}};
+  }
+  if (const auto* rmsprop =
+          dynamic_cast<const torch::optim::RMSpropParamState*>(&state)) {
+    return {{"square_avg", rmsprop->square_avg()},
+            {"momentum_buffer", rmsprop->momentum_buffer()},
+            {"grad_avg", rmsprop->grad_avg()}};
+  }
+  return {};
+}
+
+std::string ShapeText(at::IntArrayRef sizes) {
+  std::string text = "[";
+  for (size_t i = 0; i < sizes.size(); ++i) {
+    absl::StrAppend(&text, i == 0 ? "" : ", ", sizes[i]);
+  }
+  return text + "]";
+}
+
+// LibTorch restores an optimiser's state by parameter position without
+// looking at shapes, so a state saved for other networks would load and
+// only fail (or silently broadcast) at the next step.
+absl::Status CheckStateShapes(const torch::optim::Optimizer& optimizer,
+                              const std::string& key) {
+  int index = 0;
+  for (const auto& group : optimizer.param_groups()) {
+    for (const at::Tensor& parameter : group.params()) {
+      const auto found = optimizer.state().find(
+          c10::guts::to_string(parameter.unsafeGetTensorImpl()));
+      if (found != optimizer.state().end()) {
+        for (const auto& [name, tensor] : ShapedState(*found->second)) {
+          if (tensor.defined() && tensor.sizes() != parameter.sizes()) {
+            return absl::InvalidArgumentError(
+                absl::StrCat("optimiser state '", key, "' does not fit: its ",
+                             name, " of parameter ", index, " has shape ",
+                             ShapeText(tensor.sizes()), ", the parameter ",
+                             ShapeText(parameter.sizes())));
+          }
+        }
+      }
+      ++index;
+    }
+  }
+  return absl::OkStatus();
+}
+
+}  // namespace
+
 absl::Status LoadOptimizer(torch::optim::Optimizer& optimizer,
                            const std::string& key,
                            torch::serialize::InputArchive& archive) {
-  return CatchTorchErrors(
+  // The state before, to put back when the saved one does not fit.
+  std::stringstream before;
+  {
+    torch::serialize::OutputArchive saved;
+    optimizer.save(saved);
+    saved.save_to(before);
+  }
+  absl::Status status = CatchTorchErrors(
       absl::StrCat("optimiser state '", key, "' is missing or does not fit"),
       [&] {
         torch::serialize::InputArchive state;
         archive.read(key, state);
         optimizer.load(state);
       });
+  if (status.ok()) status = CheckStateShapes(optimizer, key);
+  if (!status.ok()) {
+    CatchTorchErrors("the optimiser's own state", [&] {
+      torch::serialize::InputArchive saved;
+      saved.load_from(before);
+      optimizer.load(saved);
+    }).IgnoreError();  // the error to report is the first one
+  }
+  return status;
 }
 
 }  // namespace vantage

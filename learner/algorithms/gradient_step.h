@@ -72,7 +72,9 @@ class MeanStats {
 };
 
 // Checkpoint helpers: an optimiser's state under `key`. Loading a state
-// that does not fit the optimiser is an InvalidArgument error.
+// that does not fit the optimiser (missing, or a tensor whose shape is not
+// its parameter's) is an InvalidArgument error and leaves the optimiser as
+// it was.
 void SaveOptimizer(const torch::optim::Optimizer& optimizer,
                    const std::string& key,
                    torch::serialize::OutputArchive& archive);
