@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <deque>
+#include <fstream>
 #include <set>
 
 #include "absl/flags/commandlineflag.h"
@@ -9,11 +11,13 @@
 #include "absl/flags/parse.h"
 #include "absl/flags/reflection.h"
 #include "absl/status/status.h"
+#include "absl/strings/ascii.h"
 #include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_join.h"
 #include "absl/strings/str_replace.h"
 #include "absl/strings/str_split.h"
+#include "absl/strings/strip.h"
 
 namespace vantage {
 namespace {
@@ -45,7 +49,7 @@ absl::Status NotOwn(const Command& command, absl::string_view flag) {
 // The flags on the command line itself, each checked to be the command's
 // own and to parse, so that a mistake is a message naming the command and
 // exit 2 rather than absl's exit 1. Flags inside --flagfile files are
-// checked after parsing (CheckFlagsFromFiles).
+// on the command line by then (ExpandFlagfiles).
 absl::Status CheckCommandLineFlags(const Command& command, int argc,
                                    char** argv) {
   for (int i = 2; i < argc; ++i) {
@@ -100,8 +104,66 @@ absl::Status CheckCommandLineFlags(const Command& command, int argc,
   return absl::OkStatus();
 }
 
-// Flags set from a --flagfile or the environment are held to the same rule.
-absl::Status CheckFlagsFromFiles(const Command& command) {
+// --flagfile=FILE[,FILE...] (or --flagfile FILE) replaced by the flags in
+// the files, one per line ('#' starts a comment line, blank lines are
+// skipped, a file may name more files), so that their flags are checked as
+// the command line's are: absl's own reading exits 1 on a mistake in them.
+// The expanded arguments are kept in `storage`.
+absl::Status ExpandFlagfiles(std::vector<char*>& arguments,
+                             std::deque<std::string>& storage, int depth = 0) {
+  if (depth > 8) {
+    return absl::InvalidArgumentError(
+        "--flagfile: files name each other more than 8 deep (a cycle?)");
+  }
+  std::vector<char*> expanded;
+  for (size_t i = 0; i < arguments.size(); ++i) {
+    absl::string_view arg = arguments[i];
+    if (arg == "--") {
+      expanded.insert(expanded.end(), arguments.begin() + i, arguments.end());
+      break;
+    }
+    absl::string_view value;
+    if (absl::ConsumePrefix(&arg, "--flagfile=") ||
+        absl::ConsumePrefix(&arg, "-flagfile=")) {
+      value = arg;
+    } else if ((arg == "--flagfile" || arg == "-flagfile") &&
+               i + 1 < arguments.size()) {
+      value = arguments[++i];
+    } else {
+      expanded.push_back(arguments[i]);
+      continue;
+    }
+    for (absl::string_view path : absl::StrSplit(value, ',')) {
+      std::ifstream file{std::string(path)};
+      if (!file) {
+        return absl::InvalidArgumentError(
+            absl::StrCat("--flagfile=", path, ": cannot read it"));
+      }
+      std::vector<char*> flags;
+      std::string line;
+      for (int number = 1; std::getline(file, line); ++number) {
+        const absl::string_view flag = absl::StripAsciiWhitespace(line);
+        if (flag.empty() || flag[0] == '#') continue;
+        if (flag[0] != '-') {
+          return absl::InvalidArgumentError(
+              absl::StrCat("--flagfile=", path, " line ", number, ": '", flag,
+                           "' is not a flag (one --name=value per line)"));
+        }
+        flags.push_back(storage.emplace_back(flag).data());
+      }
+      if (absl::Status status = ExpandFlagfiles(flags, storage, depth + 1);
+          !status.ok()) {
+        return status;
+      }
+      expanded.insert(expanded.end(), flags.begin(), flags.end());
+    }
+  }
+  arguments = std::move(expanded);
+  return absl::OkStatus();
+}
+
+// Flags set from the environment (--fromenv) are held to the same rule.
+absl::Status CheckFlagsFromEnvironment(const Command& command) {
   std::vector<std::string> names;
   for (const auto& [name, flag] : absl::GetAllFlags()) {
     if (FlagSourceFlags().count(name) == 0 && FlagGiven(name) &&
@@ -225,6 +287,11 @@ int RunCommandLine(const std::vector<Command>& commands, int argc,
   }
   std::vector<char*> arguments(argv, argv + argc);
   if (command->take_own_arguments) command->take_own_arguments(arguments);
+  std::deque<std::string> from_files;
+  if (absl::Status status = ExpandFlagfiles(arguments, from_files);
+      !status.ok()) {
+    return CommandFailure(name, kUsageError, std::string(status.message()));
+  }
   argc = static_cast<int>(arguments.size());
   argv = arguments.data();
   if (absl::Status status = CheckCommandLineFlags(*command, argc, argv);
@@ -232,7 +299,7 @@ int RunCommandLine(const std::vector<Command>& commands, int argc,
     return CommandFailure(name, kUsageError, std::string(status.message()));
   }
   const std::vector<char*> positional = absl::ParseCommandLine(argc, argv);
-  if (absl::Status status = CheckFlagsFromFiles(*command); !status.ok()) {
+  if (absl::Status status = CheckFlagsFromEnvironment(*command); !status.ok()) {
     return CommandFailure(name, kUsageError, std::string(status.message()));
   }
   // positional[0] is the program, positional[1] the command.

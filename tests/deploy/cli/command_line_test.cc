@@ -146,6 +146,35 @@ TEST(CommandLineTest, AFlagfileIsTheCommandLine) {
   EXPECT_THAT(foreign.err, HasSubstr("--rho is not a flag of `vantage envs`"));
 }
 
+// A mistake inside a flagfile is a usage error (exit 2) naming the flag or
+// the line, as the same mistake on the command line is.
+TEST(CommandLineTest, MistakesInAFlagfileAreUsageErrors) {
+  const struct {
+    std::string lines;
+    std::string message;
+  } cases[] = {
+      {"--steps=64\n--no_such_flag=1\n", "unknown flag --no_such_flag"},
+      {"# a comment\n\n--steps=many\n", "--steps=many: "},
+      {"--steps=64\nsteps=64\n",
+       "line 2: 'steps=64' is not a flag (one --name=value per line)"},
+      {"--flagfile=/no/such/file.flags\n",
+       "--flagfile=/no/such/file.flags: cannot read it"},
+  };
+  int index = 0;
+  for (const auto& [lines, message] : cases) {
+    const std::string file =
+        WriteTemp(absl::StrCat("mistake", index++, ".flags"), lines);
+    const Outcome outcome = RunVantage("train --flagfile " + file);
+    EXPECT_EQ(outcome.exit_code, 2) << lines << outcome.err;
+    EXPECT_THAT(outcome.err, HasSubstr(message)) << lines;
+    EXPECT_THAT(outcome.err, HasSubstr("vantage train: ")) << lines;
+  }
+  const Outcome missing = RunVantage("train --flagfile=/no/such.flags");
+  EXPECT_EQ(missing.exit_code, 2);
+  EXPECT_THAT(missing.err, HasSubstr("--flagfile=/no/such.flags: cannot "
+                                     "read it"));
+}
+
 // For each algorithm: what `vantage help train` says an absent flag means
 // is what a fresh run's config.json holds, and the run does it (each
 // update consumes envs x horizon steps).
