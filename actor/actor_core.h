@@ -43,6 +43,8 @@ class ActorCore {
 
   const EnvSpec& spec() const { return envs_->spec(); }
   int64_t policy_version() const { return version_; }
+  // The seed its environments were created with.
+  uint64_t env_seed() const { return config_.seed; }
   // The id segments carry. A learner assigns one per registration, so an
   // actor that registers again (after the learner restarted) starts new
   // streams that are never stitched onto the old ones.

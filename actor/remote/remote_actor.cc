@@ -132,7 +132,10 @@ class Session {
       }
       actor_config.num_envs = config_.num_envs;
       actor_config.segment_length = run.training().segment_length();
-      actor_config.seed = config_.seed;
+      actor_config.seed =
+          config_.seed.has_value()
+              ? *config_.seed
+              : ActorEnvSeed(run.training().seed(), response.actor_id());
       actor_config.actor_id = response.actor_id();
       actor_config.network.hidden.assign(run.training().hidden().begin(),
                                          run.training().hidden().end());
@@ -153,9 +156,12 @@ class Session {
     if (absl::Status status = Apply(response.weights(), *actor); !status.ok()) {
       return status;
     }
-    std::fprintf(stderr, "%s: registered as actor %ld, policy version %ld\n",
+    std::fprintf(stderr,
+                 "%s: registered as actor %ld, policy version %ld, env seed "
+                 "%llu\n",
                  config_.name.c_str(), static_cast<long>(response.actor_id()),
-                 static_cast<long>(actor->policy_version()));
+                 static_cast<long>(actor->policy_version()),
+                 static_cast<unsigned long long>(actor->env_seed()));
 
     WeightsSlot slot;
     grpc::ClientContext subscription_context;
@@ -272,6 +278,17 @@ class TimeSplitReport {
 };
 
 }  // namespace
+
+uint64_t ActorEnvSeed(uint64_t run_seed, int64_t actor_id) {
+  // SplitMix64's output for state run_seed + (id + 1) * its odd increment:
+  // each step a bijection of 64-bit words, so distinct ids never share a
+  // seed, and the seeds scatter far from the launcher's run_seed + i.
+  uint64_t z =
+      run_seed + 0x9E3779B97F4A7C15ULL * (static_cast<uint64_t>(actor_id) + 1);
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ULL;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBULL;
+  return z ^ (z >> 31);
+}
 
 absl::Status RunRemoteActor(const RemoteActorConfig& config,
                             const std::atomic<bool>& stop) {

@@ -5,6 +5,7 @@
 
 #include <atomic>
 #include <cstdint>
+#include <optional>
 #include <string>
 
 #include "absl/status/status.h"
@@ -17,7 +18,10 @@ struct RemoteActorConfig {
   std::string learner = "127.0.0.1:50051";  // HOST:PORT
   std::string env = "InvertedPendulum";
   int num_envs = 1;
-  uint64_t seed = 0;
+  // The environments' seed. Absent: ActorEnvSeed of the run's seed and the
+  // actor id of the registration, so that actors started with the same
+  // flags (a Deployment's pods) reset their environments differently.
+  std::optional<uint64_t> seed;
   std::string name = "actor";
   // Reconnection attempts after the learner went away or refused; 0: give
   // up at the first failure, -1: forever.
@@ -31,6 +35,12 @@ struct RemoteActorConfig {
   // If set, the metrics port goes there once serving (see port_file.h).
   std::string metrics_port_file;
 };
+
+// A seed for the environments of the actor registered as `actor_id` in a
+// run seeded `run_seed`: distinct for distinct ids (a bijection of the id
+// for a given run seed) and scattered far from the seeds run_seed + i that the
+// launcher gives its own actors.
+uint64_t ActorEnvSeed(uint64_t run_seed, int64_t actor_id);
 
 // Registers, acts with the newest weights (picked up between segments; in
 // a sync run it waits for version v + 1 after each horizon), streams

@@ -29,7 +29,7 @@ int RunActor(const std::vector<std::string>&) {
   config.learner = absl::GetFlag(FLAGS_learner);
   if (FlagGiven("env")) config.env = absl::GetFlag(FLAGS_env);
   config.num_envs = absl::GetFlag(FLAGS_envs);
-  config.seed = absl::GetFlag(FLAGS_seed);
+  if (FlagGiven("seed")) config.seed = absl::GetFlag(FLAGS_seed);
   config.name = absl::GetFlag(FLAGS_name);
   config.max_reconnects = absl::GetFlag(FLAGS_max_reconnects);
   config.metrics_address = absl::GetFlag(FLAGS_metrics);
@@ -61,7 +61,9 @@ Command ActorCommand() {
       "policy and streams trajectory segments to it, reconnecting with\n"
       "backoff when the learner goes away (its environments kept). Ends at\n"
       "SIGINT/SIGTERM (exit 0) or when the learner refuses it or the\n"
-      "reconnects run out (exit 1).";
+      "reconnects run out (exit 1). Without --seed its environments' seed\n"
+      "comes from the run's seed and the actor id the learner assigns, so\n"
+      "actors started alike (a Deployment's pods) reset differently.";
   command.flags = {
       "learner",           "env",           "envs", "seed", "name", "metrics",
       "metrics_port_file", "max_reconnects"};

@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <set>
 #include <string>
 #include <thread>
 #include <vector>
@@ -48,13 +49,16 @@ void ExpectSyncWithOneActorReproducesLocalMode(const std::string& tag,
       RunVantage("train --mode=local " + run + " --run_dir=" + local).exit_code,
       0);
   const Learner learner = StartLearner(run + " --run_dir=" + remote);
+  const std::string actor_err = TempPath("actor.err");
   const int actor =
       StartVantage("actor --learner=127.0.0.1:" + learner.port +
                        " --env=InvertedPendulum --envs=2 --seed=5",
-                   TempPath("actor.out"), TempPath("actor.err"));
+                   TempPath("actor.out"), actor_err);
   EXPECT_EQ(WaitVantage(learner.pid, 120), 0) << ReadFile(learner.err);
   kill(actor, SIGTERM);
   EXPECT_EQ(WaitVantage(actor, 20), 0);
+  // A --seed given is the environments' seed, as in local mode.
+  EXPECT_THAT(ReadFile(actor_err), HasSubstr(", env seed 5\n"));
   EXPECT_THAT(ReadFile(learner.out), HasSubstr("RESULT train"));
   const std::vector<std::string> expected = DeterministicProgress(local);
   ASSERT_EQ(expected.size(), 1u + 6);
@@ -84,23 +88,32 @@ TEST(DistributedTest, SyncWithOneActorReproducesLocalModeWithEx2) {
 }
 
 // Two actors of two envs each fill the learner's four-stream batches: no
-// update can happen without both.
+// update can happen without both. Started with the same flags and no
+// --seed (as a Deployment's pods are), their environments get different
+// seeds from their registrations.
 TEST(DistributedTest, TwoActorsFeedOneLearner) {
   const std::string run = FreshDirectory("two");
   const Learner learner = StartLearner(
       "--steps=4096 --horizon=256 --envs=4 --seed=1 --run_dir=" + run);
   std::vector<int> actors;
+  std::vector<std::string> logs;
   for (int i = 0; i < 2; ++i) {
-    actors.push_back(StartVantage(
-        "actor --learner=127.0.0.1:" + learner.port +
-            " --env=InvertedPendulum --envs=2 --seed=" + std::to_string(10 + i),
-        TempPath("a.out"), TempPath("a.err")));
+    logs.push_back(TempPath("a.err"));
+    actors.push_back(StartVantage("actor --learner=127.0.0.1:" + learner.port +
+                                      " --env=InvertedPendulum --envs=2",
+                                  TempPath("a.out"), logs.back()));
   }
   EXPECT_EQ(WaitVantage(learner.pid, 120), 0) << ReadFile(learner.err);
-  for (int pid : actors) {
-    kill(pid, SIGTERM);
-    EXPECT_EQ(WaitVantage(pid, 20), 0);
+  std::set<std::string> seeds;
+  for (int i = 0; i < 2; ++i) {
+    kill(actors[i], SIGTERM);
+    EXPECT_EQ(WaitVantage(actors[i], 20), 0);
+    const std::string log = ReadFile(logs[i]);
+    const size_t at = log.find(", env seed ");
+    ASSERT_NE(at, std::string::npos) << log;
+    seeds.insert(log.substr(at, log.find('\n', at) - at));
   }
+  EXPECT_EQ(seeds.size(), 2u) << *seeds.begin();
   const std::vector<std::string> rows = DeterministicProgress(run);
   ASSERT_EQ(rows.size(), 1u + 4);
   EXPECT_THAT(rows[4], ::testing::StartsWith("4096,4,4,"));
@@ -237,7 +250,7 @@ TEST(DistributedTest, AKilledLearnerResumesFromItsLastCheckpoint) {
   // acts with the checkpoint's policy.
   EXPECT_THAT(log, HasSubstr(absl::StrCat("registered as actor 1, policy "
                                           "version ",
-                                          version, "\n")));
+                                          version, ", env seed ")));
   const std::vector<std::string> rows = DeterministicProgress(run);
   ASSERT_EQ(rows.size(), 1u + 8) << absl::StrJoin(rows, "\n");
   for (int v = 1; v <= 8; ++v) {

@@ -568,6 +568,19 @@ def run_test(args, scratch, pods):
                      f"{tail(pod.log)}")
     print("ok: the same actor processes reconnected by themselves", flush=True)
 
+    # The pods run the same args: their environments' seeds must still
+    # differ, or every actor would replay the same resets.
+    seeds = {}
+    for pod in actors:
+        with open(pod.log, errors="replace") as f:
+            found = re.search(r"registered as actor \d+, .*env seed (\d+)", f.read())
+        if not found:
+            fail(f"{pod.name} did not log its env seed: {tail(pod.log)}")
+        seeds[pod.name] = found.group(1)
+    if len(actors) > 1 and len(set(seeds.values())) != len(actors):
+        fail(f"actor pods share env seeds: {seeds}")
+    print(f"ok: the actor pods' env seeds differ: {seeds}", flush=True)
+
     for pod in actors:
         pod.process.send_signal(signal.SIGTERM)
     for pod in actors:
