@@ -390,6 +390,12 @@ absl::Status RunDistributedTraining(const LaunchConfig& config,
     }
     for (int i = 0; done > 0 && i < run.distributed().actors(); ++i) {
       if (actors[i] != done) continue;
+      // Exit 0: the learner told it the run is complete; the learner's own
+      // exit follows.
+      if (WIFEXITED(status) && WEXITSTATUS(status) == 0) {
+        actors[i] = -1;
+        break;
+      }
       if (actor_restarts >= config.max_actor_restarts) {
         actors[i] = -1;
         result = absl::InternalError(

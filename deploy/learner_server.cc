@@ -315,6 +315,10 @@ absl::Status RunLearnerServer(
       std::fprintf(stderr, "learner: no checkpoint at the stop: %s\n",
                    std::string(status.message()).c_str());
     }
+  } else {
+    // Complete: the actors are told so (and exit), rather than finding
+    // the learner gone and reconnecting to it forever.
+    gateway.FinishRun();
   }
   return finish(absl::OkStatus());
 }

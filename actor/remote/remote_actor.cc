@@ -82,12 +82,24 @@ class WeightsSlot {
     std::lock_guard<std::mutex> lock(mutex_);
     return weights_;
   }
-  void End() { ended_ = true; }
+  // The subscription ended with `status` (how the learner finished it).
+  void End(absl::Status status) {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      end_status_ = std::move(status);
+    }
+    ended_ = true;
+  }
   bool ended() const { return ended_; }
+  absl::Status end_status() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return end_status_;
+  }
 
  private:
   mutable std::mutex mutex_;
   std::shared_ptr<const pb::Weights> weights_;
+  absl::Status end_status_;
   std::atomic<bool> ended_{false};
 };
 
@@ -175,7 +187,7 @@ class Session {
     std::thread reader([&] {
       pb::Weights weights;
       while (subscription->Read(&weights)) slot.Put(weights);
-      slot.End();
+      slot.End(FromGrpc(subscription->Finish(), "weights subscription"));
     });
 
     grpc::ClientContext stream_context;
@@ -222,7 +234,10 @@ class Session {
         if (!status.ok()) break;
       }
       if (slot.ended()) {
-        status = absl::UnavailableError("the weights subscription ended");
+        status = slot.end_status();
+        if (status.ok()) {
+          status = absl::UnavailableError("the weights subscription ended");
+        }
         break;
       }
       const double inference_before = actor->inference_seconds();
@@ -245,6 +260,8 @@ class Session {
     subscription_context.TryCancel();
     reader.join();
     if (stop) return absl::OkStatus();
+    // The run's end outranks the segment stream's, cut by the shutdown.
+    if (absl::IsOutOfRange(status)) return status;
     return finished.ok() ? status : finished;
   }
 
@@ -329,6 +346,12 @@ absl::Status RunRemoteActor(const RemoteActorConfig& config,
     bool progressed = false;
     const absl::Status status = session.Run(spec, actor, stop, progressed);
     if (stop) break;
+    if (absl::IsOutOfRange(status)) {
+      // The learner completed the run (registration or subscription).
+      std::fprintf(stderr, "%s: %s; exiting\n", config.name.c_str(),
+                   std::string(status.message()).c_str());
+      break;
+    }
     if (IsRefusal(status)) return status;
     if (progressed) {
       failures = 0;

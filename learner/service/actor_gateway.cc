@@ -88,6 +88,7 @@ absl::StatusOr<pb::RegisterResponse> ActorGateway::Register(
   std::string secret = NewSecret();
   {
     std::unique_lock<std::mutex> lock(mutex_);
+    if (run_over_) return absl::OutOfRangeError(kRunOver);
     if (closed_) return absl::UnavailableError("the learner is shutting down");
     if (static_cast<int64_t>(actors_.size()) >=
             config_.limits.max_live_actors ||
@@ -314,6 +315,18 @@ void ActorGateway::Close() {
 bool ActorGateway::closed() const {
   std::lock_guard<std::mutex> lock(mutex_);
   return closed_;
+}
+
+void ActorGateway::FinishRun() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  run_over_ = true;
+  closed_ = true;
+  changed_.notify_all();
+}
+
+bool ActorGateway::run_over() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return run_over_;
 }
 
 GatewayCounters ActorGateway::counters() const {

@@ -27,6 +27,9 @@
 
 namespace vantage {
 
+// What actors are told once the run is complete (OUT_OF_RANGE).
+inline constexpr char kRunOver[] = "the run is over: every step is done";
+
 // What one client can make the learner hold. Defaults suit a cluster run of
 // a few hundred actors; every one is a flag of `vantage learner`.
 struct GatewayLimits {
@@ -148,6 +151,12 @@ class ActorGateway {
   // Wakes every waiter; no more registrations or weights.
   void Close();
   bool closed() const;
+  // Closes because the run is complete: registrations and weight
+  // subscriptions then end with kRunOver's OUT_OF_RANGE, which actors take
+  // as the end of their work (a plain Close is a learner going away, after
+  // which they reconnect).
+  void FinishRun();
+  bool run_over() const;
 
   GatewayCounters counters() const;
   // One entry per live registration, by actor id.
@@ -174,6 +183,7 @@ class ActorGateway {
   int64_t next_actor_id_ = 0;
   std::shared_ptr<const pb::Weights> weights_;
   bool closed_ = false;
+  bool run_over_ = false;
   GatewayCounters counters_;
 };
 

@@ -246,6 +246,9 @@ grpc::Status LearnerService::StreamedSubscribeWeights(
       Touch(*key);
       known = weights->version();
     }
+    if (gateway_.run_over()) {
+      return grpc::Status(grpc::StatusCode::OUT_OF_RANGE, kRunOver);
+    }
     return grpc::Status::OK;
   });
   CloseBoundCall(*key, actor_id);

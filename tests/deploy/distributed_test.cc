@@ -32,6 +32,7 @@ namespace vantage {
 namespace {
 
 using ::testing::HasSubstr;
+using ::testing::Not;
 
 constexpr char kRun[] = "--steps=3072 --horizon=256 --envs=2 --seed=5";
 
@@ -90,7 +91,9 @@ TEST(DistributedTest, SyncWithOneActorReproducesLocalModeWithEx2) {
 // Two actors of two envs each fill the learner's four-stream batches: no
 // update can happen without both. Started with the same flags and no
 // --seed (as a Deployment's pods are), their environments get different
-// seeds from their registrations.
+// seeds from their registrations. When the run is complete the learner
+// tells them so, and they exit 0 by themselves instead of reconnecting
+// (forever, by default) to a learner that is gone.
 TEST(DistributedTest, TwoActorsFeedOneLearner) {
   const std::string run = FreshDirectory("two");
   const Learner learner = StartLearner(
@@ -106,9 +109,11 @@ TEST(DistributedTest, TwoActorsFeedOneLearner) {
   EXPECT_EQ(WaitVantage(learner.pid, 120), 0) << ReadFile(learner.err);
   std::set<std::string> seeds;
   for (int i = 0; i < 2; ++i) {
-    kill(actors[i], SIGTERM);
-    EXPECT_EQ(WaitVantage(actors[i], 20), 0);
+    EXPECT_EQ(WaitVantage(actors[i], 20), 0) << ReadFile(logs[i]);
     const std::string log = ReadFile(logs[i]);
+    EXPECT_THAT(log, HasSubstr("the run is over: every step is done; "
+                               "exiting"));
+    EXPECT_THAT(log, Not(HasSubstr("reconnecting")));
     const size_t at = log.find(", env seed ");
     ASSERT_NE(at, std::string::npos) << log;
     seeds.insert(log.substr(at, log.find('\n', at) - at));

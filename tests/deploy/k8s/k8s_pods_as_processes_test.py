@@ -29,8 +29,9 @@ it is SIGKILLed and started again with the same args and claim: it must
 say it resumes, the same actor processes must reconnect by themselves, and
 the learner must finish (exit 0) with progress.csv holding one row per
 update (the rows up to the checkpoint unchanged, none missing, none twice)
-and the run's final step count. The actors then end at SIGTERM (exit 0)
-within the pod's grace period. No process is left behind.
+and the run's final step count. The actors, told by the finishing learner
+that the run is over, then end by themselves (exit 0) within the pod's
+grace period. No process is left behind.
 """
 
 import argparse
@@ -56,6 +57,8 @@ import k8s_render  # noqa: E402
 from k8s_render import TestFailure  # noqa: E402
 
 LEARNER = ("StatefulSet", "vantage-learner")
+# What an actor logs when the learner tells it the run is complete.
+RUN_OVER = "the run is over: every step is done; exiting"
 ACTOR = ("Deployment", "vantage-actor")
 SERVICE = ("Service", "vantage-learner")
 # Generous bounds for a loaded two-core machine; the base's run is about
@@ -535,7 +538,10 @@ def run_test(args, scratch, pods):
     deadline = time.monotonic() + RUN_TIMEOUT_S
     while learner.alive():
         for pod in actors:
-            if not pod.alive():
+            # Exit 0 once told the run is over, which the learner says as it
+            # finishes; any other exit is a failure.
+            if not pod.alive() and not (pod.process.returncode == 0 and
+                                        RUN_OVER in open(pod.log).read()):
                 fail(f"{pod.name} exited ({pod.process.returncode}) while the learner "
                      f"resumed: {tail(pod.log)}")
         if time.monotonic() > deadline:
@@ -559,7 +565,7 @@ def run_test(args, scratch, pods):
           f"rows, {steps} steps, {time.monotonic() - started:.1f} s in", flush=True)
 
     for pod, pid, size in zip(actors, actor_pids, actor_log_sizes):
-        if pod.process.pid != pid or not pod.alive():
+        if pod.process.pid != pid:
             fail(f"{pod.name} is not the process started before the learner's restart")
         with open(pod.log, errors="replace") as f:
             f.seek(size)
@@ -581,17 +587,18 @@ def run_test(args, scratch, pods):
         fail(f"actor pods share env seeds: {seeds}")
     print(f"ok: the actor pods' env seeds differ: {seeds}", flush=True)
 
-    for pod in actors:
-        pod.process.send_signal(signal.SIGTERM)
+    # The finished learner told the actors the run is over: they end by
+    # themselves, exit 0, rather than reconnecting to it forever.
     for pod in actors:
         try:
             code = pod.process.wait(timeout=pod.grace_s)
         except subprocess.TimeoutExpired:
-            fail(f"{pod.name} did not end within its {pod.grace_s} s grace period "
-                 "after SIGTERM")
-        if code != 0:
-            fail(f"{pod.name} exited {code} at SIGTERM: {tail(pod.log)}")
-    print("ok: the actors ended at SIGTERM with exit 0", flush=True)
+            fail(f"{pod.name} still runs {pod.grace_s} s after the run ended: "
+                 f"{tail(pod.log)}")
+        if code != 0 or RUN_OVER not in open(pod.log).read():
+            fail(f"{pod.name} exited {code} after the run: {tail(pod.log)}")
+    print("ok: told the run is over, the actors ended by themselves with exit 0",
+          flush=True)
 
     # The root filesystem is read-only in the pods (and HOME is on it):
     # nothing may have been written outside the writable volumes. The
