@@ -10,6 +10,8 @@
 
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
+#include "absl/time/clock.h"
+#include "absl/time/time.h"
 #include "common/net/port_file.h"
 #include "common/util/phase_times.h"
 #include "deploy/progress_columns.h"
@@ -64,6 +66,52 @@ absl::StatusOr<ServerCheckpointState> ReadServerState(
   }
   return state;
 }
+
+// A sync learner takes each update's rollouts from every env stream of its
+// batch, so with fewer streams registered it waits without end: said once
+// per shortfall that lasts kGrace (actors take a moment to register), and
+// always in the missing_env_slots series.
+class EnvSlotShortfall {
+ public:
+  static constexpr absl::Duration kGrace = absl::Seconds(10);
+
+  EnvSlotShortfall(bool sync, int64_t needed) : sync_(sync), needed_(needed) {}
+
+  // The streams missing now, given those of the registered actors.
+  int64_t Check(int64_t live_env_slots, absl::Time now = absl::Now()) {
+    const int64_t missing =
+        sync_ ? std::max<int64_t>(0, needed_ - live_env_slots) : 0;
+    if (missing == 0) {
+      if (said_) {
+        std::fprintf(stderr,
+                     "learner: all %ld env streams of the batch are "
+                     "registered again\n",
+                     static_cast<long>(needed_));
+      }
+      since_ = absl::InfiniteFuture();
+      said_ = false;
+      return 0;
+    }
+    if (since_ == absl::InfiniteFuture()) since_ = now;
+    if (!said_ && now - since_ >= kGrace) {
+      std::fprintf(stderr,
+                   "learner: a sync update takes a rollout from each of %ld "
+                   "env streams and the registered actors have %ld: no "
+                   "update until %ld more register\n",
+                   static_cast<long>(needed_),
+                   static_cast<long>(live_env_slots),
+                   static_cast<long>(missing));
+      said_ = true;
+    }
+    return missing;
+  }
+
+ private:
+  const bool sync_;
+  const int64_t needed_;
+  absl::Time since_ = absl::InfiniteFuture();
+  bool said_ = false;
+};
 
 }  // namespace
 
@@ -194,13 +242,15 @@ absl::Status RunLearnerServer(
     }
   }
   std::atomic<int64_t> buffered_steps{0};
+  std::atomic<int64_t> missing_env_slots{0};
   auto record_gateway = [&] {
     if (metrics == nullptr) return;
     const GatewayCounters counters = gateway.counters();
     metrics->RecordSegmentsAccepted(counters.accepted_segments);
     metrics->RecordRejected(counters.rejected);
     metrics->RecordActors({counters.live_actors, service.open_streams(),
-                           counters.registrations, counters.expirations});
+                           counters.registrations, counters.expirations,
+                           missing_env_slots.load()});
     metrics->SetQueueDepth(static_cast<int64_t>(queue.size()),
                            buffered_steps.load());
     std::vector<LearnerMetrics::ActorActivity> actors;
@@ -222,8 +272,11 @@ absl::Status RunLearnerServer(
   // same thread ends idle streams, expires registrations and keeps the
   // ingest metrics fresh while updates block.
   std::thread watcher([&] {
+    EnvSlotShortfall shortfall(config.run_config.distributed().sync(),
+                               own_streams);
     while (!stop && !gateway.closed()) {
       std::this_thread::sleep_for(std::chrono::milliseconds(50));
+      missing_env_slots = shortfall.Check(gateway.counters().live_env_slots);
       service.CancelIdleStreams();
       std::vector<int64_t> gone = gateway.ExpireIdle();
       if (!gone.empty()) {

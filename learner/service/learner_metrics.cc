@@ -58,6 +58,11 @@ LearnerMetrics::LearnerMetrics()
           metrics_.AddGauge("live_streams",
                             "Open segment streams and weight subscriptions "
                             "of registered actors.")),
+      missing_env_slots_(metrics_.AddGauge(
+          "missing_env_slots",
+          "Env streams a sync run's batch needs beyond those of the "
+          "registered actors: while above 0 no update can happen (0 in "
+          "async runs).")),
       registrations_(metrics_.AddCounter("registrations_total",
                                          "Actor registrations granted.")),
       expirations_(
@@ -168,6 +173,7 @@ void LearnerMetrics::RecordActors(const Actors& actors) {
   std::lock_guard<std::mutex> lock(mutex_);
   live_actors_.Set(static_cast<double>(actors.live_actors));
   live_streams_.Set(static_cast<double>(actors.live_streams));
+  missing_env_slots_.Set(static_cast<double>(actors.missing_env_slots));
   registrations_total_.Record(actors.registrations_total);
   expirations_total_.Record(actors.expirations_total);
 }

@@ -59,13 +59,15 @@ class LearnerMetrics {
   // stitcher's buffers and pending rollouts.
   void SetQueueDepth(int64_t segments, int64_t buffered_steps);
   // Who is connected: live registrations, their open segment streams and
-  // weight subscriptions, and the running totals of registrations granted
-  // and expired.
+  // weight subscriptions, the running totals of registrations granted and
+  // expired, and the env streams a sync batch needs beyond those
+  // registered (while > 0 no update can happen).
   struct Actors {
     int64_t live_actors = 0;
     int64_t live_streams = 0;
     int64_t registrations_total = 0;
     int64_t expirations_total = 0;
+    int64_t missing_env_slots = 0;
   };
   void RecordActors(const Actors& actors);
   // Running total of updates undone for non-finite numbers.
@@ -126,6 +128,7 @@ class LearnerMetrics {
   prometheus::Counter& episodes_;
   prometheus::Gauge& live_actors_;
   prometheus::Gauge& live_streams_;
+  prometheus::Gauge& missing_env_slots_;
   prometheus::Counter& registrations_;
   prometheus::Counter& expirations_;
   prometheus::Counter& rolled_back_updates_;

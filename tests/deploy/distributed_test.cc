@@ -300,6 +300,45 @@ TEST(DistributedTest, AStoppedRunKeepsEveryUpdateAndResumes) {
   }
 }
 
+// A sync learner takes each update's rollouts from all four env streams of
+// its batch: with one actor of two registered it cannot update, and says
+// so in its log and in vantage_learner_missing_env_slots; a second actor
+// ends the shortfall and the run completes.
+TEST(DistributedTest, ASyncLearnerShortOfEnvStreamsSaysSo) {
+  const std::string run = FreshDirectory("short");
+  const Learner learner = StartLearner(
+      "--steps=2048 --horizon=256 --envs=4 --seed=3 --metrics=127.0.0.1:0 "
+      "--run_dir=" +
+      run);
+  const int port = MetricsPort(learner.err, "learner");
+  ASSERT_GT(port, 0) << ReadFile(learner.err);
+  const std::string command = "actor --learner=127.0.0.1:" + learner.port +
+                              " --env=InvertedPendulum --envs=2";
+  const int first = StartVantage(command, TempPath("a.out"), TempPath("a.err"));
+  const std::string said =
+      "a sync update takes a rollout from each of 4 env "
+      "streams and the registered actors have 2: no "
+      "update until 2 more register";
+  for (int i = 0;
+       i < 600 && ReadFile(learner.err).find(said) == std::string::npos; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  EXPECT_THAT(ReadFile(learner.err), HasSubstr(said));
+  absl::StatusOr<std::string> text = HttpGet(port, "/metrics");
+  ASSERT_TRUE(text.ok()) << text.status();
+  EXPECT_EQ(Sample(*text, "vantage_learner_missing_env_slots"), 2);
+  EXPECT_LE(DeterministicProgress(run).size(), 1u);  // no update yet
+  const int second =
+      StartVantage(command, TempPath("a.out"), TempPath("a.err"));
+  EXPECT_EQ(WaitVantage(learner.pid, 120), 0) << ReadFile(learner.err);
+  EXPECT_THAT(ReadFile(learner.err),
+              HasSubstr("all 4 env streams of the batch are registered "
+                        "again"));
+  EXPECT_EQ(DeterministicProgress(run).size(), 1u + 2);
+  EXPECT_EQ(WaitVantage(first, 20), 0);
+  EXPECT_EQ(WaitVantage(second, 20), 0);
+}
+
 // Scrapes the learner while it trains: every column of progress.csv is a
 // series of the learner's, and scrapes agree with that update's row.
 TEST(DistributedTest, PrometheusCountersAgreeWithProgressCsv) {
