@@ -267,6 +267,8 @@ absl::Status RunDistributedTraining(const LaunchConfig& config,
           args.push_back("--run_dir=" + config.run_dir);
       }
       args.insert(args.end(), security_args.begin(), security_args.end());
+      args.insert(args.end(), config.learner_args.begin(),
+                  config.learner_args.end());
       const std::vector<std::string> metrics_args = metrics.LearnerArgs(rank);
       args.insert(args.end(), metrics_args.begin(), metrics_args.end());
       absl::StatusOr<pid_t> pid = SpawnSelf(args);

@@ -6,6 +6,7 @@
 
 #include <atomic>
 #include <string>
+#include <vector>
 
 #include "absl/status/status.h"
 #include "proto/run_config.pb.h"
@@ -39,6 +40,8 @@ struct LaunchConfig {
   // the run ends or is stopped (a failed run keeps them, so that
   // Prometheus sees it down).
   std::string metrics_address;
+  // More flags for every learner (`vantage train`'s learner limits).
+  std::vector<std::string> learner_args;
 };
 
 // Starts `vantage learner` on 127.0.0.1 with a free port (with

@@ -9,6 +9,7 @@
 #include "absl/strings/str_cat.h"
 #include "actor/envs/env_registry.h"
 #include "common/nn/compute_threads.h"
+#include "deploy/cli/learner_limit_flags.h"
 #include "deploy/cli/run_flags.h"
 #include "deploy/cli/security_flags.h"
 #include "deploy/cli/shared_flags.h"
@@ -34,71 +35,11 @@ ABSL_FLAG(double, replica_timeout_s,
           absl::ToDoubleSeconds(vantage::ReplicaGroupConfig().timeout),
           "how long a learner waits for the others (to join, or in an "
           "update) before it fails");
-// What clients can make a learner hold; defaults from the structs that use
-// them (docs/security.md explains each).
-ABSL_FLAG(int64_t, max_live_actors, vantage::GatewayLimits().max_live_actors,
-          "registrations held at once (more: RESOURCE_EXHAUSTED)");
-ABSL_FLAG(int64_t, max_envs_per_actor,
-          vantage::GatewayLimits().max_envs_per_actor,
-          "env slots one registration may claim");
-ABSL_FLAG(int64_t, max_live_env_slots,
-          vantage::GatewayLimits().max_live_env_slots,
-          "env slots over all live registrations");
-ABSL_FLAG(double, actor_expiry_s,
-          absl::ToDoubleSeconds(vantage::GatewayLimits().actor_expiry),
-          "a registration with no open call for this long expires");
-ABSL_FLAG(double, idle_stream_timeout_s,
-          absl::ToDoubleSeconds(vantage::ServiceLimits().idle_stream_timeout),
-          "a segment stream silent for this long is cancelled");
-ABSL_FLAG(double, max_abs_observation,
-          vantage::ValueLimits().max_abs_observation,
-          "segments with a larger |observation| are refused");
-ABSL_FLAG(double, max_abs_action, vantage::ValueLimits().max_abs_action,
-          "segments with a larger |action| are refused");
-ABSL_FLAG(double, max_abs_reward, vantage::ValueLimits().max_abs_reward,
-          "segments with a larger |reward| are refused");
-ABSL_FLAG(double, max_abs_log_prob, vantage::ValueLimits().max_abs_log_prob,
-          "segments with a larger |behaviour log-prob| are refused");
-ABSL_FLAG(int, max_server_threads,
-          vantage::LearnerServerConfig().max_server_threads,
-          "gRPC server threads (each open call holds one)");
-ABSL_FLAG(int64_t, max_grpc_memory_mb,
-          vantage::LearnerServerConfig().max_grpc_memory_bytes >> 20,
-          "memory gRPC may use for its buffers, MiB");
-
 namespace vantage {
 namespace {
 
 int Fail(int code, absl::string_view message) {
   return CommandFailure("learner", code, std::string(message));
-}
-
-// The limit flags; out-of-range values are errors naming the flag.
-absl::Status ReadLimits(LearnerServerConfig& server) {
-  GatewayLimits& limits = server.limits;
-  limits.max_live_actors = absl::GetFlag(FLAGS_max_live_actors);
-  limits.max_envs_per_actor = absl::GetFlag(FLAGS_max_envs_per_actor);
-  limits.max_live_env_slots = absl::GetFlag(FLAGS_max_live_env_slots);
-  limits.actor_expiry = absl::Seconds(absl::GetFlag(FLAGS_actor_expiry_s));
-  limits.values.max_abs_observation = absl::GetFlag(FLAGS_max_abs_observation);
-  limits.values.max_abs_action = absl::GetFlag(FLAGS_max_abs_action);
-  limits.values.max_abs_reward = absl::GetFlag(FLAGS_max_abs_reward);
-  limits.values.max_abs_log_prob = absl::GetFlag(FLAGS_max_abs_log_prob);
-  server.service_limits.idle_stream_timeout =
-      absl::Seconds(absl::GetFlag(FLAGS_idle_stream_timeout_s));
-  server.max_server_threads = absl::GetFlag(FLAGS_max_server_threads);
-  server.max_grpc_memory_bytes = absl::GetFlag(FLAGS_max_grpc_memory_mb) << 20;
-  if (absl::Status status = limits.Validate(); !status.ok()) return status;
-  if (!(server.service_limits.idle_stream_timeout > absl::ZeroDuration())) {
-    return absl::InvalidArgumentError("--idle_stream_timeout_s must be > 0");
-  }
-  if (server.max_server_threads < 8) {
-    return absl::InvalidArgumentError("--max_server_threads must be >= 8");
-  }
-  if (absl::GetFlag(FLAGS_max_grpc_memory_mb) < 1) {
-    return absl::InvalidArgumentError("--max_grpc_memory_mb must be >= 1");
-  }
-  return absl::OkStatus();
 }
 
 // --learner_threads, or the machine's cores over the run's learners.
@@ -139,7 +80,7 @@ int RunLearner(const std::vector<std::string>&) {
     return Fail(kRuntimeError, status.message());
   }
   LearnerServerConfig server;
-  if (absl::Status status = ReadLimits(server); !status.ok()) {
+  if (absl::Status status = ReadLearnerLimits(server); !status.ok()) {
     return Fail(kUsageError, status.message());
   }
   absl::StatusOr<SecurityOptions> security = SecurityFromFlags(/*server=*/true);
@@ -214,11 +155,10 @@ Command LearnerCommand() {
   command.flags = RunFlagNames(/*with_mode=*/false);
   for (const char* name :
        {"listen", "port_file", "metrics", "metrics_port_file", "rank",
-        "world_size", "rendezvous", "replica_timeout_s", "max_live_actors",
-        "max_envs_per_actor", "max_live_env_slots", "actor_expiry_s",
-        "idle_stream_timeout_s", "max_abs_observation", "max_abs_action",
-        "max_abs_reward", "max_abs_log_prob", "max_server_threads",
-        "max_grpc_memory_mb"}) {
+        "world_size", "rendezvous", "replica_timeout_s"}) {
+    command.flags.push_back(name);
+  }
+  for (const std::string& name : LearnerLimitFlagNames()) {
     command.flags.push_back(name);
   }
   for (const std::string& name : SecurityFlagNames()) {

@@ -13,6 +13,7 @@
 #include "actor/envs/env_registry.h"
 #include "common/nn/compute_threads.h"
 #include "common/nn/network_config.h"
+#include "deploy/cli/learner_limit_flags.h"
 #include "deploy/cli/run_flags.h"
 #include "deploy/cli/security_flags.h"
 #include "deploy/cli/shared_flags.h"
@@ -56,6 +57,7 @@ int RunDistributed(const ResolvedRun& run) {
   launch.tls_key = security->tls_key_file;
   launch.tls_ca = security->tls_ca_file;
   launch.metrics_address = absl::GetFlag(FLAGS_metrics);
+  launch.learner_args = GivenLearnerLimitArgs();
   std::printf(
       "%s %s with %s, estimator %s (rho %g), %ld steps, seed %lu: "
       "1 learner + %d actors x %d envs over gRPC%s%s\n",
@@ -144,6 +146,20 @@ int RunTrain(const std::vector<std::string>&) {
   if (!request.ok()) return Fail(kUsageError, request.status().message());
   absl::StatusOr<ResolvedRun> run = ResolveRunRequest(*request);
   if (!run.ok()) return Fail(kUsageError, run.status().message());
+  if (const std::vector<std::string> limits = GivenLearnerLimitArgs();
+      !limits.empty()) {
+    if (run->config.mode() != "distributed") {
+      return Fail(
+          kUsageError,
+          absl::StrCat(limits.front().substr(0, limits.front().find('=')),
+                       " limits the learner of --mode=distributed; a "
+                       "--mode=local run has none"));
+    }
+    LearnerServerConfig checked;
+    if (absl::Status status = ReadLearnerLimits(checked); !status.ok()) {
+      return Fail(kUsageError, status.message());
+    }
+  }
   if (absl::Status status = CheckRunCanStart(*run); !status.ok()) {
     return Fail(kUsageError, status.message());
   }
@@ -200,13 +216,17 @@ Command TrainCommand() {
       "--actors actor processes over loopback gRPC, restarted from the run's\n"
       "checkpoints when one dies), or with --mode=local one process. With\n"
       "--run_dir the run keeps config.json, progress.csv and checkpoints\n"
-      "there, and --resume=DIR continues it. Ends with a line\n"
-      "`RESULT train ... mean_return=R` (the last 100 episodes).";
+      "there, and --resume=DIR continues it. The learner's limits\n"
+      "(--max_live_actors ...) pass on to the learners it starts. Ends with\n"
+      "a line `RESULT train ... mean_return=R` (the last 100 episodes).";
   command.flags = RunFlagNames(/*with_mode=*/true);
   for (const std::string& name : SecurityFlagNames()) {
     command.flags.push_back(name);
   }
   command.flags.push_back("metrics");
+  for (const std::string& name : LearnerLimitFlagNames()) {
+    command.flags.push_back(name);
+  }
   command.defaults = RunFlagDefaults(/*with_mode=*/true);
   command.example =
       "vantage train --env=Hopper --algo=ppo --estimator=max --rho=0.3 "

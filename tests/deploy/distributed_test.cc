@@ -451,5 +451,40 @@ TEST(DistributedTest, AnActorWithoutALearnerGivesUpWhenTold) {
   EXPECT_EQ(RunVantage("actor --envs=1").exit_code, 2);
 }
 
+// `vantage train` takes the learner's limits and passes the ones given to
+// the learner it starts; out of range, or for a local run, they are usage
+// errors before anything starts.
+TEST(DistributedTest, TrainPassesItsLearnerLimitsOn) {
+  const std::string run = FreshDirectory("limits");
+  const std::string err = TempPath("train.err");
+  const int train = StartVantage(
+      "train --actors=1 --envs_per_actor=2 --steps=1000000 --horizon=256 "
+      "--max_live_actors=7 --actor_expiry_s=33 --run_dir=" +
+          run,
+      TempPath("train.out"), err);
+  std::vector<int> learners;
+  for (int i = 0; i < 600 && learners.empty(); ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    learners = ChildrenRunning(train, " learner ");
+  }
+  ASSERT_EQ(learners.size(), 1u) << ReadFile(err);
+  std::string command_line =
+      ReadFile("/proc/" + std::to_string(learners[0]) + "/cmdline");
+  std::replace(command_line.begin(), command_line.end(), '\0', ' ');
+  EXPECT_THAT(command_line, HasSubstr(" --max_live_actors=7 "));
+  EXPECT_THAT(command_line, HasSubstr(" --actor_expiry_s=33 "));
+  EXPECT_THAT(command_line, Not(HasSubstr("--max_live_env_slots")));
+  kill(train, SIGTERM);
+  EXPECT_EQ(WaitVantage(train, 60), 0) << ReadFile(err);
+
+  const Outcome local = RunVantage("train --mode=local --max_live_actors=3");
+  EXPECT_EQ(local.exit_code, 2);
+  EXPECT_THAT(local.err, HasSubstr("--max_live_actors limits the learner of "
+                                   "--mode=distributed"));
+  const Outcome zero = RunVantage("train --max_live_actors=0");
+  EXPECT_EQ(zero.exit_code, 2);
+  EXPECT_THAT(zero.err, HasSubstr("max_live_actors must be >= 1, got 0"));
+}
+
 }  // namespace
 }  // namespace vantage
