@@ -229,6 +229,13 @@ absl::StatusOr<UpdateStats> LearnerCore::Update(std::vector<Rollout> rollouts) {
                     exploration_.get());
   ReplicaGroup& replicas = *replicas_;
   const double world = replicas.world_size();
+  // Only rank 0's generator goes into checkpoints (it is the run's): above
+  // rank 0 each update draws from a stream fixed by the seed, the rank and
+  // the version, so that a resumed run repeats every replica's draws.
+  if (replicas.rank() != 0) {
+    rng_.seed(ReplicaSeed(config_.seed, replicas.rank()) +
+              static_cast<uint64_t>(version_));
+  }
   // A collective that fails (a replica gone) throws from inside the
   // algorithm; nothing of the update may stay.
   try {
@@ -551,10 +558,6 @@ absl::StatusOr<std::unique_ptr<LearnerCore>> LearnerCore::Load(
   }
   for (int64_t i = 0; i < returns.numel(); ++i) {
     core.recent_returns_.push_back(returns[i].item<double>());
-  }
-  if (core.replicas_->rank() != 0) {
-    core.rng_.seed(ReplicaSeed(config.seed, core.replicas_->rank()) +
-                   static_cast<uint64_t>(core.version_));
   }
   if (absl::Status status = core.SynchroniseReplicas(); !status.ok()) {
     return status;
