@@ -99,6 +99,15 @@ TEST(ReplicaGroupTest, AReplicaThatNeverComesTimesOut) {
       << group.status();
 }
 
+// Replica `rank`'s share of a two-stream batch: the segments of its slot.
+std::vector<Segment> OwnSegments(const std::vector<Segment>& batch, int rank) {
+  std::vector<Segment> own;
+  for (const Segment& segment : batch) {
+    if (segment.env_slot == rank) own.push_back(segment);
+  }
+  return own;
+}
+
 // A checkpoint of `learner` in memory, for a second learner to start from
 // exactly the same state.
 std::string Snapshot(const LearnerCore& learner) {
@@ -183,11 +192,7 @@ TEST_P(DataParallelLearnerTest, ASplitBatchGivesTheWholeBatchsUpdate) {
     const UpdateStats expected = UpdateWith(*single, batch);
     std::array<UpdateStats, 2> stats;
     InTwoThreads([&](int rank) {
-      std::vector<Segment> own;
-      for (const Segment& segment : batch) {
-        if (segment.env_slot == rank) own.push_back(segment);
-      }
-      stats[rank] = UpdateWith(*replicas[rank], own);
+      stats[rank] = UpdateWith(*replicas[rank], OwnSegments(batch, rank));
     });
     ExpectSameWeights(*replicas[0], *replicas[1]);
     ExpectClose(replicas[0]->CurrentWeights(), single->CurrentWeights(), 1e-5);
@@ -236,11 +241,8 @@ TEST(DataParallelResumeTest, ReplicasRestoredFromRankZerosCheckpointGoOnAlike) {
   auto update_both = [&](std::array<std::unique_ptr<LearnerCore>, 2>& pair,
                          const std::vector<Segment>& batch) {
     InTwoThreads([&](int rank) {
-      std::vector<Segment> own;
-      for (const Segment& segment : batch) {
-        if (segment.env_slot == rank) own.push_back(segment);
-      }
-      const UpdateStats stats = UpdateWith(*pair[rank], own);
+      const UpdateStats stats =
+          UpdateWith(*pair[rank], OwnSegments(batch, rank));
       EXPECT_FALSE(stats.rolled_back) << stats.rollback_reason;
     });
   };
