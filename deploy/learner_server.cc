@@ -351,10 +351,7 @@ absl::Status RunLearnerServer(
       for (int64_t lag : stats.rollout_policy_lags) {
         metrics->RecordPolicyLag(lag);
       }
-      metrics->RecordUpdate(stats.policy_version, stats.env_steps,
-                            stats.episodes, stats.update_seconds,
-                            row->mean_return, row->steps_per_second);
-      metrics->RecordRolledBackUpdates(stats.rolled_back_updates);
+      metrics->RecordUpdate(stats.policy_version, stats.update_seconds);
       metrics->AddUpdatePhases(stats.advantage_seconds,
                                stats.optimisation_seconds, publish_seconds);
       record_gateway();

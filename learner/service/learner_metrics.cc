@@ -126,9 +126,7 @@ absl::StatusOr<std::unique_ptr<LearnerMetrics>> LearnerMetrics::Start(
 int LearnerMetrics::port() const { return metrics_.port(); }
 
 void LearnerMetrics::RecordUpdate(int64_t policy_version,
-                                  int64_t env_steps_total,
-                                  int64_t episodes_total, double update_seconds,
-                                  double mean_return, double steps_per_second) {
+                                  double update_seconds) {
   std::lock_guard<std::mutex> lock(mutex_);
   if (policy_version > last_update_version_) {
     last_update_version_ = policy_version;
@@ -139,11 +137,6 @@ void LearnerMetrics::RecordUpdate(int64_t policy_version,
       update_seconds_.Observe(update_seconds);
     }
   }
-  policy_version_.Set(static_cast<double>(policy_version));
-  env_steps_total_.Record(env_steps_total);
-  episodes_total_.Record(episodes_total);
-  if (std::isfinite(mean_return)) mean_return_.Set(mean_return);
-  if (std::isfinite(steps_per_second)) steps_per_second_.Set(steps_per_second);
 }
 
 void LearnerMetrics::RecordSegmentsAccepted(int64_t total_segments) {
@@ -176,11 +169,6 @@ void LearnerMetrics::RecordActors(const Actors& actors) {
   missing_env_slots_.Set(static_cast<double>(actors.missing_env_slots));
   registrations_total_.Record(actors.registrations_total);
   expirations_total_.Record(actors.expirations_total);
-}
-
-void LearnerMetrics::RecordRolledBackUpdates(int64_t total) {
-  std::lock_guard<std::mutex> lock(mutex_);
-  rolled_back_total_.Record(total);
 }
 
 void LearnerMetrics::RecordStatistics(

@@ -34,17 +34,13 @@ class LearnerMetrics {
   // The port actually listened on.
   int port() const;
 
-  // After an update that published `policy_version`. The totals are the
-  // learner's running totals (counters advance by the difference to the
-  // highest total seen). The update is counted, and `update_seconds`
-  // observed, only if `policy_version` is above the last one recorded, so
-  // the same update recorded twice counts once (and sets the time of the
-  // last update, which starts at the process's start). A non-finite mean return
-  // (NaN before the first episode ends) or steps per second leaves its
-  // gauge as it was.
-  void RecordUpdate(int64_t policy_version, int64_t env_steps_total,
-                    int64_t episodes_total, double update_seconds,
-                    double mean_return, double steps_per_second);
+  // After an update that published `policy_version`: the update is
+  // counted, `update_seconds` observed and the time of the last update set
+  // (it starts at the process's start), only if `policy_version` is above
+  // the last one recorded, so the same update recorded twice counts once.
+  // The update's values (version, steps, episodes, return, ...) are its
+  // statistics (RecordStatistics), which alone set their series.
+  void RecordUpdate(int64_t policy_version, double update_seconds);
   // Running total of segments admitted into the learner's queue.
   void RecordSegmentsAccepted(int64_t total_segments);
   // Running totals of refused segments and calls by reason (the gateway's
@@ -70,12 +66,12 @@ class LearnerMetrics {
     int64_t missing_env_slots = 0;
   };
   void RecordActors(const Actors& actors);
-  // Running total of updates undone for non-finite numbers.
-  void RecordRolledBackUpdates(int64_t total);
 
   // The update's statistics, each a gauge prefix + name (or, if `total`,
-  // a counter fed from that running total, as RecordUpdate feeds its
-  // own), created on first report; the same name must always come with
+  // a counter fed from that running total: it advances by the difference
+  // to the highest total seen), created on first report (the learner's
+  // own series, such as env_steps_total and mean_return, exist from the
+  // start); the same name must always come with
   // the same help and kind. A non-finite value (a statistic the algorithm
   // has not got) leaves its series as it was.
   struct Statistic {

@@ -42,18 +42,37 @@ std::vector<std::string> Scrape(const LearnerMetrics& metrics) {
   return absl::StrSplit(*body, '\n');
 }
 
+// An update as the learner reports one: its progress row's statistics
+// (the only source of their series), then the update itself.
+void RecordUpdateRow(LearnerMetrics& metrics, int64_t policy_version,
+                     int64_t env_steps_total, int64_t episodes_total,
+                     double update_seconds, double mean_return,
+                     double steps_per_second) {
+  metrics.RecordStatistics(
+      {{"policy_version", "Policy version.",
+        static_cast<double>(policy_version)},
+       {"env_steps_total", "Steps.", static_cast<double>(env_steps_total),
+        /*total=*/true},
+       {"episodes_total", "Episodes.", static_cast<double>(episodes_total),
+        /*total=*/true},
+       {"mean_return", "Return.", mean_return},
+       {"steps_per_second", "Rate.", steps_per_second}});
+  metrics.RecordUpdate(policy_version, update_seconds);
+}
+
 TEST(LearnerMetricsTest, ServesRecordedValuesWithHelp) {
   std::unique_ptr<LearnerMetrics> metrics = StartOnAnyPort();
   ASSERT_NE(metrics, nullptr);
-  metrics->RecordUpdate(/*policy_version=*/1, /*env_steps_total=*/4096,
-                        /*episodes_total=*/3, /*update_seconds=*/0.5,
-                        /*mean_return=*/12.5, /*steps_per_second=*/1000);
+  RecordUpdateRow(*metrics, /*policy_version=*/1, /*env_steps_total=*/4096,
+                  /*episodes_total=*/3, /*update_seconds=*/0.5,
+                  /*mean_return=*/12.5, /*steps_per_second=*/1000);
   metrics->RecordSegmentsAccepted(32);
   metrics->RecordRejected({{"stale", 3}, {"malformed", 1}});
   metrics->SetQueueDepth(5, 640);
   metrics->RecordActors({/*live_actors=*/2, /*live_streams=*/4,
                          /*registrations_total=*/5, /*expirations_total=*/3});
-  metrics->RecordRolledBackUpdates(1);
+  metrics->RecordStatistics(
+      {{"rolled_back_updates_total", "Rolled back.", 1, /*total=*/true}});
 
   const std::vector<std::string> lines = Scrape(*metrics);
   for (const char* line : {
@@ -114,7 +133,7 @@ TEST(LearnerMetricsTest, SameTotalsTwiceCountOnce) {
   std::unique_ptr<LearnerMetrics> metrics = StartOnAnyPort();
   ASSERT_NE(metrics, nullptr);
   for (int i = 0; i < 2; ++i) {
-    metrics->RecordUpdate(1, 4096, 3, 0.5, 12.5, 1000);
+    RecordUpdateRow(*metrics, 1, 4096, 3, 0.5, 12.5, 1000);
     metrics->RecordSegmentsAccepted(32);
     metrics->RecordRejected({{"stale", 3}});
   }
@@ -130,8 +149,8 @@ TEST(LearnerMetricsTest, SameTotalsTwiceCountOnce) {
 
   // Newer totals add their difference; an older total arriving late adds
   // nothing.
-  metrics->RecordUpdate(2, 8192, 5, 0.25, 13.0, 1100);
-  metrics->RecordUpdate(1, 4096, 3, 0.5, 12.5, 1000);
+  RecordUpdateRow(*metrics, 2, 8192, 5, 0.25, 13.0, 1100);
+  RecordUpdateRow(*metrics, 1, 4096, 3, 0.5, 12.5, 1000);
   metrics->RecordSegmentsAccepted(40);
   metrics->RecordSegmentsAccepted(35);
   metrics->RecordRejected({{"stale", 7}, {"unknown_actor", 2}});
@@ -174,10 +193,10 @@ TEST(LearnerMetricsTest, NanMeanReturnKeepsTheGauge) {
   std::unique_ptr<LearnerMetrics> metrics = StartOnAnyPort();
   ASSERT_NE(metrics, nullptr);
   const double nan = std::numeric_limits<double>::quiet_NaN();
-  metrics->RecordUpdate(1, 100, 0, 0.1, nan, 50);
+  RecordUpdateRow(*metrics, 1, 100, 0, 0.1, nan, 50);
   EXPECT_THAT(Scrape(*metrics), Contains("vantage_learner_mean_return 0"));
-  metrics->RecordUpdate(2, 200, 1, 0.1, -3.5, 50);
-  metrics->RecordUpdate(3, 300, 1, 0.1, nan, nan);
+  RecordUpdateRow(*metrics, 2, 200, 1, 0.1, -3.5, 50);
+  RecordUpdateRow(*metrics, 3, 300, 1, 0.1, nan, nan);
   const std::vector<std::string> lines = Scrape(*metrics);
   EXPECT_THAT(lines, Contains("vantage_learner_mean_return -3.5"));
   EXPECT_THAT(lines, Contains("vantage_learner_steps_per_second 50"));
@@ -236,10 +255,10 @@ TEST(LearnerMetricsTest, StatisticsAreGaugesOrCountersByKind) {
                              {"clip_fraction", "Clipped share.", 0.25},
                              {"batch_rejected_segments_total", "Refused.", 4,
                               /*total=*/true},
-                             // Fed by RecordUpdate too: one series.
+                             // The learner's own series: the same one.
                              {"env_steps_total", "Steps.", 4096, true},
                              {"mean_return", "Return.", 7.0}});
-  metrics->RecordUpdate(1, 4096, 3, 0.5, 7.0, 1000);
+  RecordUpdateRow(*metrics, 1, 4096, 3, 0.5, 7.0, 1000);
   // A statistic the algorithm has not got keeps its gauge; totals only
   // grow by their difference.
   metrics->RecordStatistics(
@@ -268,7 +287,7 @@ TEST(LearnerMetricsTest, UpdatePhasesAndTheLastUpdateTime) {
   metrics->AddUpdatePhases(0.25, -1, std::nan(""));
   metrics->SetMaxPolicyLag(3);
   const double before = absl::ToDoubleSeconds(absl::Now() - absl::UnixEpoch());
-  metrics->RecordUpdate(1, 10, 0, 0.1, 0, 10);
+  RecordUpdateRow(*metrics, 1, 10, 0, 0.1, 0, 10);
   const std::vector<std::string> lines = Scrape(*metrics);
   for (const char* line : {
            "vantage_learner_update_phase_seconds_total{phase=\"advantages\"} "
