@@ -5,6 +5,7 @@
 #include "absl/flags/reflection.h"
 #include "absl/time/time.h"
 #include "deploy/cli/command_line.h"
+#include "deploy/learner_server.h"
 #include "learner/service/actor_gateway.h"
 #include "learner/service/learner_service.h"
 
@@ -74,6 +75,11 @@ absl::Status ReadLearnerLimits(LearnerServerConfig& server) {
     return absl::InvalidArgumentError("--max_grpc_memory_mb must be >= 1");
   }
   return absl::OkStatus();
+}
+
+absl::Status CheckLearnerLimits() {
+  LearnerServerConfig checked;
+  return ReadLearnerLimits(checked);
 }
 
 std::vector<std::string> GivenLearnerLimitArgs() {

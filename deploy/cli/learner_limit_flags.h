@@ -9,9 +9,12 @@
 #include <vector>
 
 #include "absl/status/status.h"
-#include "deploy/learner_server.h"
 
 namespace vantage {
+
+// Declared, not included: the server's config reaches LibTorch, and the
+// commands that only check or pass the flags on need not.
+struct LearnerServerConfig;
 
 std::vector<std::string> LearnerLimitFlagNames();
 
@@ -19,6 +22,9 @@ std::vector<std::string> LearnerLimitFlagNames();
 // gRPC server's bounds from the flags; an out-of-range value is an error
 // naming its flag.
 absl::Status ReadLearnerLimits(LearnerServerConfig& server);
+
+// The same checks, for a command that only passes the flags on.
+absl::Status CheckLearnerLimits();
 
 // "--name=value" of each limit flag given, for a child learner.
 std::vector<std::string> GivenLearnerLimitArgs();

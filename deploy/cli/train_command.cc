@@ -155,8 +155,7 @@ int RunTrain(const std::vector<std::string>&) {
                        " limits the learner of --mode=distributed; a "
                        "--mode=local run has none"));
     }
-    LearnerServerConfig checked;
-    if (absl::Status status = ReadLearnerLimits(checked); !status.ok()) {
+    if (absl::Status status = CheckLearnerLimits(); !status.ok()) {
       return Fail(kUsageError, status.message());
     }
   }
