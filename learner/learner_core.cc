@@ -218,17 +218,216 @@ absl::StatusOr<UpdateStats> LearnerCore::RunUpdate(SegmentSource& source) {
   return Update(std::move(rollouts));
 }
 
-absl::StatusOr<UpdateStats> LearnerCore::Update(std::vector<Rollout> rollouts) {
-  const auto update_start = std::chrono::steady_clock::now();
+// What an update's optimisation works on: the batch, its advantages, the
+// algorithm's view of both, and how stale each rollout was.
+struct LearnerCore::PreparedBatch {
+  ExplorationStats exploration;
+  TrainingBatch batch;
+  Advantages advantages;
+  UpdateBatch update;
+  // How many versions behind the current one each rollout's oldest step
+  // was acted.
+  std::vector<int64_t> lags;
+};
+
+// Everything the update's statistics need, summed over the replicas in one
+// collective; the algorithm's statistics are means over them.
+struct LearnerCore::ReplicaSums {
+  double samples = 0, episodes = 0, rejected = 0, stale_segments = 0,
+         stale_steps = 0, evicted_steps = 0;
+  double return_sum = 0, return_count = 0;  // of the last-100 windows
+  double biased_samples = 0, abs_bias_sum = 0;
+  // Of the value targets and of their residuals to the critic's values.
+  double target_sum = 0, target_squares = 0, residual_sum = 0,
+         residual_squares = 0;
+  double policy_loss = 0, value_loss = 0, entropy = 0, approx_kl = 0,
+         clip_fraction = 0;
+
+  static constexpr double ReplicaSums::*kFields[] = {
+      &ReplicaSums::samples,        &ReplicaSums::episodes,
+      &ReplicaSums::rejected,       &ReplicaSums::stale_segments,
+      &ReplicaSums::stale_steps,    &ReplicaSums::evicted_steps,
+      &ReplicaSums::return_sum,     &ReplicaSums::return_count,
+      &ReplicaSums::biased_samples, &ReplicaSums::abs_bias_sum,
+      &ReplicaSums::target_sum,     &ReplicaSums::target_squares,
+      &ReplicaSums::residual_sum,   &ReplicaSums::residual_squares,
+      &ReplicaSums::policy_loss,    &ReplicaSums::value_loss,
+      &ReplicaSums::entropy,        &ReplicaSums::approx_kl,
+      &ReplicaSums::clip_fraction};
+
+  ReplicaSums Over(ReplicaGroup& replicas) const {
+    std::vector<double> values;
+    for (double ReplicaSums::*field : kFields) values.push_back(this->*field);
+    values = SumAcrossReplicas(replicas, values);
+    ReplicaSums sums;
+    for (size_t i = 0; i < values.size(); ++i) sums.*kFields[i] = values[i];
+    return sums;
+  }
+};
+
+absl::StatusOr<LearnerCore::PreparedBatch> LearnerCore::PrepareBatch(
+    std::vector<Rollout>& rollouts) {
   // The batch is normalised with the statistics the acting policy used
   // (shipped with its weights), so that in sync mode the first epoch's
   // ratios start at 1; the statistics absorb the batch after the update.
   const double clip = config_.observation_clip;
+  PreparedBatch prepared;
+  if (exploration_ != nullptr) {
+    prepared.exploration = exploration_->ShapeRewards(rollouts);
+  }
+  absl::StatusOr<TrainingBatch> batch =
+      AssembleBatch(rollouts, [&](const at::Tensor& observations) {
+        at::NoGradGuard no_grad;
+        return value_->forward(ObservationsForNetwork(config_.spec, normalizer_,
+                                                      observations, clip));
+      });
+  if (!batch.ok()) return batch.status();
+  prepared.batch = *std::move(batch);
+  AdvantageInputs& inputs = prepared.batch.advantage_inputs;
+  if (config_.scale_rewards) {
+    if (absl::Status status = reward_scaler_.Observe(rollouts, *replicas_);
+        !status.ok()) {
+      return status;
+    }
+    inputs.rewards = reward_scaler_.Scale(inputs.rewards);
+  }
+  absl::StatusOr<Advantages> advantages =
+      ComputeAdvantages(inputs, config_.advantage, rng_);
+  if (!advantages.ok()) return advantages.status();
+  prepared.advantages = *std::move(advantages);
+  prepared.update = MakeUpdateBatch(
+      prepared.batch, prepared.advantages, [&](const at::Tensor& raw) {
+        return ObservationsForNetwork(config_.spec, normalizer_, raw, clip);
+      });
+  for (const Rollout& rollout : rollouts) {
+    prepared.lags.push_back(version_ -
+                            rollout.policy_versions.min().item<int64_t>());
+  }
+  prepared.update.lagged =
+      std::any_of(prepared.lags.begin(), prepared.lags.end(),
+                  [](int64_t lag) { return lag > 0; });
+  return prepared;
+}
+
+LearnerCore::ReplicaSums LearnerCore::SumOverReplicas(
+    const PreparedBatch& prepared, AlgorithmStats& algorithm) {
+  const Advantages& advantages = prepared.advantages;
+  const at::Tensor targets = advantages.returns.to(at::kDouble);
+  const at::Tensor residual =
+      targets - prepared.batch.advantage_inputs.values.to(at::kDouble);
+  ReplicaSums own;
+  own.samples =
+      static_cast<double>(prepared.update.horizon * prepared.update.streams);
+  own.episodes = static_cast<double>(unreported_.episodes);
+  own.rejected = static_cast<double>(unreported_.rejected);
+  own.stale_segments = static_cast<double>(unreported_.stale_segments);
+  own.stale_steps = static_cast<double>(unreported_.stale_steps);
+  own.evicted_steps = static_cast<double>(stitcher_.stats().evicted_steps);
+  own.return_sum =
+      std::accumulate(recent_returns_.begin(), recent_returns_.end(), 0.0);
+  own.return_count = static_cast<double>(recent_returns_.size());
+  own.biased_samples = advantages.mask.to(at::kDouble).sum().item<double>();
+  own.abs_bias_sum = (advantages.biased - advantages.gae)
+                         .abs()
+                         .to(at::kDouble)
+                         .sum()
+                         .item<double>();
+  own.target_sum = targets.sum().item<double>();
+  own.target_squares = targets.pow(2).sum().item<double>();
+  own.residual_sum = residual.sum().item<double>();
+  own.residual_squares = residual.pow(2).sum().item<double>();
+  own.policy_loss = algorithm.policy_loss;
+  own.value_loss = algorithm.value_loss;
+  own.entropy = algorithm.entropy;
+  own.approx_kl = algorithm.approx_kl;
+  own.clip_fraction = algorithm.clip_fraction;
+  const ReplicaSums sums = own.Over(*replicas_);
+  const double world = replicas_->world_size();
+  algorithm.policy_loss = sums.policy_loss / world;
+  algorithm.value_loss = sums.value_loss / world;
+  algorithm.entropy = sums.entropy / world;
+  algorithm.approx_kl = sums.approx_kl / world;
+  algorithm.clip_fraction = sums.clip_fraction / world;
+  return sums;
+}
+
+absl::Status LearnerCore::Commit(const std::vector<Rollout>& rollouts,
+                                 const ReplicaSums& sums, UpdateGuard& guard,
+                                 UpdateStats& stats) {
+  // The same decision on every replica: the statistics are global and the
+  // parameters identical.
+  stats.rollback_reason =
+      stats.exploration.fault.empty()
+          ? guard.Fault(stats.algorithm, config_.rollback_gradient_norm)
+          : stats.exploration.fault;
+  if (!stats.rollback_reason.empty()) {
+    guard.Restore();
+    stats.rolled_back = true;
+    ++rolled_back_updates_;
+    std::fprintf(stderr,
+                 "learner: warning: update to version %ld rolled back (%s); "
+                 "its batch of %ld steps is dropped\n",
+                 static_cast<long>(version_ + 1), stats.rollback_reason.c_str(),
+                 static_cast<long>(sums.samples));
+  } else {
+    // A dropped batch must not move the statistics either; byte
+    // observations are not normalised, so have none.
+    if (!config_.spec.byte_observations()) {
+      std::vector<at::Tensor> observations;
+      for (const Rollout& rollout : rollouts) {
+        observations.push_back(
+            rollout.observations.slice(0, 0, config_.horizon));
+      }
+      if (absl::Status status = UpdateAcrossReplicas(*replicas_, normalizer_,
+                                                     at::cat(observations));
+          !status.ok()) {
+        return status;
+      }
+    }
+    if (exploration_ != nullptr) exploration_->Commit();
+  }
+  env_steps_ += static_cast<int64_t>(sums.samples);
+  episodes_ += static_cast<int64_t>(sums.episodes);
+  rejected_ += static_cast<int64_t>(sums.rejected);
+  stale_segments_ += static_cast<int64_t>(sums.stale_segments);
+  stale_steps_ += static_cast<int64_t>(sums.stale_steps);
+  unreported_ = LocalCounts();
+  ++version_;
+  stats.rolled_back_updates = rolled_back_updates_;
+  stats.policy_version = version_;
+  stats.env_steps = env_steps_;
+  stats.episodes = episodes_;
+  stats.mean_return = sums.return_count > 0
+                          ? sums.return_sum / sums.return_count
+                          : std::numeric_limits<double>::quiet_NaN();
+  stats.biased_fraction = sums.biased_samples / sums.samples;
+  stats.mean_abs_bias = sums.abs_bias_sum / sums.samples;
+  const auto variance = [&](double sum, double squares) {
+    return (squares - sum * sum / sums.samples) /
+           std::max(sums.samples - 1.0, 1.0);
+  };
+  stats.explained_variance =
+      1.0 - variance(sums.residual_sum, sums.residual_squares) /
+                (variance(sums.target_sum, sums.target_squares) + 1e-8);
+  stats.rejected_segments = rejected_;
+  stats.first_rejection = std::move(first_rejection_);
+  first_rejection_.clear();
+  stats.stale_segments = stale_segments_;
+  stats.stale_steps = stale_steps_;
+  stats.evicted_steps = static_cast<int64_t>(sums.evicted_steps);
+  return absl::OkStatus();
+}
+
+absl::StatusOr<UpdateStats> LearnerCore::Update(std::vector<Rollout> rollouts) {
+  using Clock = std::chrono::steady_clock;
+  const auto seconds_since = [](Clock::time_point start) {
+    return std::chrono::duration<double>(Clock::now() - start).count();
+  };
+  const auto update_start = Clock::now();
   UpdateGuard guard(*policy_, *value_, *updater_,
                     config_.scale_rewards ? &reward_scaler_ : nullptr,
                     exploration_.get());
   ReplicaGroup& replicas = *replicas_;
-  const double world = replicas.world_size();
   // Only rank 0's generator goes into checkpoints (it is the run's): above
   // rank 0 each update draws from a stream fixed by the seed, the rank and
   // the version, so that a resumed run repeats every replica's draws.
@@ -239,170 +438,36 @@ absl::StatusOr<UpdateStats> LearnerCore::Update(std::vector<Rollout> rollouts) {
   // A collective that fails (a replica gone) throws from inside the
   // algorithm; nothing of the update may stay.
   try {
-    ExplorationStats exploration;
-    if (exploration_ != nullptr) {
-      exploration = exploration_->ShapeRewards(rollouts);
-    }
-    absl::StatusOr<TrainingBatch> batch =
-        AssembleBatch(rollouts, [&](const at::Tensor& observations) {
-          at::NoGradGuard no_grad;
-          return value_->forward(ObservationsForNetwork(
-              config_.spec, normalizer_, observations, clip));
-        });
-    if (!batch.ok()) {
+    absl::StatusOr<PreparedBatch> prepared = PrepareBatch(rollouts);
+    if (!prepared.ok()) {
       guard.Restore();
-      return batch.status();
+      return prepared.status();
     }
-    if (config_.scale_rewards) {
-      if (absl::Status status = reward_scaler_.Observe(rollouts, replicas);
-          !status.ok()) {
-        guard.Restore();
-        return status;
-      }
-      batch->advantage_inputs.rewards =
-          reward_scaler_.Scale(batch->advantage_inputs.rewards);
-    }
-    absl::StatusOr<Advantages> advantages =
-        ComputeAdvantages(batch->advantage_inputs, config_.advantage, rng_);
-    if (!advantages.ok()) {
-      guard.Restore();
-      return advantages.status();
-    }
-
-    UpdateBatch update =
-        MakeUpdateBatch(*batch, *advantages, [&](const at::Tensor& raw) {
-          return ObservationsForNetwork(config_.spec, normalizer_, raw, clip);
-        });
-    // How many versions behind the current one each rollout's oldest step
-    // was acted.
-    std::vector<int64_t> lags;
-    for (const Rollout& rollout : rollouts) {
-      lags.push_back(version_ - rollout.policy_versions.min().item<int64_t>());
-    }
-    update.lagged = std::any_of(lags.begin(), lags.end(),
-                                [](int64_t lag) { return lag > 0; });
-    const int64_t samples = update.horizon * update.streams;
-    const double progress =
-        static_cast<double>(env_steps_) / config_.total_env_steps;
     UpdateStats stats;
-    stats.exploration = exploration;
-    const auto optimisation_start = std::chrono::steady_clock::now();
-    stats.advantage_seconds =
-        std::chrono::duration<double>(optimisation_start - update_start)
-            .count();
-    stats.algorithm = updater_->Update(update, progress, rng_);
-    stats.optimisation_seconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() -
-                                      optimisation_start)
-            .count();
-
-    // Everything the statistics need, summed over the replicas in one
-    // collective (every replica holds `samples` samples).
-    const at::Tensor targets = advantages->returns.to(at::kDouble);
-    const at::Tensor residual =
-        targets - batch->advantage_inputs.values.to(at::kDouble);
-    AlgorithmStats& algorithm = stats.algorithm;
-    const std::vector<double> sums = SumAcrossReplicas(
-        replicas,
-        {static_cast<double>(samples),
-         static_cast<double>(unreported_.episodes),
-         static_cast<double>(unreported_.rejected),
-         static_cast<double>(unreported_.stale_segments),
-         static_cast<double>(unreported_.stale_steps),
-         static_cast<double>(stitcher_.stats().evicted_steps),
-         std::accumulate(recent_returns_.begin(), recent_returns_.end(), 0.0),
-         static_cast<double>(recent_returns_.size()),
-         advantages->mask.to(at::kDouble).sum().item<double>(),
-         (advantages->biased - advantages->gae)
-             .abs()
-             .to(at::kDouble)
-             .sum()
-             .item<double>(),
-         targets.sum().item<double>(), targets.pow(2).sum().item<double>(),
-         residual.sum().item<double>(), residual.pow(2).sum().item<double>(),
-         algorithm.policy_loss, algorithm.value_loss, algorithm.entropy,
-         algorithm.approx_kl, algorithm.clip_fraction});
-    for (auto [field, sum] : {std::pair{&algorithm.policy_loss, sums[14]},
-                              std::pair{&algorithm.value_loss, sums[15]},
-                              std::pair{&algorithm.entropy, sums[16]},
-                              std::pair{&algorithm.approx_kl, sums[17]},
-                              std::pair{&algorithm.clip_fraction, sums[18]}}) {
-      *field = sum / world;
+    stats.exploration = prepared->exploration;
+    const auto optimisation_start = Clock::now();
+    stats.advantage_seconds = seconds_since(update_start);
+    stats.algorithm = updater_->Update(
+        prepared->update,
+        static_cast<double>(env_steps_) / config_.total_env_steps, rng_);
+    stats.optimisation_seconds = seconds_since(optimisation_start);
+    const ReplicaSums sums = SumOverReplicas(*prepared, stats.algorithm);
+    if (absl::Status status = Commit(rollouts, sums, guard, stats);
+        !status.ok()) {
+      return status;
     }
-    // The same decision on every replica: the statistics are global and
-    // the parameters identical.
-    stats.rollback_reason =
-        exploration.fault.empty()
-            ? guard.Fault(stats.algorithm, config_.rollback_gradient_norm)
-            : exploration.fault;
-    const double global_samples = sums[0];
-    if (!stats.rollback_reason.empty()) {
-      guard.Restore();
-      stats.rolled_back = true;
-      ++rolled_back_updates_;
-      std::fprintf(stderr,
-                   "learner: warning: update to version %ld rolled back (%s); "
-                   "its batch of %ld steps is dropped\n",
-                   static_cast<long>(version_ + 1),
-                   stats.rollback_reason.c_str(),
-                   static_cast<long>(global_samples));
-    } else {
-      // A dropped batch must not move the statistics either; byte
-      // observations are not normalised, so have none.
-      if (!config_.spec.byte_observations()) {
-        std::vector<at::Tensor> observations;
-        for (const Rollout& rollout : rollouts) {
-          observations.push_back(
-              rollout.observations.slice(0, 0, config_.horizon));
-        }
-        if (absl::Status status = UpdateAcrossReplicas(replicas, normalizer_,
-                                                       at::cat(observations));
-            !status.ok()) {
-          return status;
-        }
-      }
-      if (exploration_ != nullptr) exploration_->Commit();
-    }
-    env_steps_ += static_cast<int64_t>(global_samples);
-    episodes_ += static_cast<int64_t>(sums[1]);
-    rejected_ += static_cast<int64_t>(sums[2]);
-    stale_segments_ += static_cast<int64_t>(sums[3]);
-    stale_steps_ += static_cast<int64_t>(sums[4]);
-    unreported_ = LocalCounts();
-    stats.rolled_back_updates = rolled_back_updates_;
-    stats.rollout_policy_lags = std::move(lags);
-    ++version_;
-    stats.policy_version = version_;
-    stats.env_steps = env_steps_;
-    stats.episodes = episodes_;
-    stats.mean_return = sums[7] > 0 ? sums[6] / sums[7]
-                                    : std::numeric_limits<double>::quiet_NaN();
-    stats.biased_fraction = sums[8] / global_samples;
-    stats.mean_abs_bias = sums[9] / global_samples;
-    const auto variance = [&](double sum, double squares) {
-      return (squares - sum * sum / global_samples) /
-             std::max(global_samples - 1.0, 1.0);
-    };
-    stats.explained_variance = 1.0 - variance(sums[12], sums[13]) /
-                                         (variance(sums[10], sums[11]) + 1e-8);
-    stats.rejected_segments = rejected_;
-    stats.first_rejection = std::move(first_rejection_);
-    first_rejection_.clear();
-    stats.stale_segments = stale_segments_;
-    stats.stale_steps = stale_steps_;
-    stats.evicted_steps = static_cast<int64_t>(sums[5]);
-    stats.update_seconds = std::chrono::duration<double>(
-                               std::chrono::steady_clock::now() - update_start)
-                               .count();
+    stats.rollout_policy_lags = std::move(prepared->lags);
+    stats.update_seconds = seconds_since(update_start);
     return stats;
   } catch (const std::exception& error) {
     guard.Restore();
     return absl::UnavailableError(absl::StrCat(
         "the update to version ", version_ + 1, " failed",
-        world > 1 ? absl::StrCat(" on learner replica ", replicas.rank(),
-                                 " of ", replicas.world_size(),
-                                 " (another replica is gone or timed out)")
-                  : "",
+        replicas.world_size() > 1
+            ? absl::StrCat(" on learner replica ", replicas.rank(), " of ",
+                           replicas.world_size(),
+                           " (another replica is gone or timed out)")
+            : "",
         "; the learner is as before it: ", error.what()));
   }
 }

@@ -25,6 +25,7 @@
 namespace vantage {
 
 class Ex2Bonus;
+class UpdateGuard;
 
 // Consumes segments, stitches rollouts, evaluates the critic, estimates
 // advantages (GAE + the biased path ensemble, rho-mixed), runs the
@@ -96,8 +97,22 @@ class LearnerCore {
   // Rank 0's networks, normaliser and counters on every replica; an error
   // if this replica's version differs from rank 0's.
   absl::Status SynchroniseReplicas();
-  // The update once its batch is complete.
+  // The update once its batch is complete, under a guard that undoes it on
+  // any error or a rollback: the batch and its advantages (PrepareBatch),
+  // the algorithm's optimisation, the statistics summed over the replicas
+  // (SumOverReplicas), and the new version committed (Commit).
   absl::StatusOr<UpdateStats> Update(std::vector<Rollout> rollouts);
+  struct PreparedBatch;
+  struct ReplicaSums;
+  absl::StatusOr<PreparedBatch> PrepareBatch(std::vector<Rollout>& rollouts);
+  // Also turns the algorithm's statistics into means over the replicas.
+  ReplicaSums SumOverReplicas(const PreparedBatch& prepared,
+                              AlgorithmStats& algorithm);
+  // Keeps the update or, when its statistics are faulty, rolls it back;
+  // either way the counters and the version advance.
+  absl::Status Commit(const std::vector<Rollout>& rollouts,
+                      const ReplicaSums& sums, UpdateGuard& guard,
+                      UpdateStats& stats);
 
   const LearnerConfig config_;
   std::shared_ptr<ReplicaGroup> replicas_;
