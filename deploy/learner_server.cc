@@ -113,264 +113,342 @@ class EnvSlotShortfall {
   bool said_ = false;
 };
 
-}  // namespace
+// The learner process: opens the run (Open), serves actors (Serve), trains
+// until the run is done or stopped (Train), and shuts the service down
+// (Finish). Members outlive the watcher thread, which Finish joins.
+class LearnerProcess {
+ public:
+  LearnerProcess(const LearnerServerConfig& config,
+                 const std::atomic<bool>& stop)
+      : config_(config),
+        stop_(stop),
+        own_streams_(config.training.num_envs /
+                     std::max(1, config.replicas.world_size)),
+        times_({"advantages", "optimisation", "bookkeeping", "publish"}) {
+    training_ = config.training;
+    training_.record = config.replicas.rank == 0;
+  }
 
-absl::Status RunLearnerServer(
-    const LearnerServerConfig& config, const std::atomic<bool>& stop,
-    const std::function<void(const ProgressRow&)>& on_update) {
-  const int world_size = config.replicas.world_size;
-  if (world_size < 1 || config.training.num_envs % world_size != 0) {
+  // Checks the configuration, joins the other replicas and opens the run
+  // (resumed, or a new directory made before serving so that a taken one
+  // fails fast).
+  absl::Status Open();
+  // The gateway, the gRPC service, the port file, the metrics endpoint and
+  // the watcher thread; a failure leaves nothing serving.
+  absl::Status Serve();
+  // Updates until the run's steps are done or a stop is requested; each
+  // update's row goes to `on_update`.
+  absl::Status Train(const std::function<void(const ProgressRow&)>& on_update);
+  // Stops serving and the watcher; a stop request makes any error OK.
+  absl::Status Finish(absl::Status status);
+
+ private:
+  LearnerConfig LearnerConfigFor(const EnvSpec& spec) const;
+  absl::Status RestoreServerState(const std::string& path,
+                                  const CheckpointExtras& extras);
+  absl::StatusOr<CheckpointExtras> ServerState() const {
+    return ServerStateExtras(config_.spec, gateway_->next_actor_id());
+  }
+  // Writes a checkpoint unless the version has one; says why not if that
+  // fails (`when`: the moment, for the message).
+  void KeepCheckpoint(const char* when);
+  absl::Status StartMetrics();
+  // Closing the queue is how a stop request reaches a blocked update; the
+  // same thread ends idle streams, expires registrations and keeps the
+  // ingest metrics fresh while updates block.
+  void Watch();
+  void RecordGateway();
+  // Frees what the stitcher holds for registrations that expired (the
+  // stitcher belongs to the update loop's thread).
+  void ForgetExpiredActors();
+  void RecordUpdate(const ProgressRow& row, double publish_seconds);
+
+  const LearnerServerConfig& config_;
+  const std::atomic<bool>& stop_;
+  LocalTrainingConfig training_;
+  // This replica's share of the batch.
+  const int64_t own_streams_;
+  std::shared_ptr<ReplicaGroup> replicas_;
+  std::unique_ptr<TrainingRun> run_;
+  int64_t first_actor_id_ = 0;
+  std::unique_ptr<SegmentQueue> queue_;
+  std::unique_ptr<ActorGateway> gateway_;
+  std::unique_ptr<LearnerService> service_;
+  RunningServer server_;
+  std::unique_ptr<LearnerMetrics> metrics_;
+  std::thread watcher_;
+  std::atomic<int64_t> buffered_steps_{0};
+  std::atomic<int64_t> missing_env_slots_{0};
+  std::mutex expired_mutex_;
+  std::vector<int64_t> expired_;
+  // Where the learner's time goes, printed when it stops; the rest is
+  // waiting for a batch.
+  PhaseTimes times_;
+};
+
+LearnerConfig LearnerProcess::LearnerConfigFor(const EnvSpec& spec) const {
+  LearnerConfig learner_config = MakeLearnerConfig(training_, spec);
+  learner_config.rollouts_per_batch = own_streams_;
+  learner_config.max_segment_steps =
+      config_.run_config.training().segment_length();
+  learner_config.value_limits = config_.limits.values;
+  return learner_config;
+}
+
+absl::Status LearnerProcess::RestoreServerState(
+    const std::string& path, const CheckpointExtras& extras) {
+  absl::StatusOr<ServerCheckpointState> state = ReadServerState(path, extras);
+  if (!state.ok()) return state.status();
+  if (absl::Status same = CheckSameSpec(config_.spec, state->spec);
+      !same.ok()) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(path, " was written for another version of ",
+                     config_.spec.name, ": ", same.message()));
+  }
+  first_actor_id_ = state->next_actor_id;
+  return absl::OkStatus();
+}
+
+absl::Status LearnerProcess::Open() {
+  const int world_size = config_.replicas.world_size;
+  if (world_size < 1 || config_.training.num_envs % world_size != 0) {
     return absl::InvalidArgumentError(absl::StrCat(
-        "the batch of ", config.training.num_envs,
+        "the batch of ", config_.training.num_envs,
         " env streams does not split over ", world_size, " learners"));
   }
-  LocalTrainingConfig training = config.training;
-  training.record = config.replicas.rank == 0;
-  // This replica's share of the batch.
-  const int64_t own_streams = training.num_envs / world_size;
-  auto learner_config_for = [&](const EnvSpec& spec) {
-    LearnerConfig learner_config = MakeLearnerConfig(training, spec);
-    learner_config.rollouts_per_batch = own_streams;
-    learner_config.max_segment_steps =
-        config.run_config.training().segment_length();
-    learner_config.value_limits = config.limits.values;
-    return learner_config;
-  };
-  if (absl::Status status = config.limits.Validate(); !status.ok()) {
+  if (absl::Status status = config_.limits.Validate(); !status.ok()) {
     return status;
   }
-  const EnvSpec& spec = config.spec;
   absl::StatusOr<std::shared_ptr<ReplicaGroup>> replicas =
-      JoinReplicaGroup(config.replicas);
+      JoinReplicaGroup(config_.replicas);
   if (!replicas.ok()) return replicas.status();
+  replicas_ = *std::move(replicas);
   if (world_size > 1) {
     std::fprintf(stderr, "learner: replica %d of %d joined at %s\n",
-                 config.replicas.rank, world_size,
-                 config.replicas.rendezvous.c_str());
+                 config_.replicas.rank, world_size,
+                 config_.replicas.rendezvous.c_str());
   }
-  // A resumed run knows its learner and the actor ids it handed out before
-  // any actor registers; a new run's directory is made before serving, so a
-  // taken one fails fast.
-  int64_t first_actor_id = 0;
   absl::StatusOr<std::unique_ptr<TrainingRun>> run = TrainingRun::Open(
-      training, learner_config_for(spec),
-      [&](const std::string& path, const CheckpointExtras& extras) {
-        absl::StatusOr<ServerCheckpointState> state =
-            ReadServerState(path, extras);
-        if (!state.ok()) return state.status();
-        if (absl::Status same = CheckSameSpec(spec, state->spec); !same.ok()) {
-          return absl::InvalidArgumentError(
-              absl::StrCat(path, " was written for another version of ",
-                           spec.name, ": ", same.message()));
-        }
-        first_actor_id = state->next_actor_id;
-        return absl::OkStatus();
+      training_, LearnerConfigFor(config_.spec),
+      [this](const std::string& path, const CheckpointExtras& extras) {
+        return RestoreServerState(path, extras);
       },
-      *replicas);
+      replicas_);
   if (!run.ok()) return run.status();
-  LearnerCore& learner = (*run)->learner();
-  if (training.resume) {
+  run_ = *std::move(run);
+  if (training_.resume) {
     std::fprintf(stderr,
                  "learner: resuming %s from policy version %ld (%ld env "
                  "steps)\n",
-                 training.run_dir.c_str(),
-                 static_cast<long>(learner.policy_version()),
-                 static_cast<long>(learner.env_steps()));
+                 training_.run_dir.c_str(),
+                 static_cast<long>(run_->learner().policy_version()),
+                 static_cast<long>(run_->learner().env_steps()));
   }
+  return absl::OkStatus();
+}
 
+absl::Status LearnerProcess::Serve() {
+  const pb::RunConfig& run_config = config_.run_config;
+  const int64_t segment_length = run_config.training().segment_length();
   // Room for two whole batches: asynchronous actors keep acting for the
   // next batch while an update runs (which is how acting hides behind
   // learning), and actors that outpace the learner beyond that block on
   // their streams instead of growing memory.
   const int64_t batch_segments =
-      own_streams *
-      (training.learner.horizon /
-       std::max<int64_t>(1, config.run_config.training().segment_length()));
-  SegmentQueue queue(
+      own_streams_ *
+      (training_.learner.horizon / std::max<int64_t>(1, segment_length));
+  queue_ = std::make_unique<SegmentQueue>(
       static_cast<size_t>(std::max<int64_t>(8, 2 * batch_segments)));
   GatewayConfig gateway_config;
-  gateway_config.run_config = config.run_config;
-  gateway_config.max_segment_steps =
-      config.run_config.training().segment_length();
-  gateway_config.max_policy_lag =
-      config.run_config.distributed().max_policy_lag();
-  gateway_config.first_actor_id = first_actor_id;
-  gateway_config.spec = spec;
-  gateway_config.limits = config.limits;
-  ActorGateway gateway(gateway_config, queue);
+  gateway_config.run_config = run_config;
+  gateway_config.max_segment_steps = segment_length;
+  gateway_config.max_policy_lag = run_config.distributed().max_policy_lag();
+  gateway_config.first_actor_id = first_actor_id_;
+  gateway_config.spec = config_.spec;
+  gateway_config.limits = config_.limits;
+  gateway_ = std::make_unique<ActorGateway>(gateway_config, *queue_);
   // Nothing larger than the run's largest valid segment is ever read.
-  ServiceLimits service_limits = config.service_limits;
-  service_limits.max_segment_message_bytes = MaxSegmentMessageBytes(
-      spec, config.run_config.training().segment_length());
-  LearnerService service(gateway, service_limits);
+  ServiceLimits service_limits = config_.service_limits;
+  service_limits.max_segment_message_bytes =
+      MaxSegmentMessageBytes(config_.spec, segment_length);
+  service_ = std::make_unique<LearnerService>(*gateway_, service_limits);
   ServerOptions options;
-  options.listen = config.listen;
-  options.security = config.security;
+  options.listen = config_.listen;
+  options.security = config_.security;
   options.max_receive_message_bytes =
       std::max(service_limits.max_segment_message_bytes,
                service_limits.max_request_bytes);
-  options.max_threads = config.max_server_threads;
-  options.max_memory_bytes = config.max_grpc_memory_bytes;
-  absl::StatusOr<RunningServer> server = StartServer(options, service);
+  options.max_threads = config_.max_server_threads;
+  options.max_memory_bytes = config_.max_grpc_memory_bytes;
+  absl::StatusOr<RunningServer> server = StartServer(options, *service_);
   if (!server.ok()) return server.status();
-  std::fprintf(stderr, "learner: serving on port %d\n", server->port);
-  if (!config.port_file.empty()) {
-    if (absl::Status status = WritePortFile(config.port_file, server->port);
-        !status.ok()) {
-      return status;
-    }
+  server_ = *std::move(server);
+  std::fprintf(stderr, "learner: serving on port %d\n", server_.port);
+  absl::Status status = config_.port_file.empty()
+                            ? absl::OkStatus()
+                            : WritePortFile(config_.port_file, server_.port);
+  if (status.ok()) status = StartMetrics();
+  if (!status.ok()) {
+    server_.server->Shutdown();
+    return status;
   }
-  std::unique_ptr<LearnerMetrics> metrics;
-  if (!config.metrics_address.empty()) {
-    absl::StatusOr<std::unique_ptr<LearnerMetrics>> started =
-        LearnerMetrics::Start(config.metrics_address,
-                              config.security.auth_token);
-    if (!started.ok()) {
-      server->server->Shutdown();
-      return started.status();
+  watcher_ = std::thread([this] { Watch(); });
+  return absl::OkStatus();
+}
+
+absl::Status LearnerProcess::StartMetrics() {
+  if (config_.metrics_address.empty()) return absl::OkStatus();
+  absl::StatusOr<std::unique_ptr<LearnerMetrics>> started =
+      LearnerMetrics::Start(config_.metrics_address,
+                            config_.security.auth_token);
+  if (!started.ok()) return started.status();
+  metrics_ = *std::move(started);
+  metrics_->SetMaxPolicyLag(config_.run_config.distributed().max_policy_lag());
+  std::fprintf(stderr, "learner: metrics on port %d\n", metrics_->port());
+  if (config_.metrics_port_file.empty()) return absl::OkStatus();
+  return WritePortFile(config_.metrics_port_file, metrics_->port());
+}
+
+void LearnerProcess::Watch() {
+  EnvSlotShortfall shortfall(config_.run_config.distributed().sync(),
+                             own_streams_);
+  while (!stop_ && !gateway_->closed()) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    missing_env_slots_ = shortfall.Check(gateway_->counters().live_env_slots);
+    service_->CancelIdleStreams();
+    std::vector<int64_t> gone = gateway_->ExpireIdle();
+    if (!gone.empty()) {
+      std::lock_guard<std::mutex> lock(expired_mutex_);
+      expired_.insert(expired_.end(), gone.begin(), gone.end());
     }
-    metrics = *std::move(started);
-    metrics->SetMaxPolicyLag(config.run_config.distributed().max_policy_lag());
-    std::fprintf(stderr, "learner: metrics on port %d\n", metrics->port());
-    if (!config.metrics_port_file.empty()) {
-      if (absl::Status status =
-              WritePortFile(config.metrics_port_file, metrics->port());
-          !status.ok()) {
-        server->server->Shutdown();
-        return status;
-      }
-    }
+    RecordGateway();
   }
-  std::atomic<int64_t> buffered_steps{0};
-  std::atomic<int64_t> missing_env_slots{0};
-  auto record_gateway = [&] {
-    if (metrics == nullptr) return;
-    const GatewayCounters counters = gateway.counters();
-    metrics->RecordSegmentsAccepted(counters.accepted_segments);
-    metrics->RecordRejected(counters.rejected);
-    metrics->RecordActors({counters.live_actors, service.open_streams(),
-                           counters.registrations, counters.expirations,
-                           missing_env_slots.load()});
-    metrics->SetQueueDepth(static_cast<int64_t>(queue.size()),
-                           buffered_steps.load());
-    std::vector<LearnerMetrics::ActorActivity> actors;
-    const absl::Time now = absl::Now();
-    for (const ActorActivity& actor : gateway.activity()) {
-      // An open stream is an actor heard from now, even one that waits
-      // for room in the queue.
-      const absl::Time seen = actor.connected ? now : actor.last_seen;
-      actors.push_back({actor.actor_id, actor.accepted_steps,
-                        absl::ToDoubleSeconds(seen - absl::UnixEpoch())});
-    }
-    metrics->RecordActorActivity(actors);
-  };
-  // Registrations that expired, for the update loop to free (the stitcher
-  // belongs to that thread).
-  std::mutex expired_mutex;
-  std::vector<int64_t> expired;
-  // Closing the queue is how a stop request reaches a blocked update; the
-  // same thread ends idle streams, expires registrations and keeps the
-  // ingest metrics fresh while updates block.
-  std::thread watcher([&] {
-    EnvSlotShortfall shortfall(config.run_config.distributed().sync(),
-                               own_streams);
-    while (!stop && !gateway.closed()) {
-      std::this_thread::sleep_for(std::chrono::milliseconds(50));
-      missing_env_slots = shortfall.Check(gateway.counters().live_env_slots);
-      service.CancelIdleStreams();
-      std::vector<int64_t> gone = gateway.ExpireIdle();
-      if (!gone.empty()) {
-        std::lock_guard<std::mutex> lock(expired_mutex);
-        expired.insert(expired.end(), gone.begin(), gone.end());
-      }
-      record_gateway();
-    }
-    queue.Close();
-  });
-  // Where the learner's time goes, printed when it stops; the rest is
-  // waiting for a batch.
-  PhaseTimes times({"advantages", "optimisation", "bookkeeping", "publish"});
-  auto finish = [&](absl::Status status) {
-    std::fprintf(stderr, "learner: %s\n",
-                 times.Summary("waiting for data").c_str());
-    gateway.Close();
-    queue.Close();
-    server->server->Shutdown(std::chrono::system_clock::now() +
-                             std::chrono::seconds(2));
-    watcher.join();
-    return stop ? absl::OkStatus() : status;
-  };
+  queue_->Close();
+}
 
-  auto server_state = [&]() -> absl::StatusOr<CheckpointExtras> {
-    return ServerStateExtras(spec, gateway.next_actor_id());
-  };
+void LearnerProcess::RecordGateway() {
+  if (metrics_ == nullptr) return;
+  const GatewayCounters counters = gateway_->counters();
+  metrics_->RecordSegmentsAccepted(counters.accepted_segments);
+  metrics_->RecordRejected(counters.rejected);
+  metrics_->RecordActors({counters.live_actors, service_->open_streams(),
+                          counters.registrations, counters.expirations,
+                          missing_env_slots_.load()});
+  metrics_->SetQueueDepth(static_cast<int64_t>(queue_->size()),
+                          buffered_steps_.load());
+  std::vector<LearnerMetrics::ActorActivity> actors;
+  const absl::Time now = absl::Now();
+  for (const ActorActivity& actor : gateway_->activity()) {
+    // An open stream is an actor heard from now, even one that waits for
+    // room in the queue.
+    const absl::Time seen = actor.connected ? now : actor.last_seen;
+    actors.push_back({actor.actor_id, actor.accepted_steps,
+                      absl::ToDoubleSeconds(seen - absl::UnixEpoch())});
+  }
+  metrics_->RecordActorActivity(actors);
+}
 
-  gateway.Publish(learner.CurrentWeights());
-  while (!(*run)->done() && !stop) {
-    absl::StatusOr<ProgressRow> row = (*run)->Update(queue, server_state);
-    if (!row.ok() && stop) break;
-    if (!row.ok() && absl::IsUnavailable(row.status())) {
+void LearnerProcess::KeepCheckpoint(const char* when) {
+  if (absl::Status status =
+          run_->CheckpointNow([this] { return ServerState(); });
+      !status.ok()) {
+    std::fprintf(stderr, "learner: no checkpoint %s: %s\n", when,
+                 std::string(status.message()).c_str());
+  }
+}
+
+void LearnerProcess::ForgetExpiredActors() {
+  std::lock_guard<std::mutex> lock(expired_mutex_);
+  for (int64_t actor_id : expired_) run_->learner().ForgetActor(actor_id);
+  expired_.clear();
+}
+
+void LearnerProcess::RecordUpdate(const ProgressRow& row,
+                                  double publish_seconds) {
+  // Bookkeeping: the update's statistics and checks. Waiting is the rest:
+  // for a batch, and writing checkpoints.
+  const UpdateStats& stats = row.stats;
+  times_.Add(0, stats.advantage_seconds);
+  times_.Add(1, stats.optimisation_seconds);
+  times_.Add(2, stats.update_seconds - stats.advantage_seconds -
+                    stats.optimisation_seconds);
+  times_.Add(3, publish_seconds);
+  buffered_steps_ = run_->learner().buffered_steps();
+  if (metrics_ == nullptr) return;
+  // The statistics first: a scrape that sees this update's version finds
+  // its statistics' series.
+  std::vector<LearnerMetrics::Statistic> statistics;
+  for (const ProgressColumn& column : ProgressColumns()) {
+    statistics.push_back({column.metric, column.help, column.value(row),
+                          column.kind == ProgressColumn::Metric::kCounter});
+  }
+  metrics_->RecordStatistics(statistics);
+  for (int64_t lag : stats.rollout_policy_lags) {
+    metrics_->RecordPolicyLag(lag);
+  }
+  metrics_->RecordUpdate(stats.policy_version, stats.update_seconds);
+  metrics_->AddUpdatePhases(stats.advantage_seconds, stats.optimisation_seconds,
+                            publish_seconds);
+  RecordGateway();
+}
+
+absl::Status LearnerProcess::Train(
+    const std::function<void(const ProgressRow&)>& on_update) {
+  LearnerCore& learner = run_->learner();
+  gateway_->Publish(learner.CurrentWeights());
+  while (!run_->done() && !stop_) {
+    absl::StatusOr<ProgressRow> row =
+        run_->Update(*queue_, [this] { return ServerState(); });
+    if (!row.ok() && stop_) break;
+    if (!row.ok()) {
       // A replica is gone and the update was undone: what the learner
       // holds is the last update's state, worth keeping for the restart.
-      if (absl::Status kept = (*run)->CheckpointNow(server_state); !kept.ok()) {
-        std::fprintf(stderr, "learner: no checkpoint after the failure: %s\n",
-                     std::string(kept.message()).c_str());
+      if (absl::IsUnavailable(row.status())) {
+        KeepCheckpoint("after the failure");
       }
+      return row.status();
     }
-    if (!row.ok()) return finish(row.status());
     const auto publish_start = std::chrono::steady_clock::now();
-    gateway.Publish(learner.CurrentWeights());
+    gateway_->Publish(learner.CurrentWeights());
     const double publish_seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() -
                                       publish_start)
             .count();
-    // Bookkeeping: the update's statistics and checks. Waiting is the rest:
-    // for a batch, and writing checkpoints.
-    const UpdateStats& update = row->stats;
-    times.Add(0, update.advantage_seconds);
-    times.Add(1, update.optimisation_seconds);
-    times.Add(2, update.update_seconds - update.advantage_seconds -
-                     update.optimisation_seconds);
-    times.Add(3, publish_seconds);
-    {
-      std::lock_guard<std::mutex> lock(expired_mutex);
-      for (int64_t actor_id : expired) learner.ForgetActor(actor_id);
-      expired.clear();
-    }
-    buffered_steps = learner.buffered_steps();
-    if (metrics != nullptr) {
-      const UpdateStats& stats = row->stats;
-      // The statistics first: a scrape that sees this update's version
-      // finds its statistics' series.
-      std::vector<LearnerMetrics::Statistic> statistics;
-      for (const ProgressColumn& column : ProgressColumns()) {
-        statistics.push_back({column.metric, column.help, column.value(*row),
-                              column.kind == ProgressColumn::Metric::kCounter});
-      }
-      metrics->RecordStatistics(statistics);
-      for (int64_t lag : stats.rollout_policy_lags) {
-        metrics->RecordPolicyLag(lag);
-      }
-      metrics->RecordUpdate(stats.policy_version, stats.update_seconds);
-      metrics->AddUpdatePhases(stats.advantage_seconds,
-                               stats.optimisation_seconds, publish_seconds);
-      record_gateway();
-    }
+    ForgetExpiredActors();
+    RecordUpdate(*row, publish_seconds);
     on_update(*row);
   }
-  // Stopped by a signal (a scheduler's preemption): keep every update.
-  if (stop) {
-    if (absl::Status status = (*run)->CheckpointNow(server_state);
-        !status.ok()) {
-      std::fprintf(stderr, "learner: no checkpoint at the stop: %s\n",
-                   std::string(status.message()).c_str());
-    }
+  if (stop_) {
+    // Stopped by a signal (a scheduler's preemption): keep every update.
+    KeepCheckpoint("at the stop");
   } else {
-    // Complete: the actors are told so (and exit), rather than finding
-    // the learner gone and reconnecting to it forever.
-    gateway.FinishRun();
+    // Complete: the actors are told so (and exit), rather than finding the
+    // learner gone and reconnecting to it forever.
+    gateway_->FinishRun();
   }
-  return finish(absl::OkStatus());
+  return absl::OkStatus();
+}
+
+absl::Status LearnerProcess::Finish(absl::Status status) {
+  std::fprintf(stderr, "learner: %s\n",
+               times_.Summary("waiting for data").c_str());
+  gateway_->Close();
+  queue_->Close();
+  server_.server->Shutdown(std::chrono::system_clock::now() +
+                           std::chrono::seconds(2));
+  watcher_.join();
+  return stop_ ? absl::OkStatus() : status;
+}
+
+}  // namespace
+
+absl::Status RunLearnerServer(
+    const LearnerServerConfig& config, const std::atomic<bool>& stop,
+    const std::function<void(const ProgressRow&)>& on_update) {
+  LearnerProcess process(config, stop);
+  if (absl::Status status = process.Open(); !status.ok()) return status;
+  if (absl::Status status = process.Serve(); !status.ok()) return status;
+  return process.Finish(process.Train(on_update));
 }
 
 }  // namespace vantage
