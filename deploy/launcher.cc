@@ -213,210 +213,296 @@ class MetricsPlan {
   bool announced_ = false;
 };
 
-}  // namespace
+// The processes of a run on one machine, started and watched: the learners
+// (Start), then the actors (StartActors), then Supervise until the learners
+// finish, one fails for good or a stop is requested.
+class Supervisor {
+ public:
+  Supervisor(const LaunchConfig& config, const std::atomic<bool>& stop)
+      : config_(config),
+        run_(config.run_config),
+        stop_(stop),
+        learner_count_(std::max(1, run_.distributed().learners())),
+        actor_count_(run_.distributed().actors()),
+        config_path_(config.work_dir + "/launch_config.json"),
+        security_args_(SecurityArgs(config)),
+        metrics_(config, learner_count_, actor_count_),
+        ports_(learner_count_, "0"),
+        learners_(learner_count_, -1),
+        finished_(learner_count_, false),
+        actors_(actor_count_, -1) {}
 
-absl::Status RunDistributedTraining(const LaunchConfig& config,
-                                    const std::atomic<bool>& stop) {
-  const pb::RunConfig& run = config.run_config;
-  const int learner_count = std::max(1, run.distributed().learners());
-  std::error_code error;
-  std::filesystem::create_directories(config.work_dir, error);
-  const std::string config_path = config.work_dir + "/launch_config.json";
-  {
-    std::ofstream file(config_path, std::ios::trunc);
-    file << RunConfigToJson(run);
-    if (!file.flush()) {
-      return absl::InternalError(absl::StrCat("cannot write ", config_path));
-    }
-  }
-  const auto port_file = [&](int rank) {
+  absl::Status Run();
+
+ private:
+  // How the loop goes on after a learner's exit.
+  enum class Next { kWatch, kFinished, kFailed };
+
+  absl::Status WriteLaunchConfig() const;
+  std::string PortFile(int rank) const {
     return rank == 0
-               ? config.work_dir + "/learner.port"
-               : absl::StrCat(config.work_dir, "/learner-", rank, ".port");
-  };
-  const std::vector<std::string> security_args = SecurityArgs(config);
-  MetricsPlan metrics(config, learner_count, run.distributed().actors());
-  // Learner ranks' gRPC ports ("0" until first bound: the actors keep
-  // them across restarts) and processes.
-  std::vector<std::string> ports(learner_count, "0");
-  std::vector<pid_t> learners(learner_count, -1);
+               ? config_.work_dir + "/learner.port"
+               : absl::StrCat(config_.work_dir, "/learner-", rank, ".port");
+  }
+  std::string LearnerName(int rank) const {
+    return learner_count_ > 1 ? absl::StrCat("learner ", rank)
+                              : std::string("the learner");
+  }
+  std::vector<std::string> LearnerArgs(int rank, bool resume,
+                                       const std::string& rendezvous);
   // A resumed learner continues the run directory as its config.json says,
   // on the port its actors already know. Replicas meet at a rendezvous on
   // a port fresh for every start, so a restart never meets the old group.
-  auto start_learners = [&](bool resume) -> absl::Status {
-    std::string rendezvous;
-    if (learner_count > 1) {
-      absl::StatusOr<int> port = FreeLoopbackPort();
-      if (!port.ok()) return port.status();
-      rendezvous = absl::StrCat("127.0.0.1:", *port);
-    }
-    for (int rank = 0; rank < learner_count; ++rank) {
-      std::filesystem::remove(port_file(rank), error);
-      std::vector<std::string> args = {"learner",
-                                       "--listen=127.0.0.1:" + ports[rank],
-                                       "--port_file=" + port_file(rank)};
-      if (learner_count > 1) {
-        args.push_back(absl::StrCat("--rank=", rank));
-        args.push_back("--rendezvous=" + rendezvous);
-      }
-      if (resume) {
-        args.push_back("--resume=" + config.run_dir);
-      } else {
-        args.push_back("--config=" + config_path);
-        if (!config.run_dir.empty())
-          args.push_back("--run_dir=" + config.run_dir);
-      }
-      args.insert(args.end(), security_args.begin(), security_args.end());
-      args.insert(args.end(), config.learner_args.begin(),
-                  config.learner_args.end());
-      const std::vector<std::string> metrics_args = metrics.LearnerArgs(rank);
-      args.insert(args.end(), metrics_args.begin(), metrics_args.end());
-      absl::StatusOr<pid_t> pid = SpawnSelf(args);
-      if (!pid.ok()) return pid.status();
-      learners[rank] = *pid;
-    }
-    std::vector<std::string> port_files;
-    for (int rank = 0; rank < learner_count; ++rank) {
-      port_files.push_back(port_file(rank));
-    }
-    int status = 0;
-    const int ended = WaitForPorts(learners, port_files, stop, ports, status);
-    if (ended < 0) return absl::OkStatus();
-    learners[ended] = -1;
-    return absl::InternalError(
-        absl::StrCat(learner_count > 1 ? absl::StrCat("learner ", ended)
-                                       : std::string("the learner"),
-                     " ended before serving (", Describe(status), ")"));
-  };
-  std::vector<pid_t> actors(run.distributed().actors(), -1);
-  auto everyone = [&] {
-    std::vector<pid_t> all = actors;
-    all.insert(all.end(), learners.begin(), learners.end());
+  // Returns once every learner serves (or a stop is requested).
+  absl::Status StartLearners(bool resume);
+  // Actor i serves learner i mod K, so each learner gets an equal share.
+  absl::StatusOr<pid_t> StartActor(int i);
+  absl::Status StartActors();
+  std::vector<pid_t> Everyone() const {
+    std::vector<pid_t> all = actors_;
+    all.insert(all.end(), learners_.begin(), learners_.end());
     return all;
-  };
-  if (absl::Status started = start_learners(config.resume); !started.ok()) {
-    Terminate(learners, std::chrono::seconds(10));
-    return started;
   }
-  if (stop) {
-    Terminate(learners, std::chrono::seconds(10));
+  // Until the learners finish the run (OK), one fails for good, or a stop.
+  absl::Status Supervise();
+  Next OnLearnerExit(int rank, int status, absl::Status& result);
+  // An actor that ended is restarted unless the run is over for it.
+  absl::Status OnActorExit(int i, int status);
+
+  const LaunchConfig& config_;
+  const pb::RunConfig& run_;
+  const std::atomic<bool>& stop_;
+  const int learner_count_;
+  const int actor_count_;
+  const std::string config_path_;
+  const std::vector<std::string> security_args_;
+  MetricsPlan metrics_;
+  // Learner ranks' gRPC ports ("0" until first bound: the actors keep them
+  // across restarts) and processes, and the ranks that finished the run
+  // (exit code 0).
+  std::vector<std::string> ports_;
+  std::vector<pid_t> learners_;
+  std::vector<bool> finished_;
+  std::vector<pid_t> actors_;
+  int actor_restarts_ = 0;
+  int learner_restarts_ = 0;
+};
+
+absl::Status Supervisor::WriteLaunchConfig() const {
+  std::error_code error;
+  std::filesystem::create_directories(config_.work_dir, error);
+  std::ofstream file(config_path_, std::ios::trunc);
+  file << RunConfigToJson(run_);
+  if (!file.flush()) {
+    return absl::InternalError(absl::StrCat("cannot write ", config_path_));
+  }
+  return absl::OkStatus();
+}
+
+std::vector<std::string> Supervisor::LearnerArgs(
+    int rank, bool resume, const std::string& rendezvous) {
+  std::vector<std::string> args = {"learner",
+                                   "--listen=127.0.0.1:" + ports_[rank],
+                                   "--port_file=" + PortFile(rank)};
+  if (learner_count_ > 1) {
+    args.push_back(absl::StrCat("--rank=", rank));
+    args.push_back("--rendezvous=" + rendezvous);
+  }
+  if (resume) {
+    args.push_back("--resume=" + config_.run_dir);
+  } else {
+    args.push_back("--config=" + config_path_);
+    if (!config_.run_dir.empty())
+      args.push_back("--run_dir=" + config_.run_dir);
+  }
+  args.insert(args.end(), security_args_.begin(), security_args_.end());
+  args.insert(args.end(), config_.learner_args.begin(),
+              config_.learner_args.end());
+  const std::vector<std::string> metrics_args = metrics_.LearnerArgs(rank);
+  args.insert(args.end(), metrics_args.begin(), metrics_args.end());
+  return args;
+}
+
+absl::Status Supervisor::StartLearners(bool resume) {
+  std::string rendezvous;
+  if (learner_count_ > 1) {
+    absl::StatusOr<int> port = FreeLoopbackPort();
+    if (!port.ok()) return port.status();
+    rendezvous = absl::StrCat("127.0.0.1:", *port);
+  }
+  std::vector<std::string> port_files;
+  for (int rank = 0; rank < learner_count_; ++rank) {
+    port_files.push_back(PortFile(rank));
+    std::error_code error;
+    std::filesystem::remove(port_files.back(), error);
+    absl::StatusOr<pid_t> pid =
+        SpawnSelf(LearnerArgs(rank, resume, rendezvous));
+    if (!pid.ok()) return pid.status();
+    learners_[rank] = *pid;
+  }
+  int status = 0;
+  const int ended = WaitForPorts(learners_, port_files, stop_, ports_, status);
+  if (ended < 0) return absl::OkStatus();
+  learners_[ended] = -1;
+  return absl::InternalError(absl::StrCat(
+      LearnerName(ended), " ended before serving (", Describe(status), ")"));
+}
+
+absl::StatusOr<pid_t> Supervisor::StartActor(int i) {
+  std::vector<std::string> args = {
+      "actor",
+      "--learner=127.0.0.1:" + ports_[i % learner_count_],
+      "--env=" + run_.training().env(),
+      absl::StrCat("--envs=", run_.distributed().envs_per_actor()),
+      absl::StrCat("--seed=", run_.training().seed() + i),
+      absl::StrCat("--name=actor-", i)};
+  args.insert(args.end(), security_args_.begin(), security_args_.end());
+  const std::vector<std::string> metrics_args = metrics_.ActorArgs(i);
+  args.insert(args.end(), metrics_args.begin(), metrics_args.end());
+  return SpawnSelf(args);
+}
+
+absl::Status Supervisor::StartActors() {
+  const std::string serving =
+      learner_count_ > 1 ? absl::StrCat(learner_count_, " learners on ports ",
+                                        absl::StrJoin(ports_, ", "))
+                         : absl::StrCat("learner on port ", ports_[0]);
+  std::fprintf(stderr, "launcher: %s, starting %d actors\n", serving.c_str(),
+               actor_count_);
+  for (int i = 0; i < actor_count_; ++i) {
+    absl::StatusOr<pid_t> pid = StartActor(i);
+    if (!pid.ok()) return pid.status();
+    actors_[i] = *pid;
+  }
+  return absl::OkStatus();
+}
+
+Supervisor::Next Supervisor::OnLearnerExit(int rank, int status,
+                                           absl::Status& result) {
+  learners_[rank] = -1;
+  if (WIFEXITED(status) && WEXITSTATUS(status) == 0) {
+    finished_[rank] = true;
+    return std::all_of(finished_.begin(), finished_.end(),
+                       [](bool f) { return f; })
+               ? Next::kFinished
+               : Next::kWatch;
+  }
+  const std::string who = LearnerName(rank);
+  if (learner_restarts_ >= config_.max_learner_restarts ||
+      !CanResume(config_, status)) {
+    result = absl::InternalError(
+        absl::StrCat(who, " failed (", Describe(status), ")"));
+    return Next::kFailed;
+  }
+  // The actors keep their environments and reconnect by themselves;
+  // replicas only ever train together, so all restart.
+  ++learner_restarts_;
+  std::fprintf(stderr,
+               "launcher: %s ended (%s); resuming %s from the run's last "
+               "checkpoint\n",
+               who.c_str(), Describe(status).c_str(),
+               learner_count_ > 1 ? "every learner" : "it");
+  Terminate(learners_, std::chrono::seconds(30));
+  std::fill(finished_.begin(), finished_.end(), false);
+  if (absl::Status restarted = StartLearners(/*resume=*/true);
+      !restarted.ok()) {
+    result = absl::InternalError(absl::StrCat(
+        "resuming from the last checkpoint failed: ", restarted.message()));
+    return Next::kFailed;
+  }
+  return Next::kWatch;
+}
+
+absl::Status Supervisor::OnActorExit(int i, int status) {
+  // Exit 0: the learner told it the run is complete; the learner's own exit
+  // follows.
+  if (WIFEXITED(status) && WEXITSTATUS(status) == 0) {
+    actors_[i] = -1;
     return absl::OkStatus();
   }
-  const std::string serving =
-      learner_count > 1 ? absl::StrCat(learner_count, " learners on ports ",
-                                       absl::StrJoin(ports, ", "))
-                        : absl::StrCat("learner on port ", ports[0]);
-  std::fprintf(stderr, "launcher: %s, starting %d actors\n", serving.c_str(),
-               run.distributed().actors());
-
-  // Actor i serves learner i mod K, so each learner gets an equal share.
-  auto start_actor = [&](int i) {
-    std::vector<std::string> args = {
-        "actor",
-        "--learner=127.0.0.1:" + ports[i % learner_count],
-        "--env=" + run.training().env(),
-        absl::StrCat("--envs=", run.distributed().envs_per_actor()),
-        absl::StrCat("--seed=", run.training().seed() + i),
-        absl::StrCat("--name=actor-", i)};
-    args.insert(args.end(), security_args.begin(), security_args.end());
-    const std::vector<std::string> metrics_args = metrics.ActorArgs(i);
-    args.insert(args.end(), metrics_args.begin(), metrics_args.end());
-    return SpawnSelf(args);
-  };
-  for (int i = 0; i < run.distributed().actors(); ++i) {
-    absl::StatusOr<pid_t> pid = start_actor(i);
-    if (!pid.ok()) {
-      Terminate(everyone(), std::chrono::seconds(10));
-      return pid.status();
-    }
-    actors[i] = *pid;
+  if (actor_restarts_ >= config_.max_actor_restarts) {
+    actors_[i] = -1;
+    return absl::InternalError(
+        absl::StrCat("actor ", i, " ended (", Describe(status), ") after ",
+                     actor_restarts_, " restarts; giving up"));
   }
+  ++actor_restarts_;
+  std::fprintf(stderr, "launcher: actor %d ended (%s); restarting it\n", i,
+               Describe(status).c_str());
+  absl::StatusOr<pid_t> pid = StartActor(i);
+  actors_[i] = pid.ok() ? *pid : -1;
+  return absl::OkStatus();
+}
 
-  int actor_restarts = 0;
-  int learner_restarts = 0;
-  // Ranks whose learner finished the run (exit code 0).
-  std::vector<bool> finished(learner_count, false);
-  absl::Status result;
+absl::Status Supervisor::Supervise() {
   auto last_refresh = std::chrono::steady_clock::now();
-  while (true) {
-    if (stop) {
-      // Everyone gets the signal; rank 0 writes the last checkpoint.
-      Terminate(everyone(), std::chrono::seconds(30));
-      metrics.Clear();
-      return absl::OkStatus();
-    }
+  while (!stop_) {
     if (std::chrono::steady_clock::now() - last_refresh >
         std::chrono::milliseconds(250)) {
-      metrics.Refresh();
+      metrics_.Refresh();
       last_refresh = std::chrono::steady_clock::now();
     }
     int status = 0;
     const pid_t done = waitpid(-1, &status, WNOHANG);
-    const auto learner = std::find(learners.begin(), learners.end(), done);
-    if (done > 0 && learner != learners.end()) {
-      const int rank = static_cast<int>(learner - learners.begin());
-      *learner = -1;
-      if (WIFEXITED(status) && WEXITSTATUS(status) == 0) {
-        finished[rank] = true;
-        if (std::all_of(finished.begin(), finished.end(),
-                        [](bool f) { return f; })) {
-          break;
-        }
-        continue;
-      }
-      const std::string who =
-          learner_count > 1 ? absl::StrCat("learner ", rank) : "the learner";
-      if (learner_restarts >= config.max_learner_restarts ||
-          !CanResume(config, status)) {
-        result = absl::InternalError(
-            absl::StrCat(who, " failed (", Describe(status), ")"));
-        break;
-      }
-      // The actors keep their environments and reconnect by themselves;
-      // replicas only ever train together, so all restart.
-      ++learner_restarts;
-      std::fprintf(stderr,
-                   "launcher: %s ended (%s); resuming %s from the run's last "
-                   "checkpoint\n",
-                   who.c_str(), Describe(status).c_str(),
-                   learner_count > 1 ? "every learner" : "it");
-      Terminate(learners, std::chrono::seconds(30));
-      std::fill(finished.begin(), finished.end(), false);
-      if (absl::Status restarted = start_learners(/*resume=*/true);
-          !restarted.ok()) {
-        result = absl::InternalError(absl::StrCat(
-            "resuming from the last checkpoint failed: ", restarted.message()));
-        break;
-      }
+    if (done <= 0) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
       continue;
     }
-    for (int i = 0; done > 0 && i < run.distributed().actors(); ++i) {
-      if (actors[i] != done) continue;
-      // Exit 0: the learner told it the run is complete; the learner's own
-      // exit follows.
-      if (WIFEXITED(status) && WEXITSTATUS(status) == 0) {
-        actors[i] = -1;
-        break;
+    if (const auto learner =
+            std::find(learners_.begin(), learners_.end(), done);
+        learner != learners_.end()) {
+      absl::Status result;
+      switch (OnLearnerExit(static_cast<int>(learner - learners_.begin()),
+                            status, result)) {
+        case Next::kFinished:
+          return absl::OkStatus();
+        case Next::kFailed:
+          return result;
+        case Next::kWatch:
+          continue;
       }
-      if (actor_restarts >= config.max_actor_restarts) {
-        actors[i] = -1;
-        result = absl::InternalError(
-            absl::StrCat("actor ", i, " ended (", Describe(status), ") after ",
-                         actor_restarts, " restarts; giving up"));
-        break;
-      }
-      ++actor_restarts;
-      std::fprintf(stderr, "launcher: actor %d ended (%s); restarting it\n", i,
-                   Describe(status).c_str());
-      absl::StatusOr<pid_t> pid = start_actor(i);
-      actors[i] = pid.ok() ? *pid : -1;
     }
-    if (!result.ok()) break;
+    if (const auto actor = std::find(actors_.begin(), actors_.end(), done);
+        actor != actors_.end()) {
+      if (absl::Status actor_status =
+              OnActorExit(static_cast<int>(actor - actors_.begin()), status);
+          !actor_status.ok()) {
+        return actor_status;
+      }
+    }
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
-  Terminate(everyone(), std::chrono::seconds(30));
-  if (result.ok()) metrics.Clear();
+  return absl::OkStatus();
+}
+
+absl::Status Supervisor::Run() {
+  if (absl::Status status = WriteLaunchConfig(); !status.ok()) return status;
+  if (absl::Status started = StartLearners(config_.resume); !started.ok()) {
+    Terminate(learners_, std::chrono::seconds(10));
+    return started;
+  }
+  if (stop_) {
+    Terminate(learners_, std::chrono::seconds(10));
+    return absl::OkStatus();
+  }
+  if (absl::Status started = StartActors(); !started.ok()) {
+    Terminate(Everyone(), std::chrono::seconds(10));
+    return started;
+  }
+  // Stopped (Supervise returns OK then): everyone gets the signal, and rank
+  // 0 writes the last checkpoint.
+  const absl::Status result = Supervise();
+  Terminate(Everyone(), std::chrono::seconds(30));
+  if (result.ok()) metrics_.Clear();
   return result;
+}
+
+}  // namespace
+
+absl::Status RunDistributedTraining(const LaunchConfig& config,
+                                    const std::atomic<bool>& stop) {
+  Supervisor supervisor(config, stop);
+  return supervisor.Run();
 }
 
 }  // namespace vantage
