@@ -117,50 +117,14 @@ class Session {
   // `progressed` tells whether the learner accepted us at all.
   absl::Status Run(const EnvSpec& spec, std::unique_ptr<ActorCore>& actor,
                    const std::atomic<bool>& stop, bool& progressed) {
-    pb::RegisterRequest request;
-    EnvSpecToProto(spec, request.mutable_spec());
-    request.set_actor_name(config_.name);
-    request.set_num_envs(config_.num_envs);
     pb::RegisterResponse response;
-    grpc::ClientContext register_context;
-    register_context.set_deadline(std::chrono::system_clock::now() +
-                                  std::chrono::seconds(120));
-    AddAuthToken(config_.security, register_context);
-    if (absl::Status status =
-            FromGrpc(stub_->Register(&register_context, request, &response),
-                     "registration");
-        !status.ok()) {
+    if (absl::Status status = Register(spec, response); !status.ok()) {
       return status;
     }
     progressed = true;
-    const pb::RunConfig& run = response.run_config();
     if (actor == nullptr) {
-      ActorConfig actor_config;
-      actor_config.env = config_.env;
-      // The learner's run config says how it wraps the environment; the
-      // registration carried the environment's own spec.
-      if (run.training().has_frame_stack()) {
-        actor_config.env_options.frame_stack = run.training().frame_stack();
-      }
-      actor_config.num_envs = config_.num_envs;
-      actor_config.segment_length = run.training().segment_length();
-      actor_config.seed =
-          config_.seed.has_value()
-              ? *config_.seed
-              : ActorEnvSeed(run.training().seed(), response.actor_id());
-      actor_config.actor_id = response.actor_id();
-      actor_config.network.hidden.assign(run.training().hidden().begin(),
-                                         run.training().hidden().end());
-      // A learner from before torsos existed built MLPs.
-      absl::StatusOr<Torso> torso = ParseTorso(
-          run.training().has_torso() ? run.training().torso() : "mlp");
-      if (!torso.ok()) {
-        return absl::InvalidArgumentError(absl::StrCat(
-            "the learner's run config: ", torso.status().message()));
-      }
-      actor_config.network.torso = *torso;
       absl::StatusOr<std::unique_ptr<ActorCore>> created =
-          ActorCore::Create(actor_config);
+          CreateActor(response);
       if (!created.ok()) return created.status();
       actor = *std::move(created);
     }
@@ -174,14 +138,65 @@ class Session {
                  config_.name.c_str(), static_cast<long>(response.actor_id()),
                  static_cast<long>(actor->policy_version()),
                  static_cast<unsigned long long>(actor->env_seed()));
+    return Stream(response, *actor, stop);
+  }
 
+ private:
+  absl::Status Register(const EnvSpec& spec, pb::RegisterResponse& response) {
+    pb::RegisterRequest request;
+    EnvSpecToProto(spec, request.mutable_spec());
+    request.set_actor_name(config_.name);
+    request.set_num_envs(config_.num_envs);
+    grpc::ClientContext context;
+    context.set_deadline(std::chrono::system_clock::now() +
+                         std::chrono::seconds(120));
+    AddAuthToken(config_.security, context);
+    return FromGrpc(stub_->Register(&context, request, &response),
+                    "registration");
+  }
+
+  // The actor the learner's run config describes (the first registration's;
+  // later ones keep it and its environments).
+  absl::StatusOr<std::unique_ptr<ActorCore>> CreateActor(
+      const pb::RegisterResponse& response) const {
+    const pb::RunConfig& run = response.run_config();
+    ActorConfig actor_config;
+    actor_config.env = config_.env;
+    // The learner's run config says how it wraps the environment; the
+    // registration carried the environment's own spec.
+    if (run.training().has_frame_stack()) {
+      actor_config.env_options.frame_stack = run.training().frame_stack();
+    }
+    actor_config.num_envs = config_.num_envs;
+    actor_config.segment_length = run.training().segment_length();
+    actor_config.seed =
+        config_.seed.has_value()
+            ? *config_.seed
+            : ActorEnvSeed(run.training().seed(), response.actor_id());
+    actor_config.actor_id = response.actor_id();
+    actor_config.network.hidden.assign(run.training().hidden().begin(),
+                                       run.training().hidden().end());
+    // A learner from before torsos existed built MLPs.
+    absl::StatusOr<Torso> torso =
+        ParseTorso(run.training().has_torso() ? run.training().torso() : "mlp");
+    if (!torso.ok()) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("the learner's run config: ", torso.status().message()));
+    }
+    actor_config.network.torso = *torso;
+    return ActorCore::Create(actor_config);
+  }
+
+  // The session's weights subscription and segment stream around Act.
+  absl::Status Stream(const pb::RegisterResponse& response, ActorCore& actor,
+                      const std::atomic<bool>& stop) {
     WeightsSlot slot;
     grpc::ClientContext subscription_context;
     AddAuthToken(config_.security, subscription_context);
     subscription_context.AddMetadata(kSessionMetadataKey, response.session());
     pb::WeightsRequest weights_request;
     weights_request.set_actor_id(response.actor_id());
-    weights_request.set_known_version(actor->policy_version());
+    weights_request.set_known_version(actor.policy_version());
     std::unique_ptr<grpc::ClientReader<pb::Weights>> subscription =
         stub_->SubscribeWeights(&subscription_context, weights_request);
     std::thread reader([&] {
@@ -197,64 +212,8 @@ class Session {
     std::unique_ptr<grpc::ClientWriter<pb::Segment>> writer =
         stub_->StreamSegments(&stream_context, &ack);
     StreamSink sink(*writer, metrics_, times_);
-    // Pacing: horizon h (counted from this registration) may start once
-    // the learner has published h - ahead versions since then. A sync run
-    // (ahead 0) acts one horizon per version, exactly on-policy; an async
-    // actor acts up to two horizons ahead (no more than the allowed policy
-    // lag), during the learner's updates, which is how acting hides behind
-    // learning (one horizon ahead leaves the learner waiting whenever an
-    // actor is slowed down), and never so far ahead that its segments
-    // would grow stale or memory would grow.
-    const int64_t rounds_per_horizon = std::max<int64_t>(
-        1, run.training().horizon() / run.training().segment_length());
-    const int64_t ahead =
-        run.distributed().sync()
-            ? 0
-            : std::min<int64_t>(2, run.distributed().max_policy_lag());
-    const int64_t first_version = actor->policy_version();
-    int64_t rounds = 0;
-    absl::Status status;
-    while (!stop && status.ok()) {
-      if (rounds % rounds_per_horizon == 0) {
-        const int64_t needed =
-            first_version + rounds / rounds_per_horizon - ahead;
-        auto known = [&] {
-          std::shared_ptr<const pb::Weights> newest = slot.Get();
-          return std::max(actor->policy_version(),
-                          newest == nullptr ? -1 : newest->version());
-        };
-        while (!stop && !slot.ended() && known() < needed) {
-          std::this_thread::sleep_for(std::chrono::milliseconds(2));
-        }
-        if (stop) break;
-      }
-      if (std::shared_ptr<const pb::Weights> newest = slot.Get();
-          newest != nullptr && newest->version() > actor->policy_version()) {
-        status = Apply(*newest, *actor);
-        if (!status.ok()) break;
-      }
-      if (slot.ended()) {
-        status = slot.end_status();
-        if (status.ok()) {
-          status = absl::UnavailableError("the weights subscription ended");
-        }
-        break;
-      }
-      const double inference_before = actor->inference_seconds();
-      const double env_before = actor->env_seconds();
-      status = actor->CollectSegments(sink);
-      ++rounds;
-      const double inference = actor->inference_seconds() - inference_before;
-      const double physics = actor->env_seconds() - env_before;
-      times_.Add(kInferencePhase, inference);
-      times_.Add(kPhysicsPhase, physics);
-      if (metrics_ != nullptr) {
-        metrics_->RecordEnvSteps(actor->env_steps());
-        metrics_->AddInferenceSeconds(inference);
-        metrics_->AddEnvSeconds(physics);
-        metrics_->SetPolicyVersion(actor->policy_version());
-      }
-    }
+    const absl::Status status =
+        Act(response.run_config(), actor, slot, sink, stop);
     writer->WritesDone();
     const absl::Status finished = FromGrpc(writer->Finish(), "segment stream");
     subscription_context.TryCancel();
@@ -265,7 +224,76 @@ class Session {
     return finished.ok() ? status : finished;
   }
 
- private:
+  // Acts and sends until an error, the subscription's end or `stop` (OK).
+  // Pacing: horizon h (counted from this registration) may start once the
+  // learner has published h - ahead versions since then. A sync run (ahead
+  // 0) acts one horizon per version, exactly on-policy; an async actor acts
+  // up to two horizons ahead (no more than the allowed policy lag), during
+  // the learner's updates, which is how acting hides behind learning (one
+  // horizon ahead leaves the learner waiting whenever an actor is slowed
+  // down), and never so far ahead that its segments would grow stale or
+  // memory would grow.
+  absl::Status Act(const pb::RunConfig& run, ActorCore& actor,
+                   const WeightsSlot& slot, SegmentSink& sink,
+                   const std::atomic<bool>& stop) {
+    const int64_t rounds_per_horizon = std::max<int64_t>(
+        1, run.training().horizon() / run.training().segment_length());
+    const int64_t ahead =
+        run.distributed().sync()
+            ? 0
+            : std::min<int64_t>(2, run.distributed().max_policy_lag());
+    const int64_t first_version = actor.policy_version();
+    auto known = [&] {
+      std::shared_ptr<const pb::Weights> newest = slot.Get();
+      return std::max(actor.policy_version(),
+                      newest == nullptr ? -1 : newest->version());
+    };
+    for (int64_t rounds = 0; !stop; ++rounds) {
+      if (rounds % rounds_per_horizon == 0) {
+        const int64_t needed =
+            first_version + rounds / rounds_per_horizon - ahead;
+        while (!stop && !slot.ended() && known() < needed) {
+          std::this_thread::sleep_for(std::chrono::milliseconds(2));
+        }
+        if (stop) break;
+      }
+      if (std::shared_ptr<const pb::Weights> newest = slot.Get();
+          newest != nullptr && newest->version() > actor.policy_version()) {
+        if (absl::Status status = Apply(*newest, actor); !status.ok()) {
+          return status;
+        }
+      }
+      if (slot.ended()) {
+        const absl::Status status = slot.end_status();
+        return status.ok()
+                   ? absl::UnavailableError("the weights subscription ended")
+                   : status;
+      }
+      if (absl::Status status = CollectRound(actor, sink); !status.ok()) {
+        return status;
+      }
+    }
+    return absl::OkStatus();
+  }
+
+  // One segment from every env, timed and counted.
+  absl::Status CollectRound(ActorCore& actor, SegmentSink& sink) {
+    const double inference_before = actor.inference_seconds();
+    const double env_before = actor.env_seconds();
+    const absl::Status status = actor.CollectSegments(sink);
+    const double inference = actor.inference_seconds() - inference_before;
+    const double physics = actor.env_seconds() - env_before;
+    times_.Add(kInferencePhase, inference);
+    times_.Add(kPhysicsPhase, physics);
+    if (metrics_ != nullptr) {
+      metrics_->RecordEnvSteps(actor.env_steps());
+      metrics_->AddInferenceSeconds(inference);
+      metrics_->AddEnvSeconds(physics);
+      metrics_->SetPolicyVersion(actor.policy_version());
+    }
+    return status;
+  }
+
   static absl::Status Apply(const pb::Weights& proto, ActorCore& actor) {
     absl::StatusOr<PolicyWeights> weights = WeightsFromProto(proto, 1LL << 30);
     if (!weights.ok()) return weights.status();
