@@ -9,6 +9,8 @@
 #include <thread>
 
 #include "absl/strings/str_cat.h"
+#include "absl/time/clock.h"
+#include "absl/time/time.h"
 #include "actor/actor_core.h"
 #include "actor/envs/env_registry.h"
 #include "actor/remote/actor_metrics.h"
@@ -33,6 +35,10 @@ bool IsRefusal(const absl::Status& status) {
   return absl::IsInvalidArgument(status) || absl::IsUnauthenticated(status) ||
          absl::IsPermissionDenied(status);
 }
+
+// How long a session whose segment stream the learner cut waits for the
+// subscription to say whether the run is over.
+constexpr absl::Duration kRunOverGrace = absl::Seconds(3);
 
 // The phases of the actor's time split.
 constexpr size_t kInferencePhase = 0;
@@ -91,6 +97,14 @@ class WeightsSlot {
     ended_ = true;
   }
   bool ended() const { return ended_; }
+  // Until the subscription ends or `timeout` passes; whether it ended.
+  bool WaitForEnd(absl::Duration timeout) const {
+    for (const absl::Time until = absl::Now() + timeout;
+         !ended_ && absl::Now() < until;) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+    return ended_;
+  }
   absl::Status end_status() const {
     std::lock_guard<std::mutex> lock(mutex_);
     return end_status_;
@@ -216,11 +230,22 @@ class Session {
         Act(response.run_config(), actor, slot, sink, stop);
     writer->WritesDone();
     const absl::Status finished = FromGrpc(writer->Finish(), "segment stream");
+    // A learner that completes the run says so on the subscription and then
+    // shuts down, which can cut the segment stream before that word has
+    // been read: it gets a moment to arrive before the subscription is
+    // cancelled (a learner that is gone ends the subscription at once).
+    if (!stop &&
+        (absl::IsUnavailable(status) || absl::IsUnavailable(finished))) {
+      slot.WaitForEnd(kRunOverGrace);
+    }
     subscription_context.TryCancel();
     reader.join();
     if (stop) return absl::OkStatus();
     // The run's end outranks the segment stream's, cut by the shutdown.
     if (absl::IsOutOfRange(status)) return status;
+    if (slot.ended() && absl::IsOutOfRange(slot.end_status())) {
+      return slot.end_status();
+    }
     return finished.ok() ? status : finished;
   }
 
