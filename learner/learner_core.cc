@@ -481,52 +481,10 @@ at::Tensor SpecShape(const EnvSpec& spec) {
                     at::kLong);
 }
 
-}  // namespace
-
-void LearnerCore::Save(torch::serialize::OutputArchive& archive) const {
-  WriteBytes(archive, "spec.name", config_.spec.name);
-  archive.write("spec.shape", SpecShape(config_.spec));
-  WriteBytes(archive, "algorithm", config_.algorithm.name);
-  WriteModule(archive, "policy", *policy_);
-  // A shared torso is written with both networks; this says the copies are
-  // one.
-  archive.write("shared_torso",
-                at::tensor(int64_t{config_.network.shared_torso ? 1 : 0}));
-  WriteModule(archive, "value", *value_);
-  torch::serialize::OutputArchive updater, scaler;
-  updater_->Save(updater);
-  reward_scaler_.Save(scaler);
-  archive.write("updater", updater);
-  archive.write("reward_scaler", scaler);
-  if (exploration_ != nullptr) exploration_->Save(archive, "ex2");
-  WriteRunningMeanStd(archive, "normalizer", normalizer_);
-  std::ostringstream rng;
-  rng << rng_;
-  WriteBytes(archive, "rng", rng.str());
-  archive.write("counters", at::tensor({version_, env_steps_, rejected_,
-                                        episodes_, stale_segments_,
-                                        stale_steps_, rolled_back_updates_},
-                                       at::kLong));
-  archive.write("recent_returns",
-                at::tensor(std::vector<double>(recent_returns_.begin(),
-                                               recent_returns_.end()),
-                           at::kDouble));
-}
-
-absl::StatusOr<std::unique_ptr<LearnerCore>> LearnerCore::Load(
-    const LearnerConfig& config, torch::serialize::InputArchive& archive,
-    std::shared_ptr<ReplicaGroup> replicas) {
-  if (absl::Status status = config.Validate(); !status.ok()) return status;
-  if (replicas == nullptr) replicas = SoloReplicaGroup();
-  // Synchronised after the state is read, not at creation.
-  absl::StatusOr<std::unique_ptr<LearnerCore>> created;
-  {
-    std::lock_guard<std::mutex> lock(InitialisationMutex());
-    at::manual_seed(config.seed);
-    created = std::unique_ptr<LearnerCore>(new LearnerCore(config, replicas));
-  }
-  if (!created.ok()) return created.status();
-  LearnerCore& core = **created;
+// Whether `archive` was written for the run `config` describes: its
+// environment, algorithm and torso sharing.
+absl::Status CheckCheckpointFits(const LearnerConfig& config,
+                                 torch::serialize::InputArchive& archive) {
   absl::StatusOr<std::string> name = ReadBytes(archive, "spec.name");
   if (!name.ok()) return name.status();
   at::Tensor shape;
@@ -566,6 +524,42 @@ absl::StatusOr<std::unique_ptr<LearnerCore>> LearnerCore::Load(
         " their torso, but the run config says the opposite "
         "(--shared_torso)"));
   }
+  return absl::OkStatus();
+}
+
+}  // namespace
+
+void LearnerCore::Save(torch::serialize::OutputArchive& archive) const {
+  WriteBytes(archive, "spec.name", config_.spec.name);
+  archive.write("spec.shape", SpecShape(config_.spec));
+  WriteBytes(archive, "algorithm", config_.algorithm.name);
+  WriteModule(archive, "policy", *policy_);
+  // A shared torso is written with both networks; this says the copies are
+  // one.
+  archive.write("shared_torso",
+                at::tensor(int64_t{config_.network.shared_torso ? 1 : 0}));
+  WriteModule(archive, "value", *value_);
+  torch::serialize::OutputArchive updater, scaler;
+  updater_->Save(updater);
+  reward_scaler_.Save(scaler);
+  archive.write("updater", updater);
+  archive.write("reward_scaler", scaler);
+  if (exploration_ != nullptr) exploration_->Save(archive, "ex2");
+  WriteRunningMeanStd(archive, "normalizer", normalizer_);
+  std::ostringstream rng;
+  rng << rng_;
+  WriteBytes(archive, "rng", rng.str());
+  archive.write("counters", at::tensor({version_, env_steps_, rejected_,
+                                        episodes_, stale_segments_,
+                                        stale_steps_, rolled_back_updates_},
+                                       at::kLong));
+  archive.write("recent_returns",
+                at::tensor(std::vector<double>(recent_returns_.begin(),
+                                               recent_returns_.end()),
+                           at::kDouble));
+}
+
+absl::Status LearnerCore::LoadModels(torch::serialize::InputArchive& archive) {
   torch::serialize::InputArchive updater, scaler;
   if (absl::Status status = CatchTorchErrors(
           "checkpoint entries 'updater' or 'reward_scaler' are missing",
@@ -577,25 +571,28 @@ absl::StatusOr<std::unique_ptr<LearnerCore>> LearnerCore::Load(
     return status;
   }
   for (absl::Status status :
-       {ReadModule(archive, "policy", *core.policy_),
-        ReadModule(archive, "value", *core.value_),
-        core.updater_->Load(updater), core.reward_scaler_.Load(scaler),
-        ReadRunningMeanStd(archive, "normalizer", core.normalizer_)}) {
+       {ReadModule(archive, "policy", *policy_),
+        ReadModule(archive, "value", *value_), updater_->Load(updater),
+        reward_scaler_.Load(scaler),
+        ReadRunningMeanStd(archive, "normalizer", normalizer_)}) {
     if (!status.ok()) return status;
   }
-  if (core.exploration_ != nullptr) {
-    if (absl::Status status = core.exploration_->Load(archive, "ex2");
-        !status.ok()) {
-      return absl::InvalidArgumentError(
-          absl::StrCat(status.message(),
-                       " (the run's EX2 state; a checkpoint of a run "
-                       "without EX2 cannot continue with it)"));
-    }
+  if (exploration_ == nullptr) return absl::OkStatus();
+  if (absl::Status status = exploration_->Load(archive, "ex2"); !status.ok()) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(status.message(),
+                     " (the run's EX2 state; a checkpoint of a run "
+                     "without EX2 cannot continue with it)"));
   }
+  return absl::OkStatus();
+}
+
+absl::Status LearnerCore::LoadCounters(
+    torch::serialize::InputArchive& archive) {
   absl::StatusOr<std::string> rng = ReadBytes(archive, "rng");
   if (!rng.ok()) return rng.status();
   std::istringstream rng_text(*rng);
-  rng_text >> core.rng_;
+  rng_text >> rng_;
   if (rng_text.fail()) {
     return absl::InvalidArgumentError("checkpoint entry 'rng' is malformed");
   }
@@ -612,22 +609,45 @@ absl::StatusOr<std::unique_ptr<LearnerCore>> LearnerCore::Load(
     return absl::InvalidArgumentError(
         "checkpoint entries 'counters' or 'recent_returns' are malformed");
   }
-  core.version_ = counters[0].item<int64_t>();
-  core.env_steps_ = counters[1].item<int64_t>();
-  core.rejected_ = counters[2].item<int64_t>();
-  core.episodes_ = counters[3].item<int64_t>();
-  core.stale_segments_ = counters[4].item<int64_t>();
-  core.stale_steps_ = counters[5].item<int64_t>();
-  if (counters.numel() == 7) {
-    core.rolled_back_updates_ = counters[6].item<int64_t>();
-  }
+  version_ = counters[0].item<int64_t>();
+  env_steps_ = counters[1].item<int64_t>();
+  rejected_ = counters[2].item<int64_t>();
+  episodes_ = counters[3].item<int64_t>();
+  stale_segments_ = counters[4].item<int64_t>();
+  stale_steps_ = counters[5].item<int64_t>();
+  if (counters.numel() == 7) rolled_back_updates_ = counters[6].item<int64_t>();
   for (int64_t i = 0; i < returns.numel(); ++i) {
-    core.recent_returns_.push_back(returns[i].item<double>());
+    recent_returns_.push_back(returns[i].item<double>());
   }
-  if (absl::Status status = core.SynchroniseReplicas(); !status.ok()) {
+  return absl::OkStatus();
+}
+
+absl::StatusOr<std::unique_ptr<LearnerCore>> LearnerCore::Load(
+    const LearnerConfig& config, torch::serialize::InputArchive& archive,
+    std::shared_ptr<ReplicaGroup> replicas) {
+  if (absl::Status status = config.Validate(); !status.ok()) return status;
+  if (replicas == nullptr) replicas = SoloReplicaGroup();
+  // Synchronised after the state is read, not at creation.
+  std::unique_ptr<LearnerCore> core;
+  {
+    std::lock_guard<std::mutex> lock(InitialisationMutex());
+    at::manual_seed(config.seed);
+    core.reset(new LearnerCore(config, replicas));
+  }
+  if (absl::Status status = CheckCheckpointFits(config, archive);
+      !status.ok()) {
     return status;
   }
-  return created;
+  if (absl::Status status = core->LoadModels(archive); !status.ok()) {
+    return status;
+  }
+  if (absl::Status status = core->LoadCounters(archive); !status.ok()) {
+    return status;
+  }
+  if (absl::Status status = core->SynchroniseReplicas(); !status.ok()) {
+    return status;
+  }
+  return core;
 }
 
 }  // namespace vantage

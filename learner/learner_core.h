@@ -92,6 +92,11 @@ class LearnerCore {
  private:
   LearnerCore(const LearnerConfig& config,
               std::shared_ptr<ReplicaGroup> replicas);
+  // What Load reads into a new learner: the networks, the optimiser,
+  // reward scaler, normaliser and exploration states; then the generator,
+  // counters and recent returns.
+  absl::Status LoadModels(torch::serialize::InputArchive& archive);
+  absl::Status LoadCounters(torch::serialize::InputArchive& archive);
   // Keeps the first refusal's reason of the update being gathered.
   void NoteRejection(const Segment& segment, const absl::Status& why);
   // Rank 0's networks, normaliser and counters on every replica; an error
