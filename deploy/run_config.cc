@@ -185,33 +185,11 @@ absl::StatusOr<pb::RunConfig> FromFlat(const pb::FlatRunConfig& flat) {
   return c;
 }
 
-}  // namespace
-
-absl::StatusOr<pb::RunConfig> ResolveRunConfig(const pb::RunConfig& given) {
-  pb::RunConfig c = given;
-  // The main job is the distributed one; --mode=local keeps one process.
-  if (!c.has_mode()) c.set_mode("distributed");
-  if (c.mode() != "local" && c.mode() != "distributed") {
-    return Invalid("mode:", absl::StrCat("unknown mode '", c.mode(),
-                                         "'; available: local, distributed"));
-  }
-  AlgorithmConfig algorithm = AlgorithmConfigOf(c);
-  if (absl::Status status = algorithm.Validate(); !status.ok()) {
-    return AlgorithmSettingError(status.message());
-  }
-  SetAlgorithmSettings(algorithm, c);
-  const AlgorithmRunDefaults run_defaults = RunDefaultsOf(algorithm);
-  // An exploration section naming no method means none.
-  const ExplorationConfig exploration = ExplorationConfigOf(c);
-  if (exploration.ex2.has_value()) {
-    if (absl::Status status = exploration.ex2->Validate(); !status.ok()) {
-      return AlgorithmSettingError(status.message());
-    }
-  }
-  SetExplorationSettings(exploration, c);
-
+// The training section's defaults and rules, given the algorithm's.
+absl::Status ResolveTraining(const AlgorithmConfig& algorithm,
+                             const AlgorithmRunDefaults& run_defaults,
+                             pb::TrainingSettings& t) {
   const LocalTrainingConfig local;
-  pb::TrainingSettings& t = *c.mutable_training();
   if (!t.has_env()) t.set_env(local.env);
   if (!t.has_seed()) t.set_seed(local.seed);
   if (!t.has_steps()) t.set_steps(local.total_env_steps);
@@ -262,9 +240,14 @@ absl::StatusOr<pb::RunConfig> ResolveRunConfig(const pb::RunConfig& given) {
   if (t.segment_length() < 1 || t.segment_length() > t.horizon()) {
     return Invalid("segment_length", "must be in [1, --horizon]");
   }
+  return absl::OkStatus();
+}
 
+// The advantage section's defaults (its rules are the estimator's own,
+// checked once the whole config is resolved).
+absl::Status ResolveAdvantage(const AlgorithmRunDefaults& run_defaults,
+                              pb::AdvantageSettings& a) {
   const AdvantageConfig advantage;
-  pb::AdvantageSettings& a = *c.mutable_advantage();
   if (!a.has_estimator()) a.set_estimator(StatisticName(advantage.statistic));
   absl::StatusOr<Statistic> statistic = ParseStatistic(a.estimator());
   if (!statistic.ok()) {
@@ -276,27 +259,29 @@ absl::StatusOr<pb::RunConfig> ResolveRunConfig(const pb::RunConfig& given) {
   }
   if (!a.has_gamma()) a.set_gamma(advantage.gamma);
   if (!a.has_gae_lambda()) a.set_gae_lambda(run_defaults.gae_lambda);
+  return absl::OkStatus();
+}
 
-  if (c.mode() == "distributed") {
-    if (absl::Status status = ResolveDistributed(c); !status.ok()) {
-      return status;
-    }
-  } else {
-    if (c.has_distributed()) {
-      return absl::InvalidArgumentError(
-          "--mode=local runs one strictly on-policy process: drop the "
-          "distributed settings (--actors, --envs_per_actor, --sync, "
-          "--max_policy_lag, --learners, --learner_threads)");
-    }
-    if (!t.has_envs()) t.set_envs(local.num_envs);
-    if (t.horizon() % t.segment_length() != 0) {
-      return Invalid("segment_length",
-                     "must divide --horizon in a local run (its actor sends "
-                     "each rollout as whole segments)");
-    }
+// A local run: one strictly on-policy process.
+absl::Status ResolveLocal(pb::RunConfig& c) {
+  if (c.has_distributed()) {
+    return absl::InvalidArgumentError(
+        "--mode=local runs one strictly on-policy process: drop the "
+        "distributed settings (--actors, --envs_per_actor, --sync, "
+        "--max_policy_lag, --learners, --learner_threads)");
   }
+  pb::TrainingSettings& t = *c.mutable_training();
+  if (!t.has_envs()) t.set_envs(LocalTrainingConfig().num_envs);
+  if (t.horizon() % t.segment_length() != 0) {
+    return Invalid("segment_length",
+                   "must divide --horizon in a local run (its actor sends "
+                   "each rollout as whole segments)");
+  }
+  return absl::OkStatus();
+}
 
-  pb::RecordingSettings& r = *c.mutable_recording();
+absl::Status ResolveRecording(pb::RecordingSettings& r) {
+  const LocalTrainingConfig local;
   if (!r.has_checkpoint_every()) r.set_checkpoint_every(local.checkpoint_every);
   if (!r.has_keep_checkpoints()) r.set_keep_checkpoints(local.keep_checkpoints);
   if (r.checkpoint_every() < 1) {
@@ -304,6 +289,52 @@ absl::StatusOr<pb::RunConfig> ResolveRunConfig(const pb::RunConfig& given) {
   }
   if (r.keep_checkpoints() < 1) {
     return Invalid("keep_checkpoints", "must be >= 1");
+  }
+  return absl::OkStatus();
+}
+
+}  // namespace
+
+absl::StatusOr<pb::RunConfig> ResolveRunConfig(const pb::RunConfig& given) {
+  pb::RunConfig c = given;
+  // The main job is the distributed one; --mode=local keeps one process.
+  if (!c.has_mode()) c.set_mode("distributed");
+  if (c.mode() != "local" && c.mode() != "distributed") {
+    return Invalid("mode:", absl::StrCat("unknown mode '", c.mode(),
+                                         "'; available: local, distributed"));
+  }
+  AlgorithmConfig algorithm = AlgorithmConfigOf(c);
+  if (absl::Status status = algorithm.Validate(); !status.ok()) {
+    return AlgorithmSettingError(status.message());
+  }
+  SetAlgorithmSettings(algorithm, c);
+  const AlgorithmRunDefaults run_defaults = RunDefaultsOf(algorithm);
+  // An exploration section naming no method means none.
+  const ExplorationConfig exploration = ExplorationConfigOf(c);
+  if (exploration.ex2.has_value()) {
+    if (absl::Status status = exploration.ex2->Validate(); !status.ok()) {
+      return AlgorithmSettingError(status.message());
+    }
+  }
+  SetExplorationSettings(exploration, c);
+  if (absl::Status status =
+          ResolveTraining(algorithm, run_defaults, *c.mutable_training());
+      !status.ok()) {
+    return status;
+  }
+  if (absl::Status status =
+          ResolveAdvantage(run_defaults, *c.mutable_advantage());
+      !status.ok()) {
+    return status;
+  }
+  if (absl::Status status =
+          c.mode() == "distributed" ? ResolveDistributed(c) : ResolveLocal(c);
+      !status.ok()) {
+    return status;
+  }
+  if (absl::Status status = ResolveRecording(*c.mutable_recording());
+      !status.ok()) {
+    return status;
   }
   // The estimator's own rules (gamma, lambda, rho, ensemble).
   const LocalTrainingConfig resolved = ToLocalTrainingConfig(c);
