@@ -87,6 +87,106 @@ std::vector<std::string> TrainArguments(const ExperimentDirectory& directory,
   return args;
 }
 
+namespace {
+
+// What is left of the grid to run: every cell not finished, in the order
+// to run them, counted into `totals` and `resumed`.
+absl::StatusOr<std::vector<CellTask>> PlanCells(
+    const pb::ExpandedExperiment& experiment,
+    const ExperimentDirectory& directory, GridTotals& totals, int& resumed) {
+  totals.cells = experiment.cells_size();
+  std::vector<CellTask> tasks;
+  std::vector<uint64_t> seeds;
+  for (const pb::ExperimentCell& cell : experiment.cells()) {
+    const int64_t steps = cell.config().training().steps();
+    totals.steps += steps;
+    CellStatus status = directory.Inspect(cell);
+    if (status.state == CellState::kFinished) {
+      ++totals.finished_before;
+      totals.steps_before += steps;
+      continue;
+    }
+    if (status.state == CellState::kNoCheckpoint) {
+      std::printf(
+          "experiment: %s stopped before its first checkpoint; starting it "
+          "again\n",
+          cell.dir().c_str());
+      if (absl::Status cleared = directory.ClearRun(cell); !cleared.ok()) {
+        return cleared;
+      }
+      status = CellStatus();
+    }
+    const bool resume = status.state == CellState::kResumable;
+    resumed += resume ? 1 : 0;
+    totals.steps_before += status.env_steps;
+    std::error_code error;
+    std::filesystem::create_directories(directory.RunDir(cell), error);
+    if (error) {
+      return absl::FailedPreconditionError(absl::StrCat(
+          "cannot create ", directory.RunDir(cell), ": ", error.message()));
+    }
+    CellTask task;
+    task.name = cell.dir();
+    task.train_args = TrainArguments(directory, cell, resume);
+    task.run_dir = directory.RunDir(cell);
+    task.log_path = directory.LogPath(cell);
+    task.steps = steps;
+    task.repeatable_args = TrainArguments(directory, cell, /*resume=*/false);
+    task.repeatable_args.push_back("--resume_if_exists");
+    task.cores = CoresPerCell(cell.config());
+    seeds.push_back(cell.seed());
+    tasks.push_back(std::move(task));
+  }
+  // Seed by seed, so that a grid stopped halfway holds whole comparisons
+  // (every group, the baseline among them, with the first seeds) rather
+  // than some groups with all their seeds and others with none.
+  std::vector<size_t> order(tasks.size());
+  for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::stable_sort(order.begin(), order.end(),
+                   [&](size_t a, size_t b) { return seeds[a] < seeds[b]; });
+  std::vector<CellTask> ordered;
+  for (size_t i : order) ordered.push_back(std::move(tasks[i]));
+  return ordered;
+}
+
+// Says how many cells finished; an error names the failed cells, or how
+// many were stopped.
+absl::Status Conclude(const pb::ExpandedExperiment& experiment,
+                      const std::vector<CellTask>& tasks,
+                      const GridTotals& totals,
+                      const std::vector<CellOutcome>& outcomes) {
+  std::vector<std::string> failed;
+  int stopped = 0;
+  for (size_t i = 0; i < tasks.size(); ++i) {
+    if (outcomes[i].kind == CellOutcome::Kind::kFailed) {
+      failed.push_back(tasks[i].name);
+    } else if (outcomes[i].kind == CellOutcome::Kind::kStopped) {
+      ++stopped;
+    }
+  }
+  const int finished = totals.cells - static_cast<int>(failed.size()) - stopped;
+  std::printf("experiment %s: %d of %d cells finished\n",
+              experiment.name().c_str(), finished, totals.cells);
+  std::fflush(stdout);
+  if (!failed.empty()) {
+    return absl::AbortedError(
+        absl::StrCat(failed.size(), " of ", totals.cells,
+                     " cells failed (their train.log says why): ",
+                     absl::StrJoin(failed, ", "),
+                     stopped > 0 ? absl::StrCat("; ", stopped, " stopped") : "",
+                     "; the same command again retries them"));
+  }
+  if (stopped > 0) {
+    return absl::CancelledError(
+        absl::StrCat("stopped with ", stopped,
+                     " cells unfinished; the same command again resumes "
+                     "them"));
+  }
+  return absl::OkStatus();
+}
+
+}  // namespace
+
 absl::Status RunExperiment(const pb::ExpandedExperiment& experiment,
                            const pb::RunConfig& base,
                            const ExperimentRunOptions& options,
@@ -117,97 +217,19 @@ absl::Status RunExperiment(const pb::ExpandedExperiment& experiment,
   std::filesystem::create_directories(backend_options.work_dir, error);
 
   GridTotals totals;
-  totals.cells = experiment.cells_size();
-  std::vector<CellTask> tasks;
-  std::vector<uint64_t> seeds;
   int resumed = 0;
-  for (const pb::ExperimentCell& cell : experiment.cells()) {
-    const int64_t steps = cell.config().training().steps();
-    totals.steps += steps;
-    CellStatus status = directory.Inspect(cell);
-    if (status.state == CellState::kFinished) {
-      ++totals.finished_before;
-      totals.steps_before += steps;
-      continue;
-    }
-    if (status.state == CellState::kNoCheckpoint) {
-      std::printf(
-          "experiment: %s stopped before its first checkpoint; starting it "
-          "again\n",
-          cell.dir().c_str());
-      if (absl::Status cleared = directory.ClearRun(cell); !cleared.ok()) {
-        return cleared;
-      }
-      status = CellStatus();
-    }
-    const bool resume = status.state == CellState::kResumable;
-    resumed += resume ? 1 : 0;
-    totals.steps_before += status.env_steps;
-    std::filesystem::create_directories(directory.RunDir(cell), error);
-    if (error) {
-      return absl::FailedPreconditionError(absl::StrCat(
-          "cannot create ", directory.RunDir(cell), ": ", error.message()));
-    }
-    CellTask task;
-    task.name = cell.dir();
-    task.train_args = TrainArguments(directory, cell, resume);
-    task.run_dir = directory.RunDir(cell);
-    task.log_path = directory.LogPath(cell);
-    task.steps = steps;
-    task.repeatable_args = TrainArguments(directory, cell, /*resume=*/false);
-    task.repeatable_args.push_back("--resume_if_exists");
-    task.cores = CoresPerCell(cell.config());
-    seeds.push_back(cell.seed());
-    tasks.push_back(std::move(task));
-  }
-  // Seed by seed, so that a grid stopped halfway holds whole comparisons
-  // (every group, the baseline among them, with the first seeds) rather
-  // than some groups with all their seeds and others with none.
-  std::vector<size_t> order(tasks.size());
-  for (size_t i = 0; i < order.size(); ++i) order[i] = i;
-  std::stable_sort(order.begin(), order.end(),
-                   [&](size_t a, size_t b) { return seeds[a] < seeds[b]; });
-  std::vector<CellTask> ordered;
-  for (size_t i : order) ordered.push_back(std::move(tasks[i]));
-  tasks = std::move(ordered);
+  absl::StatusOr<std::vector<CellTask>> tasks =
+      PlanCells(experiment, directory, totals, resumed);
+  if (!tasks.ok()) return tasks.status();
   std::printf(
       "experiment %s: %d cells (%d finished, %d to resume, %zu to start), "
       "%d at a time (%s backend), in %s\n",
       experiment.name().empty() ? "(unnamed)" : experiment.name().c_str(),
-      totals.cells, totals.finished_before, resumed, tasks.size() - resumed,
+      totals.cells, totals.finished_before, resumed, tasks->size() - resumed,
       backend_options.jobs, options.backend.c_str(), options.exp_dir.c_str());
   std::fflush(stdout);
-  const std::vector<CellOutcome> outcomes =
-      (*backend)->Run(tasks, totals, stop);
-
-  std::vector<std::string> failed;
-  int stopped = 0;
-  for (size_t i = 0; i < tasks.size(); ++i) {
-    if (outcomes[i].kind == CellOutcome::Kind::kFailed) {
-      failed.push_back(tasks[i].name);
-    } else if (outcomes[i].kind == CellOutcome::Kind::kStopped) {
-      ++stopped;
-    }
-  }
-  const int finished = totals.cells - static_cast<int>(failed.size()) - stopped;
-  std::printf("experiment %s: %d of %d cells finished\n",
-              experiment.name().c_str(), finished, totals.cells);
-  std::fflush(stdout);
-  if (!failed.empty()) {
-    return absl::AbortedError(
-        absl::StrCat(failed.size(), " of ", totals.cells,
-                     " cells failed (their train.log says why): ",
-                     absl::StrJoin(failed, ", "),
-                     stopped > 0 ? absl::StrCat("; ", stopped, " stopped") : "",
-                     "; the same command again retries them"));
-  }
-  if (stopped > 0) {
-    return absl::CancelledError(
-        absl::StrCat("stopped with ", stopped,
-                     " cells unfinished; the same command again resumes "
-                     "them"));
-  }
-  return absl::OkStatus();
+  return Conclude(experiment, *tasks, totals,
+                  (*backend)->Run(*tasks, totals, stop));
 }
 
 }  // namespace vantage
