@@ -145,7 +145,9 @@ int RunEnvs(const std::vector<std::string>&) {
   return 0;
 }
 
-int RunRollout(const std::vector<std::string>&) {
+namespace {
+
+absl::StatusOr<RolloutRequest> RolloutRequestFromFlags() {
   RolloutRequest request;
   request.env = absl::GetFlag(FLAGS_env);
   request.episodes = absl::GetFlag(FLAGS_episodes);
@@ -157,109 +159,155 @@ int RunRollout(const std::vector<std::string>&) {
   if (absl::Status status =
           ParseVideoSize(absl::GetFlag(FLAGS_video_size), &request);
       !status.ok()) {
-    return Fail("rollout", status);
+    return status;
   }
   if (request.video_episodes < 0) {
-    return Fail("rollout", absl::InvalidArgumentError(
-                               "--video_episodes must be >= 0 (0: all)"));
+    return absl::InvalidArgumentError("--video_episodes must be >= 0 (0: all)");
   }
-  const int64_t episodes = request.episodes;
-  const uint64_t seed = request.seed;
-  std::string env_name = request.env;
-  std::optional<TrainedPolicy> trained;
-  if (!request.checkpoint.empty()) {
-    absl::StatusOr<TrainedPolicy> loaded =
-        LoadTrainedPolicy(request.checkpoint);
-    if (!loaded.ok()) return Fail("rollout", loaded.status());
-    trained = *std::move(loaded);
-    if (env_name.empty()) env_name = trained->config.training().env();
-    if (env_name != trained->config.training().env()) {
-      return Fail("rollout",
-                  absl::InvalidArgumentError(absl::StrCat(
-                      "the checkpoint's policy was trained on ",
-                      trained->config.training().env(), ", not ", env_name)));
+  return request;
+}
+
+// The policy of --checkpoint, if one is given; its run's env becomes
+// request.env when that is empty and must equal it otherwise.
+absl::StatusOr<std::optional<TrainedPolicy>> LoadRolloutPolicy(
+    RolloutRequest& request) {
+  if (request.checkpoint.empty()) return std::optional<TrainedPolicy>();
+  absl::StatusOr<TrainedPolicy> trained = LoadTrainedPolicy(request.checkpoint);
+  if (!trained.ok()) return trained.status();
+  const std::string& trained_env = trained->config.training().env();
+  if (request.env.empty()) request.env = trained_env;
+  if (request.env != trained_env) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("the checkpoint's policy was trained on ", trained_env,
+                     ", not ", request.env));
+  }
+  std::printf("policy: %s (version %ld, %s actions)\n",
+              trained->checkpoint_path.c_str(),
+              static_cast<long>(trained->version),
+              request.stochastic ? "sampled" : "deterministic");
+  trained->Seed(request.seed);
+  return std::optional<TrainedPolicy>(*std::move(trained));
+}
+
+// The rollout's actions: the trained policy's, or uniform random ones.
+class RolloutActions {
+ public:
+  RolloutActions(const EnvSpec& spec, std::optional<TrainedPolicy>& trained,
+                 const RolloutRequest& request)
+      : spec_(spec),
+        trained_(trained),
+        deterministic_(!request.stochastic),
+        rng_(request.seed),
+        action_(spec.discrete ? 1 : spec.action_size) {}
+
+  const std::vector<double>& Act(const std::vector<double>& observation) {
+    if (trained_.has_value()) {
+      action_ = trained_->Act(observation, deterministic_);
+    } else if (spec_.discrete) {
+      action_[0] = static_cast<double>(std::uniform_int_distribution<int64_t>(
+          0, spec_.action_size - 1)(rng_));
+    } else {
+      for (size_t i = 0; i < action_.size(); ++i) {
+        // Unbounded actuators get actions in [-1, 1].
+        const double low =
+            std::isfinite(spec_.action_low[i]) ? spec_.action_low[i] : -1.0;
+        const double high =
+            std::isfinite(spec_.action_high[i]) ? spec_.action_high[i] : 1.0;
+        action_[i] = std::uniform_real_distribution<double>(low, high)(rng_);
+      }
     }
-    std::printf("policy: %s (version %ld, %s actions)\n",
-                trained->checkpoint_path.c_str(),
-                static_cast<long>(trained->version),
-                request.stochastic ? "sampled" : "deterministic");
+    return action_;
   }
-  if (trained.has_value()) trained->Seed(seed);
-  if (env_name.empty()) {
+
+ private:
+  const EnvSpec& spec_;
+  std::optional<TrainedPolicy>& trained_;
+  const bool deterministic_;
+  std::mt19937_64 rng_;
+  std::vector<double> action_;
+};
+
+struct RolloutTotals {
+  double total_return = 0.0;
+  int64_t total_length = 0;
+  Digest digest;
+};
+
+// Plays episode `episode` (recorded if the video wants it) into `totals`;
+// 0, or the exit code of the failure it reported.
+int PlayEpisode(Environment& env, int64_t episode, uint64_t seed,
+                RolloutActions& actions, VideoRecorder& video,
+                RolloutTotals& totals) {
+  std::vector<double> observation(env.spec().observation_size);
+  if (absl::Status status =
+          env.Reset(seed * 1000003 + episode, absl::MakeSpan(observation));
+      !status.ok()) {
+    return Fail("rollout", status, kRuntimeError);
+  }
+  totals.digest.Add(observation);
+  // A frame after the reset and after every step.
+  const bool recording = video.recording(episode);
+  int video_code = kRuntimeError;
+  absl::Status recorded =
+      recording ? video.Add(env, &video_code) : absl::OkStatus();
+  double episode_return = 0.0;
+  int64_t length = 0;
+  while (recorded.ok()) {
+    absl::StatusOr<StepResult> result =
+        env.Step(actions.Act(observation), absl::MakeSpan(observation));
+    if (!result.ok()) return Fail("rollout", result.status(), kRuntimeError);
+    totals.digest.Add(observation);
+    if (recording) recorded = video.Add(env, &video_code);
+    if (!recorded.ok()) break;
+    episode_return += result->reward;
+    ++length;
+    if (result->terminated || result->truncated) {
+      std::printf("episode %ld return=%.3f length=%ld %s\n",
+                  static_cast<long>(episode), episode_return,
+                  static_cast<long>(length),
+                  result->terminated ? "terminated" : "truncated");
+      break;
+    }
+  }
+  if (!recorded.ok()) return Fail("rollout", recorded, video_code);
+  totals.total_return += episode_return;
+  totals.total_length += length;
+  return 0;
+}
+
+}  // namespace
+
+int RunRollout(const std::vector<std::string>&) {
+  absl::StatusOr<RolloutRequest> request = RolloutRequestFromFlags();
+  if (!request.ok()) return Fail("rollout", request.status());
+  absl::StatusOr<std::optional<TrainedPolicy>> trained =
+      LoadRolloutPolicy(*request);
+  if (!trained.ok()) return Fail("rollout", trained.status());
+  if (request->env.empty()) {
     return Fail("rollout", absl::InvalidArgumentError(
                                "--env=NAME is required (see `vantage envs`)"));
   }
+  const int64_t episodes = request->episodes;
   if (episodes < 1) {
     return Fail("rollout",
                 absl::InvalidArgumentError("--episodes must be >= 1"));
   }
   // A trained policy sees the environment as its run wrapped it.
   absl::StatusOr<std::unique_ptr<Environment>> made = MakeEnvironment(
-      env_name,
-      trained.has_value() ? EnvOptionsOf(trained->config) : EnvOptions{});
+      request->env,
+      trained->has_value() ? EnvOptionsOf((*trained)->config) : EnvOptions{});
   if (!made.ok()) return Fail("rollout", made.status());
   Environment& env = **made;
   const EnvSpec& spec = env.spec();
-  std::mt19937_64 rng(seed);
-  std::vector<double> observation(spec.observation_size);
-  std::vector<double> action(spec.discrete ? 1 : spec.action_size);
-  VideoRecorder video(request, spec);
-  int video_code = kRuntimeError;
-  Digest digest;
-  double total_return = 0.0;
-  int64_t total_length = 0;
+  RolloutActions actions(spec, *trained, *request);
+  VideoRecorder video(*request, spec);
+  RolloutTotals totals;
   for (int64_t episode = 0; episode < episodes; ++episode) {
-    if (absl::Status status =
-            env.Reset(seed * 1000003 + episode, absl::MakeSpan(observation));
-        !status.ok()) {
-      return Fail("rollout", status, kRuntimeError);
+    if (const int code =
+            PlayEpisode(env, episode, request->seed, actions, video, totals);
+        code != 0) {
+      return code;
     }
-    digest.Add(observation);
-    const bool recording = video.recording(episode);
-    if (recording) {
-      if (absl::Status status = video.Add(env, &video_code); !status.ok()) {
-        return Fail("rollout", status, video_code);
-      }
-    }
-    double episode_return = 0.0;
-    int64_t length = 0;
-    while (true) {
-      if (trained.has_value()) {
-        action = trained->Act(observation, !request.stochastic);
-      } else if (spec.discrete) {
-        action[0] = static_cast<double>(std::uniform_int_distribution<int64_t>(
-            0, spec.action_size - 1)(rng));
-      } else {
-        for (size_t i = 0; i < action.size(); ++i) {
-          // Unbounded actuators get actions in [-1, 1].
-          const double low =
-              std::isfinite(spec.action_low[i]) ? spec.action_low[i] : -1.0;
-          const double high =
-              std::isfinite(spec.action_high[i]) ? spec.action_high[i] : 1.0;
-          action[i] = std::uniform_real_distribution<double>(low, high)(rng);
-        }
-      }
-      absl::StatusOr<StepResult> result =
-          env.Step(action, absl::MakeSpan(observation));
-      if (!result.ok()) return Fail("rollout", result.status(), kRuntimeError);
-      digest.Add(observation);
-      if (recording) {
-        if (absl::Status status = video.Add(env, &video_code); !status.ok()) {
-          return Fail("rollout", status, video_code);
-        }
-      }
-      episode_return += result->reward;
-      ++length;
-      if (result->terminated || result->truncated) {
-        std::printf("episode %ld return=%.3f length=%ld %s\n",
-                    static_cast<long>(episode), episode_return,
-                    static_cast<long>(length),
-                    result->terminated ? "terminated" : "truncated");
-        break;
-      }
-    }
-    total_return += episode_return;
-    total_length += length;
   }
   if (absl::Status status = video.Finish(); !status.ok()) {
     return Fail("rollout", status, kRuntimeError);
@@ -267,10 +315,11 @@ int RunRollout(const std::vector<std::string>&) {
   std::printf(
       "RESULT rollout env=%s obs_dim=%ld act_dim=%ld episodes=%ld "
       "mean_return=%.3f mean_length=%.1f digest=%016lx\n",
-      env_name.c_str(), static_cast<long>(spec.observation_size),
+      request->env.c_str(), static_cast<long>(spec.observation_size),
       static_cast<long>(spec.action_size), static_cast<long>(episodes),
-      total_return / episodes, static_cast<double>(total_length) / episodes,
-      static_cast<unsigned long>(digest.value()));
+      totals.total_return / episodes,
+      static_cast<double>(totals.total_length) / episodes,
+      static_cast<unsigned long>(totals.digest.value()));
   return 0;
 }
 
