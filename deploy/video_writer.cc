@@ -53,24 +53,11 @@ struct ScaleDeleter {
   void operator()(SwsContext* scale) const { sws_freeContext(scale); }
 };
 
-}  // namespace
-
-// Declared so that the encoder and its buffers go before the container
-// that owns the stream they feed.
-struct VideoWriter::Av {
-  std::unique_ptr<AVFormatContext, FormatDeleter> format;
-  AVStream* stream = nullptr;  // owned by format
-  std::unique_ptr<AVCodecContext, CodecDeleter> codec;
-  std::unique_ptr<AVFrame, FrameDeleter> frame;
-  std::unique_ptr<AVPacket, PacketDeleter> packet;
-  std::unique_ptr<SwsContext, ScaleDeleter> scale;
-};
-
-absl::StatusOr<std::unique_ptr<VideoWriter>> VideoWriter::Open(
-    const std::string& path, int width, int height, double fps) {
+// The path's container (.mp4 or .gif), the size and the frame rate.
+absl::Status CheckVideoRequest(const std::string& path, int width, int height,
+                               double fps) {
   const std::string lower = absl::AsciiStrToLower(path);
-  const bool gif = absl::EndsWith(lower, ".gif");
-  if (!gif && !absl::EndsWith(lower, ".mp4")) {
+  if (!absl::EndsWith(lower, ".gif") && !absl::EndsWith(lower, ".mp4")) {
     return absl::InvalidArgumentError(absl::StrCat(
         "video '", path, "': unknown extension (use .mp4 or .gif)"));
   }
@@ -86,23 +73,11 @@ absl::StatusOr<std::unique_ptr<VideoWriter>> VideoWriter::Open(
     return absl::InvalidArgumentError(
         absl::StrCat("video frame rate ", fps, ": must be > 0"));
   }
-  // FFmpeg's encoders report what they do at the info level.
-  av_log_set_level(AV_LOG_ERROR);
-  const int keep_every =
-      gif ? static_cast<int>(std::ceil(fps / kMaxGifFps - 1e-9)) : 1;
-  const AVRational rate = av_d2q(fps / keep_every, 100000);
+  return absl::OkStatus();
+}
 
-  auto av = std::make_unique<Av>();
-  AVFormatContext* format = nullptr;
-  int code = avformat_alloc_output_context2(&format, nullptr,
-                                            gif ? "gif" : "mp4", path.c_str());
-  if (code < 0 || format == nullptr) {
-    return absl::InternalError(absl::StrCat("video '", path, "': no ",
-                                            gif ? "GIF" : "MP4",
-                                            " muxer: ", AvError(code)));
-  }
-  av->format.reset(format);
-
+// GIF's own encoder; for MP4, H.264 where FFmpeg has it, else MPEG-4.
+absl::StatusOr<const AVCodec*> FindEncoder(const std::string& path, bool gif) {
   const AVCodec* encoder = nullptr;
   if (gif) {
     encoder = avcodec_find_encoder(AV_CODEC_ID_GIF);
@@ -115,8 +90,112 @@ absl::StatusOr<std::unique_ptr<VideoWriter>> VideoWriter::Open(
         absl::StrCat("video '", path, "': this FFmpeg has no ",
                      gif ? "GIF" : "H.264 or MPEG-4", " encoder"));
   }
+  return encoder;
+}
+
+void ConfigureEncoder(const AVCodec& encoder, const AVFormatContext& format,
+                      int width, int height, AVRational rate, bool gif,
+                      AVCodecContext& codec) {
+  codec.width = width;
+  codec.height = height;
+  codec.time_base = av_inv_q(rate);
+  codec.framerate = rate;
+  // GIF wants a palette: 3-3-2 bit RGB is a fixed one the encoder takes.
+  codec.pix_fmt = gif ? AV_PIX_FMT_RGB8 : AV_PIX_FMT_YUV420P;
+  if (encoder.id == AV_CODEC_ID_H264) {
+    av_opt_set(codec.priv_data, "preset", "veryfast", 0);
+    av_opt_set(codec.priv_data, "crf", "23", 0);
+  } else if (encoder.id == AV_CODEC_ID_MPEG4) {
+    codec.flags |= AV_CODEC_FLAG_QSCALE;
+    codec.global_quality = FF_QP2LAMBDA * 4;
+    codec.gop_size = 12;
+  }
+  if (format.oformat->flags & AVFMT_GLOBALHEADER) {
+    codec.flags |= AV_CODEC_FLAG_GLOBAL_HEADER;
+  }
+}
+
+// Opens the configured encoder, describes its stream and gives the frame
+// its buffers.
+absl::Status StartEncoder(const std::string& path, const AVCodec* encoder,
+                          AVRational rate, AVCodecContext* codec,
+                          AVStream* stream, AVFrame* frame) {
+  int code = avcodec_open2(codec, encoder, nullptr);
+  if (code < 0) {
+    return absl::InternalError(absl::StrCat("video '", path, "': cannot open ",
+                                            encoder->name, ": ",
+                                            AvError(code)));
+  }
+  if ((code = avcodec_parameters_from_context(stream->codecpar, codec)) < 0) {
+    return absl::InternalError(
+        absl::StrCat("video '", path, "': ", AvError(code)));
+  }
+  stream->time_base = codec->time_base;
+  stream->avg_frame_rate = rate;
+  frame->format = codec->pix_fmt;
+  frame->width = codec->width;
+  frame->height = codec->height;
+  if ((code = av_frame_get_buffer(frame, 0)) < 0) {
+    return absl::ResourceExhaustedError(
+        absl::StrCat("video '", path, "': ", AvError(code)));
+  }
+  return absl::OkStatus();
+}
+
+// Opens the file and writes the container's header.
+absl::Status StartFile(const std::string& path, AVFormatContext* format) {
+  int code = avio_open(&format->pb, path.c_str(), AVIO_FLAG_WRITE);
+  if (code < 0) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "video '", path, "': cannot open it for writing: ", AvError(code)));
+  }
+  if ((code = avformat_write_header(format, nullptr)) < 0) {
+    return absl::InternalError(absl::StrCat(
+        "video '", path, "': cannot write the header: ", AvError(code)));
+  }
+  return absl::OkStatus();
+}
+
+}  // namespace
+
+// Declared so that the encoder and its buffers go before the container
+// that owns the stream they feed.
+struct VideoWriter::Av {
+  std::unique_ptr<AVFormatContext, FormatDeleter> format;
+  AVStream* stream = nullptr;  // owned by format
+  std::unique_ptr<AVCodecContext, CodecDeleter> codec;
+  std::unique_ptr<AVFrame, FrameDeleter> frame;
+  std::unique_ptr<AVPacket, PacketDeleter> packet;
+  std::unique_ptr<SwsContext, ScaleDeleter> scale;
+};
+
+absl::StatusOr<std::unique_ptr<VideoWriter>> VideoWriter::Open(
+    const std::string& path, int width, int height, double fps) {
+  if (absl::Status status = CheckVideoRequest(path, width, height, fps);
+      !status.ok()) {
+    return status;
+  }
+  const bool gif = absl::EndsWith(absl::AsciiStrToLower(path), ".gif");
+  // FFmpeg's encoders report what they do at the info level.
+  av_log_set_level(AV_LOG_ERROR);
+  const int keep_every =
+      gif ? static_cast<int>(std::ceil(fps / kMaxGifFps - 1e-9)) : 1;
+  const AVRational rate = av_d2q(fps / keep_every, 100000);
+
+  auto av = std::make_unique<Av>();
+  AVFormatContext* format = nullptr;
+  const int code = avformat_alloc_output_context2(
+      &format, nullptr, gif ? "gif" : "mp4", path.c_str());
+  if (code < 0 || format == nullptr) {
+    return absl::InternalError(absl::StrCat("video '", path, "': no ",
+                                            gif ? "GIF" : "MP4",
+                                            " muxer: ", AvError(code)));
+  }
+  av->format.reset(format);
+  absl::StatusOr<const AVCodec*> encoder = FindEncoder(path, gif);
+  if (!encoder.ok()) return encoder.status();
   av->stream = avformat_new_stream(format, nullptr);
-  av->codec.reset(avcodec_alloc_context3(encoder));
+  av->codec.reset(avcodec_alloc_context3(*encoder));
   av->frame.reset(av_frame_alloc());
   av->packet.reset(av_packet_alloc());
   if (av->stream == nullptr || av->codec == nullptr || av->frame == nullptr ||
@@ -125,42 +204,11 @@ absl::StatusOr<std::unique_ptr<VideoWriter>> VideoWriter::Open(
         absl::StrCat("video '", path, "': out of memory"));
   }
   AVCodecContext* codec = av->codec.get();
-  codec->width = width;
-  codec->height = height;
-  codec->time_base = av_inv_q(rate);
-  codec->framerate = rate;
-  // GIF wants a palette: 3-3-2 bit RGB is a fixed one the encoder takes.
-  codec->pix_fmt = gif ? AV_PIX_FMT_RGB8 : AV_PIX_FMT_YUV420P;
-  if (encoder->id == AV_CODEC_ID_H264) {
-    av_opt_set(codec->priv_data, "preset", "veryfast", 0);
-    av_opt_set(codec->priv_data, "crf", "23", 0);
-  } else if (encoder->id == AV_CODEC_ID_MPEG4) {
-    codec->flags |= AV_CODEC_FLAG_QSCALE;
-    codec->global_quality = FF_QP2LAMBDA * 4;
-    codec->gop_size = 12;
-  }
-  if (format->oformat->flags & AVFMT_GLOBALHEADER) {
-    codec->flags |= AV_CODEC_FLAG_GLOBAL_HEADER;
-  }
-  if ((code = avcodec_open2(codec, encoder, nullptr)) < 0) {
-    return absl::InternalError(absl::StrCat("video '", path, "': cannot open ",
-                                            encoder->name, ": ",
-                                            AvError(code)));
-  }
-  if ((code = avcodec_parameters_from_context(av->stream->codecpar, codec)) <
-      0) {
-    return absl::InternalError(
-        absl::StrCat("video '", path, "': ", AvError(code)));
-  }
-  av->stream->time_base = codec->time_base;
-  av->stream->avg_frame_rate = rate;
-
-  av->frame->format = codec->pix_fmt;
-  av->frame->width = width;
-  av->frame->height = height;
-  if ((code = av_frame_get_buffer(av->frame.get(), 0)) < 0) {
-    return absl::ResourceExhaustedError(
-        absl::StrCat("video '", path, "': ", AvError(code)));
+  ConfigureEncoder(**encoder, *format, width, height, rate, gif, *codec);
+  if (absl::Status status = StartEncoder(path, *encoder, rate, codec,
+                                         av->stream, av->frame.get());
+      !status.ok()) {
+    return status;
   }
   av->scale.reset(sws_getContext(width, height, AV_PIX_FMT_RGB24, width, height,
                                  codec->pix_fmt, SWS_BILINEAR, nullptr, nullptr,
@@ -170,17 +218,11 @@ absl::StatusOr<std::unique_ptr<VideoWriter>> VideoWriter::Open(
         absl::StrCat("video '", path, "': swscale cannot convert RGB24 to ",
                      av_get_pix_fmt_name(codec->pix_fmt)));
   }
-
-  if ((code = avio_open(&format->pb, path.c_str(), AVIO_FLAG_WRITE)) < 0) {
-    return absl::InvalidArgumentError(absl::StrCat(
-        "video '", path, "': cannot open it for writing: ", AvError(code)));
-  }
-  if ((code = avformat_write_header(format, nullptr)) < 0) {
-    return absl::InternalError(absl::StrCat(
-        "video '", path, "': cannot write the header: ", AvError(code)));
+  if (absl::Status status = StartFile(path, format); !status.ok()) {
+    return status;
   }
   return std::unique_ptr<VideoWriter>(new VideoWriter(
-      std::move(av), width, height, fps, keep_every, encoder->name));
+      std::move(av), width, height, fps, keep_every, (*encoder)->name));
 }
 
 VideoWriter::VideoWriter(std::unique_ptr<Av> av, int width, int height,
