@@ -173,7 +173,18 @@ BulletWorld::BulletWorld(const PlanarModel& model)
     rotors_.push_back(
         model.links[i].armature > 0.0 ? LinkIndex(links) + rotors++ : -1);
   }
+  CreateDynamicsWorld(model);
+  CreateGround(model);
+  CreateBody(model, rotors);
+  AddColliders(model);
+  AddJointConstraints(model);
+  std::vector<double> q(num_dofs_, 0.0);
+  const std::vector<double> qd(num_dofs_, 0.0);
+  q[1] = model.root_z;
+  SetState(q, qd);
+}
 
+void BulletWorld::CreateDynamicsWorld(const PlanarModel& model) {
   // Small pools: the defaults (4096 entries) cost a few megabytes per world,
   // and a world is built for every episode. Pools overflow to the heap.
   btDefaultCollisionConstructionInfo construction;
@@ -190,7 +201,9 @@ BulletWorld::BulletWorld(const PlanarModel& model)
       collision_config_.get());
   world_->setGravity(btVector3(0, 0, -model.gravity));
   world_->getSolverInfo().m_numIterations = model.solver_iterations;
+}
 
+void BulletWorld::CreateGround(const PlanarModel& model) {
   if (ground_heights_.empty()) {
     const btVector3 normal(-std::sin(model.slope), 0, std::cos(model.slope));
     ground_shape_ = std::make_unique<btStaticPlaneShape>(normal, 0);
@@ -227,7 +240,10 @@ BulletWorld::BulletWorld(const PlanarModel& model)
   ground_info.m_restitution = 0.0;
   ground_ = std::make_unique<btRigidBody>(ground_info);
   world_->addRigidBody(ground_.get(), kGroundGroup, kBodyGroup);
+}
 
+void BulletWorld::CreateBody(const PlanarModel& model, int rotors) {
+  const int links = static_cast<int>(model.links.size());
   body_ = std::make_unique<btMultiBody>(LinkIndex(links) + rotors, 0.0,
                                         btVector3(0, 0, 0),
                                         /*fixedBase=*/true,
@@ -270,19 +286,7 @@ BulletWorld::BulletWorld(const PlanarModel& model)
             identity, btVector3(0, link.axis, 0), zero, zero, true);
       }
     }
-    if (link.is_box()) {
-      shapes_.push_back(std::make_unique<btBoxShape>(btVector3(
-          link.box_width / 2, link.box_depth / 2, link.box_height / 2)));
-      // Bullet's default margin (4 cm) lies inside the box and exceeds a
-      // thin one's half height (a 5 cm foot).
-      shapes_.back()->setMargin(kBoxMargin);
-    } else if (AlongX(link)) {
-      shapes_.push_back(
-          std::make_unique<btCapsuleShapeX>(link.radius, SegmentLength(link)));
-    } else {
-      shapes_.push_back(
-          std::make_unique<btCapsuleShapeZ>(link.radius, SegmentLength(link)));
-    }
+    shapes_.push_back(LinkShape(link));
   }
   body_->finalizeMultiDof();
   // MuJoCo's bodies have no drag; Bullet's default damps every link.
@@ -290,17 +294,40 @@ BulletWorld::BulletWorld(const PlanarModel& model)
   body_->setAngularDamping(0.0);
   body_->setHasSelfCollision(false);
   world_->addMultiBody(body_.get());
+}
 
-  for (int i = 0; i < links; ++i) {
+std::unique_ptr<btCollisionShape> BulletWorld::LinkShape(
+    const PlanarLink& link) {
+  if (link.is_box()) {
+    auto box = std::make_unique<btBoxShape>(
+        btVector3(link.box_width / 2, link.box_depth / 2, link.box_height / 2));
+    // Bullet's default margin (4 cm) lies inside the box and exceeds a thin
+    // one's half height (a 5 cm foot).
+    box->setMargin(kBoxMargin);
+    return box;
+  }
+  if (AlongX(link)) {
+    return std::make_unique<btCapsuleShapeX>(link.radius, SegmentLength(link));
+  }
+  return std::make_unique<btCapsuleShapeZ>(link.radius, SegmentLength(link));
+}
+
+void BulletWorld::AddColliders(const PlanarModel& model) {
+  for (size_t i = 0; i < model.links.size(); ++i) {
+    const int link = static_cast<int>(i);
     auto collider =
-        std::make_unique<btMultiBodyLinkCollider>(body_.get(), LinkIndex(i));
+        std::make_unique<btMultiBodyLinkCollider>(body_.get(), LinkIndex(link));
     collider->setCollisionShape(shapes_[i].get());
     collider->setFriction(model.links[i].friction);
     collider->setRestitution(0.0);
     world_->addCollisionObject(collider.get(), kBodyGroup, kGroundGroup);
-    body_->getLink(LinkIndex(i)).m_collider = collider.get();
+    body_->getLink(LinkIndex(link)).m_collider = collider.get();
     colliders_.push_back(std::move(collider));
   }
+}
+
+void BulletWorld::AddJointConstraints(const PlanarModel& model) {
+  const int links = static_cast<int>(model.links.size());
   for (int i = 1; i < links; ++i) {
     const PlanarLink& link = model.links[i];
     limits_.push_back(std::make_unique<btMultiBodyJointLimitConstraint>(
@@ -308,6 +335,7 @@ BulletWorld::BulletWorld(const PlanarModel& model)
     world_->addMultiBodyConstraint(limits_.back().get());
   }
   const btMatrix3x3 frame = btMatrix3x3::getIdentity();
+  const btVector3 zero(0, 0, 0);
   for (int j = 0; j < links - 1; ++j) {
     if (rotors_[j] < 0) continue;
     // Rows: qdot(hinge) + ratio * qdot(rotor) = 0.
@@ -317,11 +345,6 @@ BulletWorld::BulletWorld(const PlanarModel& model)
     gears_.back()->setGearRatio(-1.0);
     world_->addMultiBodyConstraint(gears_.back().get());
   }
-
-  std::vector<double> q(num_dofs_, 0.0);
-  const std::vector<double> qd(num_dofs_, 0.0);
-  q[1] = model.root_z;
-  SetState(q, qd);
 }
 
 BulletWorld::~BulletWorld() {

@@ -144,6 +144,16 @@ class BulletWorld {
   CapsulePose LinkCapsule(int link) const;
 
  private:
+  // The constructor's steps, in order: the dynamics world, the ground, the
+  // multibody (its links and their shapes), the links' colliders, and the
+  // joint limits and rotor gears.
+  void CreateDynamicsWorld(const PlanarModel& model);
+  void CreateGround(const PlanarModel& model);
+  void CreateBody(const PlanarModel& model, int rotors);
+  static std::unique_ptr<btCollisionShape> LinkShape(const PlanarLink& link);
+  void AddColliders(const PlanarModel& model);
+  void AddJointConstraints(const PlanarModel& model);
+
   // Bullet's link index of q(i), and of link `link`.
   static int DofLink(int i) { return i; }
   static int LinkIndex(int link) { return link + 2; }
