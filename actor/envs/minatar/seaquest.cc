@@ -158,7 +158,22 @@ GameStep Seaquest::Act(MinAtarAction action, std::mt19937_64& random) {
     SpawnDiver(random);
     diver_spawn_timer_ = kDiverSpawnInterval;
   }
+  MoveSub(action);
+  // Newest first throughout, as MinAtar iterates its lists.
+  MoveFriendlyBullets(step);
+  MoveDivers();
+  MoveEnemies(subs_, /*fire=*/true, step);
+  MoveEnemyBullets();
+  MoveEnemies(fish_, /*fire=*/false, step);
+  DecrementIfPositive(enemy_spawn_timer_);
+  DecrementIfPositive(diver_spawn_timer_);
+  DecrementIfPositive(shot_timer_);
+  UseOxygen(step);
+  step.terminal = terminal_;
+  return step;
+}
 
+void Seaquest::MoveSub(MinAtarAction action) {
   if (action == MinAtarAction::kFire && shot_timer_ == 0) {
     f_bullets_.push_back(Mover{sub_x_, sub_y_, facing_right_});
     shot_timer_ = kShotCoolDown;
@@ -173,8 +188,9 @@ GameStep Seaquest::Act(MinAtarAction action, std::mt19937_64& random) {
   } else if (action == MinAtarAction::kDown) {
     sub_y_ = std::min(kDeepest, sub_y_ + 1);
   }
+}
 
-  // Newest first throughout, as MinAtar iterates its lists.
+void Seaquest::MoveFriendlyBullets(GameStep& step) {
   for (int i = static_cast<int>(f_bullets_.size()) - 1; i >= 0; --i) {
     Mover& bullet = f_bullets_[i];
     Advance(bullet);
@@ -194,7 +210,9 @@ GameStep Seaquest::Act(MinAtarAction action, std::mt19937_64& random) {
       }
     }
   }
+}
 
+void Seaquest::MoveDivers() {
   for (int i = static_cast<int>(divers_.size()) - 1; i >= 0; --i) {
     Mover& diver = divers_[i];
     bool collected = AtSub(diver) && diver_count_ < kMaxDivers;
@@ -216,9 +234,9 @@ GameStep Seaquest::Act(MinAtarAction action, std::mt19937_64& random) {
       ++diver_count_;
     }
   }
+}
 
-  MoveEnemies(subs_, /*fire=*/true, step);
-
+void Seaquest::MoveEnemyBullets() {
   for (int i = static_cast<int>(e_bullets_.size()) - 1; i >= 0; --i) {
     Mover& bullet = e_bullets_[i];
     if (AtSub(bullet)) terminal_ = true;
@@ -229,13 +247,9 @@ GameStep Seaquest::Act(MinAtarAction action, std::mt19937_64& random) {
       terminal_ = true;
     }
   }
+}
 
-  MoveEnemies(fish_, /*fire=*/false, step);
-
-  DecrementIfPositive(enemy_spawn_timer_);
-  DecrementIfPositive(diver_spawn_timer_);
-  DecrementIfPositive(shot_timer_);
-
+void Seaquest::UseOxygen(GameStep& step) {
   if (oxygen_ <= 0) terminal_ = true;
   if (sub_y_ > 0) {
     --oxygen_;
@@ -247,8 +261,6 @@ GameStep Seaquest::Act(MinAtarAction action, std::mt19937_64& random) {
       step.reward += Surface();
     }
   }
-  step.terminal = terminal_;
-  return step;
 }
 
 void Seaquest::Observe(absl::Span<uint8_t> grid) const {

@@ -48,6 +48,14 @@ class Seaquest : public MinAtarGame {
   const std::vector<Mover>& enemy_bullets() const { return e_bullets_; }
 
  private:
+  // A step's parts, in the order Act runs them.
+  void MoveSub(MinAtarAction action);
+  void MoveFriendlyBullets(GameStep& step);
+  void MoveDivers();
+  void MoveEnemyBullets();
+  // Oxygen runs down under water; surfacing with divers scores, without
+  // any ends the game.
+  void UseOxygen(GameStep& step);
   void SpawnEnemy(std::mt19937_64& random);
   void SpawnDiver(std::mt19937_64& random);
   // Moves the enemies (fish or subs) newest first; subs also fire.
