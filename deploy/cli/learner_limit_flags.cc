@@ -22,6 +22,12 @@ ABSL_FLAG(int64_t, max_live_env_slots,
 ABSL_FLAG(double, actor_expiry_s,
           absl::ToDoubleSeconds(vantage::GatewayLimits().actor_expiry),
           "a registration with no open call for this long expires");
+ABSL_FLAG(double, claim_timeout_s,
+          absl::ToDoubleSeconds(vantage::GatewayLimits().claim_timeout),
+          "a registration that opens no call within this expires");
+ABSL_FLAG(int64_t, max_unclaimed_per_peer,
+          vantage::GatewayLimits().max_unclaimed_per_peer,
+          "registrations one host may hold before opening a call");
 ABSL_FLAG(double, idle_stream_timeout_s,
           absl::ToDoubleSeconds(vantage::ServiceLimits().idle_stream_timeout),
           "a segment stream silent for this long is cancelled");
@@ -44,10 +50,13 @@ ABSL_FLAG(int64_t, max_grpc_memory_mb,
 namespace vantage {
 
 std::vector<std::string> LearnerLimitFlagNames() {
-  return {"max_live_actors",    "max_envs_per_actor",    "max_live_env_slots",
-          "actor_expiry_s",     "idle_stream_timeout_s", "max_abs_observation",
-          "max_abs_action",     "max_abs_reward",        "max_abs_log_prob",
-          "max_server_threads", "max_grpc_memory_mb"};
+  return {"max_live_actors",      "max_envs_per_actor",
+          "max_live_env_slots",   "actor_expiry_s",
+          "claim_timeout_s",      "max_unclaimed_per_peer",
+          "idle_stream_timeout_s", "max_abs_observation",
+          "max_abs_action",       "max_abs_reward",
+          "max_abs_log_prob",     "max_server_threads",
+          "max_grpc_memory_mb"};
 }
 
 absl::Status ReadLearnerLimits(LearnerServerConfig& server) {
@@ -56,6 +65,8 @@ absl::Status ReadLearnerLimits(LearnerServerConfig& server) {
   limits.max_envs_per_actor = absl::GetFlag(FLAGS_max_envs_per_actor);
   limits.max_live_env_slots = absl::GetFlag(FLAGS_max_live_env_slots);
   limits.actor_expiry = absl::Seconds(absl::GetFlag(FLAGS_actor_expiry_s));
+  limits.claim_timeout = absl::Seconds(absl::GetFlag(FLAGS_claim_timeout_s));
+  limits.max_unclaimed_per_peer = absl::GetFlag(FLAGS_max_unclaimed_per_peer);
   limits.values.max_abs_observation = absl::GetFlag(FLAGS_max_abs_observation);
   limits.values.max_abs_action = absl::GetFlag(FLAGS_max_abs_action);
   limits.values.max_abs_reward = absl::GetFlag(FLAGS_max_abs_reward);

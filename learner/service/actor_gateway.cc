@@ -42,11 +42,16 @@ absl::Status GatewayLimits::Validate() const {
        {AtLeastOne(max_live_actors, "max_live_actors"),
         AtLeastOne(max_envs_per_actor, "max_envs_per_actor"),
         AtLeastOne(max_live_env_slots, "max_live_env_slots"),
-        AtLeastOne(max_tensor_bytes, "max_tensor_bytes"), values.Validate()}) {
+        AtLeastOne(max_tensor_bytes, "max_tensor_bytes"),
+        AtLeastOne(max_unclaimed_per_peer, "max_unclaimed_per_peer"),
+        values.Validate()}) {
     if (!status.ok()) return status;
   }
   if (actor_expiry <= absl::ZeroDuration()) {
     return absl::InvalidArgumentError("actor_expiry must be > 0");
+  }
+  if (claim_timeout <= absl::ZeroDuration()) {
+    return absl::InvalidArgumentError("claim_timeout must be > 0");
   }
   return absl::OkStatus();
 }
@@ -57,7 +62,8 @@ ActorGateway::ActorGateway(GatewayConfig config, SegmentSink& sink)
       next_actor_id_(config_.first_actor_id) {}
 
 absl::StatusOr<pb::RegisterResponse> ActorGateway::Register(
-    const pb::RegisterRequest& request, absl::Duration timeout) {
+    const pb::RegisterRequest& request, absl::string_view peer,
+    absl::Duration timeout) {
   auto refuse = [&](absl::Status status) {
     std::lock_guard<std::mutex> lock(mutex_);
     ++counters_.refused_registrations;
@@ -90,25 +96,26 @@ absl::StatusOr<pb::RegisterResponse> ActorGateway::Register(
     std::unique_lock<std::mutex> lock(mutex_);
     if (run_over_) return absl::OutOfRangeError(kRunOver);
     if (closed_) return absl::UnavailableError("the learner is shutting down");
-    if (static_cast<int64_t>(actors_.size()) >=
-            config_.limits.max_live_actors ||
-        counters_.live_env_slots + num_envs >
-            config_.limits.max_live_env_slots) {
+    const absl::Time now = absl::Now();
+    if (absl::Status quota = CheckUnclaimedQuota(peer, now); !quota.ok()) {
+      ++counters_.refused_registrations;
+      return quota;
+    }
+    if (!MakeRoom(num_envs)) {
       ++counters_.refused_registrations;
       return absl::ResourceExhaustedError(absl::StrCat(
           "the learner serves at most ", config_.limits.max_live_actors,
           " actors and ", config_.limits.max_live_env_slots,
           " env slots at once (now ", actors_.size(), " and ",
-          counters_.live_env_slots,
-          "); registrations of departed actors expire after ",
-          absl::FormatDuration(config_.limits.actor_expiry)));
+          counters_.live_env_slots, "), and every registration has a call open"));
     }
     actor_id = next_actor_id_++;
     Registration& registration = actors_[actor_id];
     registration.secret = secret;
+    registration.peer = std::string(peer);
     registration.num_envs = num_envs;
     registration.next_sequence.assign(num_envs, 0);
-    registration.last_seen = absl::Now();
+    registration.last_seen = now;
     ++counters_.registrations;
     counters_.live_env_slots += num_envs;
   }
@@ -151,6 +158,7 @@ absl::StatusOr<int64_t> ActorGateway::Attach(absl::string_view session) {
         absl::StrCat("wrong session secret for actor ", actor_id));
   }
   ++it->second.open_calls;
+  it->second.claimed = true;
   it->second.last_seen = absl::Now();
   return actor_id;
 }
@@ -164,21 +172,72 @@ void ActorGateway::Detach(int64_t actor_id) {
 }
 
 std::vector<int64_t> ActorGateway::ExpireIdle(absl::Time now) {
-  std::vector<int64_t> expired;
   std::lock_guard<std::mutex> lock(mutex_);
+  std::vector<int64_t> expired = std::move(evicted_);
+  evicted_.clear();
   for (auto it = actors_.begin(); it != actors_.end();) {
     const Registration& registration = it->second;
-    if (registration.open_calls == 0 &&
-        now - registration.last_seen > config_.limits.actor_expiry) {
+    const absl::Duration expiry = registration.claimed
+                                      ? config_.limits.actor_expiry
+                                      : config_.limits.claim_timeout;
+    if (registration.open_calls == 0 && now - registration.last_seen > expiry) {
       expired.push_back(it->first);
-      counters_.live_env_slots -= registration.num_envs;
-      ++counters_.expirations;
-      it = actors_.erase(it);
+      RemoveLocked(it++);
     } else {
       ++it;
     }
   }
   return expired;
+}
+
+absl::Status ActorGateway::CheckUnclaimedQuota(absl::string_view peer,
+                                               absl::Time now) const {
+  int64_t unclaimed = 0;
+  for (const auto& [actor_id, registration] : actors_) {
+    if (!registration.claimed && registration.peer == peer &&
+        now - registration.last_seen <= config_.limits.claim_timeout) {
+      ++unclaimed;
+    }
+  }
+  if (unclaimed < config_.limits.max_unclaimed_per_peer) {
+    return absl::OkStatus();
+  }
+  return absl::ResourceExhaustedError(absl::StrCat(
+      peer, " holds ", unclaimed,
+      " registrations that have opened no call (at most ",
+      config_.limits.max_unclaimed_per_peer, " per host); they expire after ",
+      absl::FormatDuration(config_.limits.claim_timeout)));
+}
+
+bool ActorGateway::MakeRoom(int64_t num_envs) {
+  auto full = [&] {
+    return static_cast<int64_t>(actors_.size()) >=
+               config_.limits.max_live_actors ||
+           counters_.live_env_slots + num_envs >
+               config_.limits.max_live_env_slots;
+  };
+  while (full()) {
+    // The registration longest without an open call: an actor that left,
+    // or one that registered and never came back.
+    auto idlest = actors_.end();
+    for (auto it = actors_.begin(); it != actors_.end(); ++it) {
+      if (it->second.open_calls > 0) continue;
+      if (idlest == actors_.end() ||
+          it->second.last_seen < idlest->second.last_seen) {
+        idlest = it;
+      }
+    }
+    if (idlest == actors_.end()) return false;
+    evicted_.push_back(idlest->first);
+    RemoveLocked(idlest);
+  }
+  return true;
+}
+
+void ActorGateway::RemoveLocked(std::map<int64_t, Registration>::iterator it) {
+  counters_.live_env_slots -= it->second.num_envs;
+  ++counters_.expirations;
+  actors_.erase(it);
 }
 
 absl::Status ActorGateway::Reject(const std::string& reason,

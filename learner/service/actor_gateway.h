@@ -42,6 +42,12 @@ struct GatewayLimits {
   // A registration with no open call for this long expires: its session
   // stops working and the learner frees what it buffered for it.
   absl::Duration actor_expiry = absl::Seconds(60);
+  // A registration that has opened no call yet is unclaimed: it expires
+  // after claim_timeout, and one peer host holds at most
+  // max_unclaimed_per_peer of them, so that a client registering in a loop
+  // cannot fill the table (an actor opens its calls within seconds).
+  absl::Duration claim_timeout = absl::Seconds(30);
+  int64_t max_unclaimed_per_peer = 64;
   int64_t max_tensor_bytes = 64 << 20;
   SpecLimits spec;
   ValueLimits values;
@@ -80,7 +86,7 @@ struct GatewayConfig {
 struct GatewayCounters {
   int64_t registrations = 0;  // granted, over the run of this process
   int64_t refused_registrations = 0;
-  int64_t expirations = 0;
+  int64_t expirations = 0;  // idle past their expiry, or evicted
   int64_t live_actors = 0;  // registrations not expired
   int64_t live_env_slots = 0;
   int64_t accepted_segments = 0;
@@ -106,11 +112,15 @@ class ActorGateway {
 
   // Checks the spec against the run's (InvalidArgument naming the field)
   // and num_envs against the limits, then grants an actor id and a secret
-  // session (ResourceExhausted when the live actors or env slots are at
-  // their limit). Answers once the first weights are published;
+  // session. `peer` names the caller's host (see PeerHost). When the live
+  // actors or env slots are at their limit, registrations with no open
+  // call make room, the longest idle first; ResourceExhausted when they
+  // cannot, or when `peer` holds max_unclaimed_per_peer unclaimed
+  // registrations. Answers once the first weights are published;
   // Unavailable if none arrive within `timeout`.
   absl::StatusOr<pb::RegisterResponse> Register(
-      const pb::RegisterRequest& request, absl::Duration timeout);
+      const pb::RegisterRequest& request, absl::string_view peer,
+      absl::Duration timeout);
 
   // Binds a call to the registration whose session it carries and keeps
   // that registration alive until Detach. NotFound for a session that is
@@ -133,8 +143,10 @@ class ActorGateway {
   // are no segment at all).
   void CountRejected(const std::string& reason);
 
-  // Expires the registrations idle since before now - actor_expiry and
-  // returns their ids (each once), so that the learner can free them.
+  // Expires the registrations idle since before now - actor_expiry and the
+  // unclaimed ones older than claim_timeout, and returns their ids and
+  // those of registrations evicted since the last call (each once), so
+  // that the learner can free them.
   std::vector<int64_t> ExpireIdle(absl::Time now = absl::Now());
 
   const EnvSpec& spec() const { return config_.spec; }
@@ -165,7 +177,9 @@ class ActorGateway {
  private:
   struct Registration {
     std::string secret;
+    std::string peer;
     int64_t num_envs = 0;
+    bool claimed = false;  // has opened a call
     // Per env slot: the lowest sequence number not yet admitted.
     std::vector<int64_t> next_sequence;
     int64_t open_calls = 0;
@@ -174,6 +188,13 @@ class ActorGateway {
   };
 
   absl::Status Reject(const std::string& reason, absl::Status status);
+  // With mutex_ held: whether `peer` may hold one more unclaimed
+  // registration, and room for `num_envs` more env slots made by evicting
+  // idle registrations (false if there is not enough to evict).
+  absl::Status CheckUnclaimedQuota(absl::string_view peer,
+                                   absl::Time now) const;
+  bool MakeRoom(int64_t num_envs);
+  void RemoveLocked(std::map<int64_t, Registration>::iterator it);
 
   const GatewayConfig config_;
   SegmentSink& sink_;
@@ -181,6 +202,7 @@ class ActorGateway {
   std::condition_variable changed_;
   std::map<int64_t, Registration> actors_;
   int64_t next_actor_id_ = 0;
+  std::vector<int64_t> evicted_;  // not yet returned by ExpireIdle
   std::shared_ptr<const pb::Weights> weights_;
   bool closed_ = false;
   bool run_over_ = false;

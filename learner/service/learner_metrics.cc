@@ -67,7 +67,8 @@ LearnerMetrics::LearnerMetrics()
                                          "Actor registrations granted.")),
       expirations_(
           metrics_.AddCounter("registration_expirations_total",
-                              "Registrations expired after their actor left.")),
+                              "Registrations expired after their actor left, never "
+                              "claimed, or evicted to make room.")),
       rolled_back_updates_(metrics_.AddCounter(
           "rolled_back_updates_total",
           "Updates undone because they produced non-finite numbers.")),

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
 #include "proto/wire_format.h"
 
@@ -68,6 +69,14 @@ absl::string_view SessionOf(const grpc::ServerContext& context) {
 
 }  // namespace
 
+std::string PeerHost(absl::string_view peer) {
+  if (!absl::StartsWith(peer, "ipv4:") && !absl::StartsWith(peer, "ipv6:")) {
+    return std::string(peer);
+  }
+  const size_t port = peer.rfind(':');
+  return std::string(peer.substr(0, port));
+}
+
 grpc::Status ToGrpcStatus(const absl::Status& status) {
   if (status.ok()) return grpc::Status::OK;
   return grpc::Status(static_cast<grpc::StatusCode>(status.code()),
@@ -105,7 +114,8 @@ grpc::Status LearnerService::StreamedRegister(
       return read;
     }
     absl::StatusOr<pb::RegisterResponse> registered =
-        gateway_.Register(request, kRegistrationWait);
+        gateway_.Register(request, PeerHost(context->peer()),
+                          kRegistrationWait);
     if (!registered.ok()) return ToGrpcStatus(registered.status());
     streamer->Write(*registered);
     return grpc::Status::OK;

@@ -20,6 +20,12 @@ namespace vantage {
 // absl::Status -> grpc::Status with the same code and message.
 grpc::Status ToGrpcStatus(const absl::Status& status);
 
+// The host of a gRPC peer string ("ipv4:10.0.0.7:41234" -> "ipv4:10.0.0.7",
+// "ipv6:[::1]:41234" -> "ipv6:[::1]"): what quotas per client count by, since
+// each connection of a client has a port of its own. Other kinds (unix,
+// inproc) are returned whole.
+std::string PeerHost(absl::string_view peer);
+
 // The gRPC face of an ActorGateway. Every method checks the auth token (if
 // one is required) before it reads the request, and runs in its own
 // server thread: the unary methods and SubscribeWeights use gRPC's streamed

@@ -57,7 +57,7 @@ void CheckRegister(const pb::RegisterRequest& request) {
   gateway.Publish(weights);
   for (int i = 0; i < 2; ++i) {
     absl::StatusOr<pb::RegisterResponse> response =
-        gateway.Register(request, absl::ZeroDuration());
+        gateway.Register(request, "fuzz", absl::ZeroDuration());
     if (!response.ok()) return;
     absl::StatusOr<int64_t> attached = gateway.Attach(response->session());
     if (!attached.ok() || *attached != response->actor_id()) {

@@ -384,7 +384,8 @@ TEST_F(LearnerServiceTest, RegisterIsUnavailableWhenNoWeightsArrive) {
   Start();
   const auto begin = std::chrono::steady_clock::now();
   absl::StatusOr<pb::RegisterResponse> response =
-      gateway_->Register(Request(PendulumSpec()), absl::Milliseconds(100));
+      gateway_->Register(Request(PendulumSpec()), "test",
+                         absl::Milliseconds(100));
   const auto waited = std::chrono::steady_clock::now() - begin;
   EXPECT_TRUE(absl::IsUnavailable(response.status())) << response.status();
   EXPECT_GE(waited, std::chrono::milliseconds(90));
@@ -587,7 +588,9 @@ TEST_F(LearnerServiceTest, RegistrationsStopAtTheLimits) {
   Start(config);
   gateway_->Publish(MakeWeights(0));
   pb::RegisterResponse response;
-  ASSERT_TRUE(Register(PendulumSpec(), &response).ok());      // 2 slots
+  ASSERT_TRUE(Register(PendulumSpec(), &response).ok());  // 2 slots
+  // A connected actor, which no registration can push out.
+  ASSERT_TRUE(gateway_->Attach(response.session()).ok());
   grpc::Status status = Register(PendulumSpec(), &response);  // 4 > 3 slots
   EXPECT_EQ(status.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED);
   EXPECT_THAT(status.error_message(), HasSubstr("3 env slots"));
@@ -603,6 +606,78 @@ TEST_F(LearnerServiceTest, RegistrationsStopAtTheLimits) {
   EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
   EXPECT_THAT(status.error_message(), HasSubstr("num_envs is 0"));
   EXPECT_EQ(gateway_->counters().refused_registrations, 2);
+}
+
+// Registrations straight at the gateway, as from the host `peer`.
+absl::StatusOr<pb::RegisterResponse> RegisterFrom(ActorGateway& gateway,
+                                                  absl::string_view peer) {
+  return gateway.Register(Request(PendulumSpec()), peer, absl::Seconds(5));
+}
+
+TEST_F(LearnerServiceTest, OneHostHoldsFewRegistrationsThatOpenedNoCall) {
+  GatewayConfig config = DefaultConfig();
+  config.limits.max_unclaimed_per_peer = 2;
+  config.limits.claim_timeout = absl::Seconds(10);
+  Start(config);
+  gateway_->Publish(MakeWeights(0));
+  const std::string host = "ipv4:10.0.0.1";
+  absl::StatusOr<pb::RegisterResponse> first = RegisterFrom(*gateway_, host);
+  ASSERT_TRUE(first.ok()) << first.status();
+  ASSERT_TRUE(RegisterFrom(*gateway_, host).ok());
+  absl::StatusOr<pb::RegisterResponse> third = RegisterFrom(*gateway_, host);
+  EXPECT_TRUE(absl::IsResourceExhausted(third.status())) << third.status();
+  EXPECT_THAT(third.status().message(),
+              HasSubstr("ipv4:10.0.0.1 holds 2 registrations that have "
+                        "opened no call (at most 2 per host)"));
+  // Other hosts are not held up, and a registration that opens a call no
+  // longer counts.
+  EXPECT_TRUE(RegisterFrom(*gateway_, "ipv4:10.0.0.2").ok());
+  absl::StatusOr<int64_t> attached = gateway_->Attach(first->session());
+  ASSERT_TRUE(attached.ok()) << attached.status();
+  EXPECT_TRUE(RegisterFrom(*gateway_, host).ok());
+  EXPECT_EQ(gateway_->counters().refused_registrations, 1);
+  // Unclaimed ones expire after claim_timeout, long before actor_expiry;
+  // the claimed one, with its call open, stays.
+  EXPECT_TRUE(gateway_->ExpireIdle(absl::Now()).empty());
+  EXPECT_THAT(gateway_->ExpireIdle(absl::Now() + absl::Seconds(11)),
+              ::testing::UnorderedElementsAre(1, 2, 3));
+  EXPECT_EQ(gateway_->counters().live_actors, 1);
+}
+
+TEST_F(LearnerServiceTest, AFullTableMakesRoomFromTheLongestIdle) {
+  GatewayConfig config = DefaultConfig();
+  config.limits.max_live_actors = 3;
+  Start(config);
+  gateway_->Publish(MakeWeights(0));
+  absl::StatusOr<pb::RegisterResponse> connected = RegisterFrom(*gateway_, "a");
+  ASSERT_TRUE(connected.ok()) << connected.status();
+  ASSERT_TRUE(gateway_->Attach(connected->session()).ok());
+  absl::StatusOr<pb::RegisterResponse> left = RegisterFrom(*gateway_, "b");
+  ASSERT_TRUE(left.ok()) << left.status();
+  ASSERT_TRUE(gateway_->Attach(left->session()).ok());
+  gateway_->Detach(left->actor_id());  // an actor that went away
+  absl::StatusOr<pb::RegisterResponse> silent = RegisterFrom(*gateway_, "c");
+  ASSERT_TRUE(silent.ok()) << silent.status();
+  // The table is full: the actor that left longest ago makes room, then
+  // the silent registration; the connected actor never does.
+  absl::StatusOr<pb::RegisterResponse> restarted = RegisterFrom(*gateway_, "b");
+  ASSERT_TRUE(restarted.ok()) << restarted.status();
+  EXPECT_TRUE(absl::IsNotFound(gateway_->Attach(left->session()).status()));
+  ASSERT_TRUE(gateway_->Attach(restarted->session()).ok());
+  absl::StatusOr<pb::RegisterResponse> fourth = RegisterFrom(*gateway_, "d");
+  ASSERT_TRUE(fourth.ok()) << fourth.status();
+  EXPECT_TRUE(absl::IsNotFound(gateway_->Attach(silent->session()).status()));
+  // The evicted are handed to the learner to free, once.
+  EXPECT_THAT(gateway_->ExpireIdle(absl::Now()),
+              ::testing::ElementsAre(left->actor_id(), silent->actor_id()));
+  EXPECT_TRUE(gateway_->ExpireIdle(absl::Now()).empty());
+  EXPECT_EQ(gateway_->counters().expirations, 2);
+  // With every registration connected, there is no room to make.
+  ASSERT_TRUE(gateway_->Attach(fourth->session()).ok());
+  absl::StatusOr<pb::RegisterResponse> refused = RegisterFrom(*gateway_, "e");
+  EXPECT_TRUE(absl::IsResourceExhausted(refused.status())) << refused.status();
+  EXPECT_THAT(refused.status().message(),
+              HasSubstr("every registration has a call open"));
 }
 
 TEST_F(LearnerServiceTest, ANewerStreamOfTheSameActorEndsTheOlder) {
@@ -731,4 +806,13 @@ TEST_F(LearnerServiceTest, FullQueueBlocksTheStreamUntilDrained) {
 }
 
 }  // namespace
+
+TEST(PeerHostTest, DropsThePortOfNetworkPeersOnly) {
+  EXPECT_EQ(PeerHost("ipv4:10.0.0.7:41234"), "ipv4:10.0.0.7");
+  EXPECT_EQ(PeerHost("ipv6:[::1]:41234"), "ipv6:[::1]");
+  EXPECT_EQ(PeerHost("ipv6:%5B::1%5D:5"), "ipv6:%5B::1%5D");
+  EXPECT_EQ(PeerHost("unix:/tmp/learner.sock"), "unix:/tmp/learner.sock");
+  EXPECT_EQ(PeerHost("inproc"), "inproc");
+}
+
 }  // namespace vantage
