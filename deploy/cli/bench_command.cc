@@ -245,17 +245,20 @@ Command BenchCommand() {
                    "bench_seconds", "bench_replica_of", "env",
                    "envs"};
   // train: the run flags, as `vantage train` takes them.
+  command.declared_flags = RunSettingFlags();
   for (const std::string& name : RunFlagNames(/*with_mode=*/false)) {
     if (std::find(command.flags.begin(), command.flags.end(), name) ==
         command.flags.end()) {
       command.flags.push_back(name);
     }
   }
-  command.defaults = {
-      {"env", absl::StrCat("actor: ", kActorBenchEnv,
-                           "; env: required; train: ", kTrainBenchEnv)},
-      {"steps", absl::StrCat("train: ", kTrainBenchSteps)},
-      {"envs", absl::StrCat("actor: ", kActorBenchEnvs)}};
+  // The run flags mean what they mean to `vantage train`, but for these.
+  command.defaults = RunFlagDefaults(/*with_mode=*/false);
+  command.defaults["env"] = absl::StrCat("actor: ", kActorBenchEnv,
+                                         "; env: required; train: ",
+                                         kTrainBenchEnv);
+  command.defaults["steps"] = absl::StrCat("train: ", kTrainBenchSteps);
+  command.defaults["envs"] = absl::StrCat("actor: ", kActorBenchEnvs);
   command.example = "vantage bench env --env=Hopper";
   command.take_own_arguments = InitializeGoogleBenchmark;
   command.takes_arguments = true;

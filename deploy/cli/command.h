@@ -12,7 +12,20 @@
 #include <string>
 #include <vector>
 
+#include "absl/status/status.h"
+
 namespace vantage {
+
+// A flag that is no absl flag: declared by a command from a descriptor (the
+// run settings, from proto/run_config.proto) and read by the command line
+// into DeclaredFlagValue (command_line.h).
+struct DeclaredFlag {
+  std::string name;
+  std::string help;
+  bool boolean = false;  // --name and --noname need no value
+  // OK if the flag takes `value`; else an error that names the flag.
+  std::function<absl::Status(const std::string& value)> check;
+};
 
 // Exit codes: 2 when the command line itself is wrong (a flag, a value, an
 // argument, a config file's content), so running it again cannot help; 1
@@ -26,6 +39,8 @@ struct Command {
   std::string usage;               // e.g. "vantage rollout [flags]"
   std::string description;         // a paragraph for `vantage help NAME`
   std::vector<std::string> flags;  // the flags it reads, without "--"
+  // Those of `flags` that are no absl flags.
+  std::vector<DeclaredFlag> declared_flags;
   // What an absent flag means to this command where that is not the flag's
   // own default (a flag several commands share, a default that depends on
   // another flag), taken from where the command's code takes it.

@@ -4,6 +4,8 @@
 #include <cstdio>
 #include <deque>
 #include <fstream>
+#include <map>
+#include <optional>
 #include <set>
 
 #include "absl/flags/commandlineflag.h"
@@ -46,61 +48,115 @@ absl::Status NotOwn(const Command& command, absl::string_view flag) {
                    "` (see `vantage help ", command.name, "`)"));
 }
 
+// The values given to declared flags, by name.
+std::map<std::string, std::string, std::less<>>& DeclaredValues() {
+  static auto* values = new std::map<std::string, std::string, std::less<>>;
+  return *values;
+}
+
+// A flag of the command line: an absl flag or a declared one (of any
+// command, so that another command's flag is named as such).
+struct FoundFlag {
+  absl::CommandLineFlag* absl_flag = nullptr;
+  const DeclaredFlag* declared = nullptr;
+  bool boolean() const {
+    return absl_flag != nullptr ? absl_flag->IsOfType<bool>()
+                                : declared->boolean;
+  }
+  absl::Status Check(absl::string_view name, const std::string& value) const {
+    if (declared != nullptr) return declared->check(value);
+    std::string error;
+    if (absl_flag->ParseFrom(value, &error)) return absl::OkStatus();
+    return absl::InvalidArgumentError(
+        absl::StrCat("--", name, "=", value, ": ", error));
+  }
+};
+
+std::optional<FoundFlag> FindFlag(const Command& command,
+                                  absl::string_view name) {
+  if (absl::CommandLineFlag* flag = absl::FindCommandLineFlag(name)) {
+    return FoundFlag{flag, nullptr};
+  }
+  for (const DeclaredFlag& declared : command.declared_flags) {
+    if (declared.name == name) return FoundFlag{nullptr, &declared};
+  }
+  return std::nullopt;
+}
+
+// The command's own flag first, so that its check is the one that runs.
+std::optional<FoundFlag> FindFlag(const std::vector<Command>& commands,
+                                  const Command& command,
+                                  absl::string_view name) {
+  if (std::optional<FoundFlag> own = FindFlag(command, name)) return own;
+  for (const Command& other : commands) {
+    if (std::optional<FoundFlag> found = FindFlag(other, name)) return found;
+  }
+  return std::nullopt;
+}
+
 // The flags on the command line itself, each checked to be the command's
 // own and to parse, so that a mistake is a message naming the command and
 // exit 2 rather than absl's exit 1. Flags inside --flagfile files are
-// on the command line by then (ExpandFlagfiles).
-absl::Status CheckCommandLineFlags(const Command& command, int argc,
-                                   char** argv) {
-  for (int i = 2; i < argc; ++i) {
-    absl::string_view arg = argv[i];
-    if (arg == "--") break;
+// on the command line by then (ExpandFlagfiles). Declared flags are taken
+// out of `arguments` into DeclaredValues; absl parses the rest.
+absl::Status TakeCommandLineFlags(const std::vector<Command>& commands,
+                                  const Command& command,
+                                  std::vector<char*>& arguments) {
+  std::vector<char*> kept(arguments.begin(), arguments.begin() + 2);
+  for (size_t i = 2; i < arguments.size(); ++i) {
+    absl::string_view arg = arguments[i];
+    if (arg == "--") {
+      kept.insert(kept.end(), arguments.begin() + i, arguments.end());
+      break;
+    }
+    kept.push_back(arguments[i]);
     if (arg.size() < 2 || arg[0] != '-') continue;  // an argument
     arg.remove_prefix(arg[1] == '-' ? 2 : 1);
     const size_t equals = arg.find('=');
     const absl::string_view name = arg.substr(0, equals);
     const bool has_value = equals != absl::string_view::npos;
     if (FlagSourceFlags().count(name) > 0) {
-      if (!has_value) ++i;
+      if (!has_value && i + 1 < arguments.size()) kept.push_back(arguments[++i]);
       continue;
     }
-    absl::CommandLineFlag* flag = absl::FindCommandLineFlag(name);
+    std::optional<FoundFlag> flag = FindFlag(commands, command, name);
     absl::string_view flag_name = name;
     std::string value = has_value ? std::string(arg.substr(equals + 1)) : "";
-    if (flag == nullptr && absl::StartsWith(name, "no")) {
-      absl::CommandLineFlag* negated =
-          absl::FindCommandLineFlag(name.substr(2));
-      if (negated != nullptr && negated->IsOfType<bool>() && !has_value) {
+    if (!flag.has_value() && absl::StartsWith(name, "no") && !has_value) {
+      std::optional<FoundFlag> negated =
+          FindFlag(commands, command, name.substr(2));
+      if (negated.has_value() && negated->boolean()) {
         flag = negated;
         flag_name = name.substr(2);
         value = "false";
       }
     }
-    if (flag == nullptr || !Owns(command, flag_name)) {
-      if (flag == nullptr) {
-        return absl::InvalidArgumentError(absl::StrCat("unknown flag --", name,
-                                                       " (see `vantage help ",
-                                                       command.name, "`)"));
-      }
-      return NotOwn(command, flag_name);
+    if (!flag.has_value()) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          "unknown flag --", name, " (see `vantage help ", command.name, "`)"));
     }
+    if (!Owns(command, flag_name)) return NotOwn(command, flag_name);
     if (!has_value && value.empty()) {
-      if (flag->IsOfType<bool>()) {
+      if (flag->boolean()) {
         value = "true";
-      } else if (i + 1 < argc) {
-        value = argv[++i];
+      } else if (i + 1 < arguments.size()) {
+        value = arguments[++i];
+        if (flag->absl_flag != nullptr) kept.push_back(arguments[i]);
       } else {
         return absl::InvalidArgumentError(
             absl::StrCat("--", name, " needs a value"));
       }
     }
-    // Parsing here only checks the value: absl sets it again below.
-    std::string error;
-    if (!flag->ParseFrom(value, &error)) {
-      return absl::InvalidArgumentError(
-          absl::StrCat("--", flag_name, "=", value, ": ", error));
+    // Parsing an absl flag here only checks the value: absl sets it again.
+    if (absl::Status status = flag->Check(flag_name, value); !status.ok()) {
+      return status;
+    }
+    if (flag->declared != nullptr) {
+      kept.pop_back();
+      DeclaredValues()[std::string(flag_name)] = value;
     }
   }
+  arguments = std::move(kept);
   return absl::OkStatus();
 }
 
@@ -217,7 +273,14 @@ int CommandFailure(const std::string& command, int code,
 }
 
 bool FlagGiven(absl::string_view name) {
-  return absl::flags_internal::WasPresentOnCommandLine(name);
+  return DeclaredValues().count(name) > 0 ||
+         absl::flags_internal::WasPresentOnCommandLine(name);
+}
+
+std::optional<std::string> DeclaredFlagValue(absl::string_view name) {
+  auto it = DeclaredValues().find(name);
+  if (it == DeclaredValues().end()) return std::nullopt;
+  return it->second;
 }
 
 std::string CommandHelp(const Command& command) {
@@ -228,14 +291,19 @@ std::string CommandHelp(const Command& command) {
   }
   absl::StrAppend(&text, "\nflags:\n");
   for (const std::string& name : command.flags) {
-    const absl::CommandLineFlag* flag = absl::FindCommandLineFlag(name);
-    if (flag == nullptr) continue;  // a programming error, caught by a test
+    const std::optional<FoundFlag> flag = FindFlag(command, name);
+    if (!flag.has_value()) continue;  // a programming error, caught by a test
     const auto own = command.defaults.find(name);
-    const std::string value =
-        own != command.defaults.end() ? own->second : flag->DefaultValue();
+    const std::string value = own != command.defaults.end() ? own->second
+                              : flag->absl_flag != nullptr
+                                  ? flag->absl_flag->DefaultValue()
+                                  : "";
     absl::StrAppend(&text, "  --", name, "=", value.empty() ? "\"\"" : value,
                     "\n");
-    absl::StrAppend(&text, "      ", flag->Help(), "\n");
+    absl::StrAppend(&text, "      ",
+                    flag->absl_flag != nullptr ? flag->absl_flag->Help()
+                                               : flag->declared->help,
+                    "\n");
   }
   absl::StrAppend(&text,
                   "  --flagfile=FILE\n"
@@ -292,12 +360,13 @@ int RunCommandLine(const std::vector<Command>& commands, int argc,
       !status.ok()) {
     return CommandFailure(name, kUsageError, std::string(status.message()));
   }
-  argc = static_cast<int>(arguments.size());
-  argv = arguments.data();
-  if (absl::Status status = CheckCommandLineFlags(*command, argc, argv);
+  if (absl::Status status =
+          TakeCommandLineFlags(commands, *command, arguments);
       !status.ok()) {
     return CommandFailure(name, kUsageError, std::string(status.message()));
   }
+  argc = static_cast<int>(arguments.size());
+  argv = arguments.data();
   const std::vector<char*> positional = absl::ParseCommandLine(argc, argv);
   if (absl::Status status = CheckFlagsFromEnvironment(*command); !status.ok()) {
     return CommandFailure(name, kUsageError, std::string(status.message()));

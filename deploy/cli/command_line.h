@@ -5,6 +5,7 @@
 // flag that is not the command's own (on the command line or in a
 // --flagfile), prints help, and runs it.
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -16,6 +17,10 @@ namespace vantage {
 // Whether the flag was set by the command line, a --flagfile or
 // --fromenv, as opposed to holding its default.
 bool FlagGiven(absl::string_view name);
+
+// The value a declared flag (Command::declared_flags) was given, as
+// written ("true"/"false" for --name/--noname); nullopt if not given.
+std::optional<std::string> DeclaredFlagValue(absl::string_view name);
 
 // `vantage help NAME`: usage, description, every flag with its default and
 // help, and the example.

@@ -153,6 +153,7 @@ Command LearnerCommand() {
       "environment: actors must register exactly its spec. The limits bound\n"
       "what clients can make it hold (docs/security.md).";
   command.flags = RunFlagNames(/*with_mode=*/false);
+  command.declared_flags = RunSettingFlags();
   for (const char* name :
        {"listen", "port_file", "metrics", "metrics_port_file", "rank",
         "world_size", "rendezvous", "replica_timeout_s"}) {

@@ -15,64 +15,14 @@
 #include "learner/algorithms/algorithm_config.h"
 #include "learner/exploration/ex2_config.h"
 
+// The run flags that are no run-config field. The fields' own flags are
+// declared from proto/run_config.proto (its `flag` option: RunSettingFlags),
+// --env, --envs and --seed are the shared flags (deploy/cli/shared_flags).
 // Every default is ResolveRunConfig's (see RunFlagDefaults): a flag's own
 // default below is never read, since only given flags enter the config.
-// --env, --envs and --seed are the shared flags (deploy/cli/shared_flags).
-ABSL_FLAG(std::string, mode, "",
-          "distributed (a learner and --actors actor processes over gRPC on "
-          "this machine) | local (one process)");
 ABSL_FLAG(std::string, algo, "",
           "ppo | a2c | trpo (a --config file's settings of another "
           "algorithm are dropped)");
-ABSL_FLAG(int64_t, steps, 0, "environment steps of the run");
-ABSL_FLAG(int64_t, horizon, 0, "rollout length per environment and update");
-ABSL_FLAG(std::vector<std::string>, hidden, {},
-          "hidden layer sizes of the policy and value networks");
-ABSL_FLAG(std::string, torso, "",
-          "what both networks put before their output layer: auto (mlp for "
-          "vectors; for images minatar below 36x36 pixels, else nature) | "
-          "mlp (tanh layers of --hidden) | minatar (MinAtar's net: 16 3x3 "
-          "convolutions, 128 units) | nature (the DQN net: 32 8x8/4, 64 "
-          "4x4/2, 64 3x3/1, 512 units)");
-ABSL_FLAG(bool, shared_torso, false,
-          "the value network uses the policy's convolutions, one trunk "
-          "trained by both losses (a convolutional --torso; ppo or a2c); "
-          "default: each network has its own");
-ABSL_FLAG(int64_t, frame_stack, 0,
-          "each observation is the last N ones, oldest first (images: "
-          "stacked along their channels, [N*C, H, W]); 1: none");
-ABSL_FLAG(bool, scale_rewards, false,
-          "divide rewards by the running std of discounted returns");
-ABSL_FLAG(int64_t, segment_length, 0,
-          "steps per segment an actor sends (divides --horizon in local and "
-          "--sync runs; by default the largest divisor of --horizon up to "
-          "128)");
-ABSL_FLAG(std::string, estimator, "",
-          "the biased statistic: gae (none) | max | min | maxabs | order:D");
-ABSL_FLAG(double, rho, 0, "probability of the biased estimate per sample");
-ABSL_FLAG(std::vector<std::string>, ensemble, {},
-          "the path ensemble's k-step lengths, comma-separated");
-ABSL_FLAG(double, gamma, 0, "discount");
-ABSL_FLAG(double, gae_lambda, 0, "lambda of the normal (GAE) estimate");
-ABSL_FLAG(int, actors, 0, "distributed: actor processes");
-ABSL_FLAG(int, envs_per_actor, 0, "distributed: environments per actor");
-ABSL_FLAG(bool, sync, true,
-          "distributed: each batch only from the current policy version "
-          "(actors wait for it); --nosync: asynchronous within "
-          "--max_policy_lag");
-ABSL_FLAG(int, learners, 0,
-          "distributed: data-parallel learner processes, each serving an "
-          "equal share of the actors and averaging gradients with the "
-          "others");
-ABSL_FLAG(int, learner_threads, 0,
-          "distributed: LibTorch intra-op threads of each learner (0: the "
-          "machine's cores shared out over the learners)");
-ABSL_FLAG(int64_t, max_policy_lag, 0,
-          "distributed, asynchronous: segments older than this many versions "
-          "are dropped and counted");
-ABSL_FLAG(int, checkpoint_every, 0,
-          "updates between checkpoints (with --run_dir)");
-ABSL_FLAG(int, keep_checkpoints, 0, "newest checkpoints kept");
 ABSL_FLAG(std::string, config, "",
           "a JSON run config (as a run directory's config.json); the flags "
           "given override it");
@@ -85,67 +35,9 @@ ABSL_FLAG(bool, resume_if_exists, false,
           "same settings continues it from its newest checkpoint (one that "
           "never checkpointed starts over); other settings are refused. For "
           "commands a scheduler repeats (requeued jobs, restarted pods)");
-
-// The algorithms' settings (learner/algorithms/<name>/<name>_config.h).
-ABSL_FLAG(int, ppo_epochs, 0, "ppo: epochs per update");
-ABSL_FLAG(int, ppo_minibatches, 0, "ppo: minibatches per epoch");
-ABSL_FLAG(double, ppo_learning_rate, 0,
-          "ppo: Adam's learning rate, decayed linearly to 0");
-ABSL_FLAG(double, ppo_clip, 0, "ppo: the ratio's clip range");
-ABSL_FLAG(double, ppo_entropy_coef, 0, "ppo: entropy bonus coefficient");
-ABSL_FLAG(double, ppo_value_coef, 0, "ppo: value loss coefficient");
-ABSL_FLAG(double, ppo_max_grad_norm, 0, "ppo: global gradient norm clip");
-ABSL_FLAG(bool, ppo_normalize_advantages, true,
-          "ppo: normalise advantages per minibatch (after rho mixing)");
-ABSL_FLAG(int, a2c_n, 0,
-          "a2c: n of the paper's trick: rollouts of a2c_steps_per_minibatch "
-          "x n steps updated as n minibatches (n = 1: the original A2C); "
-          "sets --horizon");
-ABSL_FLAG(int, a2c_steps_per_minibatch, 0, "a2c: steps per minibatch");
-ABSL_FLAG(double, a2c_learning_rate, 0,
-          "a2c: RMSProp's learning rate, decayed linearly to 0");
-ABSL_FLAG(double, a2c_entropy_coef, 0, "a2c: entropy bonus coefficient");
-ABSL_FLAG(double, a2c_value_coef, 0, "a2c: value loss coefficient");
-ABSL_FLAG(double, a2c_max_grad_norm, 0, "a2c: global gradient norm clip");
-ABSL_FLAG(std::string, a2c_rmsprop, "",
-          "a2c: pytorch | tensorflow: RMSProp as torch.optim.RMSprop "
-          "computes it (the mean square starts at 0, eps outside the square "
-          "root) or as TensorFlow does (starts at 1, eps inside), as the "
-          "baselines' A2C the paper ran");
-ABSL_FLAG(double, a2c_rmsprop_alpha, 0, "a2c: RMSProp's mean-square decay");
-ABSL_FLAG(double, a2c_rmsprop_eps, 0, "a2c: RMSProp's epsilon");
-ABSL_FLAG(double, trpo_max_kl, 0, "trpo: the trust region's mean-KL bound");
-ABSL_FLAG(int, trpo_cg_iterations, 0, "trpo: conjugate gradient iterations");
-ABSL_FLAG(double, trpo_cg_damping, 0, "trpo: Fisher-vector product damping");
-ABSL_FLAG(double, trpo_entropy_coef, 0, "trpo: entropy bonus coefficient");
-ABSL_FLAG(double, trpo_value_learning_rate, 0,
-          "trpo: the value function's Adam learning rate");
-ABSL_FLAG(int, trpo_value_epochs, 0, "trpo: value function epochs per update");
-
-// The exploration bonus (learner/exploration/).
 ABSL_FLAG(std::string, exploration, "",
           "none | ex2 (EX2's exemplar-model novelty bonus added to the "
           "rewards on the learner; its settings are the --ex2_ flags)");
-ABSL_FLAG(std::vector<std::string>, ex2_hidden, {},
-          "ex2: hidden layer sizes of the encoders and discriminator");
-ABSL_FLAG(int64_t, ex2_feature_dim, 0, "ex2: latent size of each encoder");
-ABSL_FLAG(double, ex2_learning_rate, 0, "ex2: the model's Adam learning rate");
-ABSL_FLAG(double, ex2_kl_weight, 0,
-          "ex2: weight of the latents' KL divergence to N(0, I)");
-ABSL_FLAG(double, ex2_bonus_coeff, 0,
-          "ex2: weight of the bonus -log p(s) in the reward");
-ABSL_FLAG(int, ex2_train_iterations, 0,
-          "ex2: the model's Adam steps per policy update");
-ABSL_FLAG(int, ex2_first_train_iterations, 0,
-          "ex2: Adam steps of the model's first fit");
-ABSL_FLAG(int64_t, ex2_replay_min, 0,
-          "ex2: states seen before the model fits at all");
-ABSL_FLAG(int64_t, ex2_replay_size, 0,
-          "ex2: newest states kept in the pool of negatives");
-ABSL_FLAG(int, ex2_batch_size, 0,
-          "ex2: positive (and negative) pairs per Adam step");
-ABSL_FLAG(bool, ex2_use_actions, true,
-          "ex2: model (state, action) pairs rather than states");
 
 namespace vantage {
 namespace {
@@ -164,6 +56,11 @@ struct RunFlag {
   const FieldDescriptor* group = nullptr;
   bool algorithm() const {
     return section != nullptr && section->containing_oneof() != nullptr;
+  }
+  // The field's `flag` option: its help line; empty for the fields whose
+  // flags are shared absl flags (--env, --envs, --seed).
+  const std::string& help() const {
+    return field->options().GetExtension(pb::flag);
   }
 };
 
@@ -482,6 +379,22 @@ absl::StatusOr<RunRequest> RunRequestFromSettings(
   return request;
 }
 
+std::vector<DeclaredFlag> RunSettingFlags() {
+  std::vector<DeclaredFlag> declared;
+  for (const RunFlag& flag : RunFlags()) {
+    if (flag.help().empty()) continue;
+    declared.push_back(
+        {flag.name, flag.help(),
+         flag.field->cpp_type() == FieldDescriptor::CPPTYPE_BOOL &&
+             !flag.field->is_repeated(),
+         [&flag](const std::string& text) {
+           pb::RunConfig scratch;
+           return SetField(flag, text, scratch);
+         }});
+  }
+  return declared;
+}
+
 absl::StatusOr<RunRequest> RunRequestFromFlags() {
   std::vector<std::pair<std::string, std::string>> settings;
   if (FlagGiven("algo")) {
@@ -491,6 +404,10 @@ absl::StatusOr<RunRequest> RunRequestFromFlags() {
     settings.emplace_back("exploration", absl::GetFlag(FLAGS_exploration));
   }
   for (const RunFlag& flag : RunFlags()) {
+    if (std::optional<std::string> value = DeclaredFlagValue(flag.name)) {
+      settings.emplace_back(flag.name, *value);
+      continue;
+    }
     if (!FlagGiven(flag.name)) continue;
     const absl::CommandLineFlag* absl_flag =
         absl::FindCommandLineFlag(flag.name);

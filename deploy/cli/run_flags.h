@@ -13,9 +13,15 @@
 #include <vector>
 
 #include "absl/status/statusor.h"
+#include "deploy/cli/command.h"
 #include "deploy/cli/run_request.h"
 
 namespace vantage {
+
+// The run flags of run-config fields with a `flag` option, for the
+// commands that take them to declare (Command::declared_flags); a value is
+// checked as the field reads it.
+std::vector<DeclaredFlag> RunSettingFlags();
 
 // The names of the run flags in the order of their sections; `with_mode`
 // adds --mode (train only: a learner is always the distributed one).

@@ -219,6 +219,7 @@ Command TrainCommand() {
       "(--max_live_actors ...) pass on to the learners it starts. Ends with\n"
       "a line `RESULT train ... mean_return=R` (the last 100 episodes).";
   command.flags = RunFlagNames(/*with_mode=*/true);
+  command.declared_flags = RunSettingFlags();
   for (const std::string& name : SecurityFlagNames()) {
     command.flags.push_back(name);
   }

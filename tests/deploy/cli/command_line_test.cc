@@ -88,6 +88,29 @@ TEST(CommandLineTest, EveryCommandHasHelp) {
   EXPECT_EQ(RunVantage("").exit_code, 2);
 }
 
+// The run flags come from the run-config proto: each setting is a flag of
+// `vantage train`, with its help line, and a run flag's value reaches the
+// run's config however it is written.
+TEST(CommandLineTest, EveryRunSettingIsAFlagOfTrain) {
+  const std::map<std::string, std::string> defaults = HelpDefaults("train");
+  for (const std::string& name : RunSettingNames()) {
+    EXPECT_EQ(defaults.count(name), 1u) << "--" << name;
+  }
+  const Outcome help = RunVantage("help train");
+  EXPECT_THAT(help.out, HasSubstr("  --ppo_clip=0.2\n      ppo: the ratio's "
+                                  "clip range\n"));
+  const std::string run = FreshDirectory("declared");
+  const Outcome outcome = RunVantage(
+      "train --mode=distributed --actors 1 --envs_per_actor=2 --nosync "
+      "--max_policy_lag 2 --steps=512 --horizon=128 --hidden 8,8 "
+      "--ppo_normalize_advantages=false --env=InvertedPendulum --run_dir=" + run);
+  ASSERT_EQ(outcome.exit_code, 0) << outcome.err;
+  const std::string config = ReadFile(run + "/config.json");
+  EXPECT_THAT(config, HasSubstr("\"sync\": false"));
+  EXPECT_THAT(config, HasSubstr("\"max_policy_lag\": \"2\""));
+  EXPECT_THAT(config, HasSubstr("\"normalize_advantages\": false"));
+}
+
 TEST(CommandLineTest, AFlagOfAnotherCommandIsAOneLineUsageError) {
   const std::pair<std::string, std::string> cases[] = {
       {"envs --rho=5", "--rho is not a flag of `vantage envs`"},
@@ -154,7 +177,7 @@ TEST(CommandLineTest, MistakesInAFlagfileAreUsageErrors) {
     std::string message;
   } cases[] = {
       {"--steps=64\n--no_such_flag=1\n", "unknown flag --no_such_flag"},
-      {"# a comment\n\n--steps=many\n", "--steps=many: "},
+      {"# a comment\n\n--steps=many\n", "--steps 'many' is not an integer"},
       {"--steps=64\nsteps=64\n",
        "line 2: 'steps=64' is not a flag (one --name=value per line)"},
       {"--flagfile=/no/such/file.flags\n",
