@@ -1,32 +1,35 @@
 #include "learner/algorithms/trpo/trpo_config.h"
 
+#include "learner/algorithms/settings_table.h"
 #include "proto/run_config.pb.h"
 
 namespace vantage {
+namespace {
+
+const SettingsTable<TrpoConfig, pb::TrpoSettings>& TrpoTable() {
+  using C = TrpoConfig;
+  static const auto* table = new SettingsTable<TrpoConfig, pb::TrpoSettings>(
+      "trpo", {{"max_kl", &C::max_kl, Above(0)},
+               {"cg_damping", &C::cg_damping, AtLeast(0)},
+               {"cg_iterations", &C::cg_iterations, AtLeast(1)},
+               {"value_learning_rate", &C::value_learning_rate, Above(0)},
+               {"value_epochs", &C::value_epochs, AtLeast(1)},
+               {"entropy_coef", &C::entropy_coef, AtLeast(0)}});
+  return *table;
+}
+
+}  // namespace
 
 absl::Status TrpoConfig::Validate() const {
-  if (!(max_kl > 0))
-    return absl::InvalidArgumentError("trpo.max_kl must be > 0");
-  if (!(cg_damping >= 0)) {
-    return absl::InvalidArgumentError("trpo.cg_damping must be >= 0");
+  if (absl::Status status = TrpoTable().Validate(*this); !status.ok()) {
+    return status;
   }
-  if (cg_iterations < 1) {
-    return absl::InvalidArgumentError("trpo.cg_iterations must be >= 1");
-  }
+  // Not settings of a run: fixed by the code that makes the config.
   if (line_search_steps < 1) {
     return absl::InvalidArgumentError("trpo line search steps must be >= 1");
   }
-  if (!(value_learning_rate > 0)) {
-    return absl::InvalidArgumentError("trpo.value_learning_rate must be > 0");
-  }
-  if (value_epochs < 1) {
-    return absl::InvalidArgumentError("trpo.value_epochs must be >= 1");
-  }
   if (value_minibatch_size < 1) {
     return absl::InvalidArgumentError("trpo value minibatch size must be >= 1");
-  }
-  if (!(entropy_coef >= 0)) {
-    return absl::InvalidArgumentError("trpo.entropy_coef must be >= 0");
   }
   return absl::OkStatus();
 }
@@ -38,26 +41,14 @@ AlgorithmRunDefaults RunDefaults(const TrpoConfig&) {
   return defaults;
 }
 
-TrpoConfig FromSettings(const pb::TrpoSettings& s) {
-  TrpoConfig c;
-  if (s.has_max_kl()) c.max_kl = s.max_kl();
-  if (s.has_cg_iterations()) c.cg_iterations = s.cg_iterations();
-  if (s.has_cg_damping()) c.cg_damping = s.cg_damping();
-  if (s.has_entropy_coef()) c.entropy_coef = s.entropy_coef();
-  if (s.has_value_learning_rate()) {
-    c.value_learning_rate = s.value_learning_rate();
-  }
-  if (s.has_value_epochs()) c.value_epochs = s.value_epochs();
-  return c;
+TrpoConfig FromSettings(const pb::TrpoSettings& settings) {
+  TrpoConfig config;
+  TrpoTable().Read(settings, config);
+  return config;
 }
 
-void ToSettings(const TrpoConfig& c, pb::TrpoSettings& s) {
-  s.set_max_kl(c.max_kl);
-  s.set_cg_iterations(c.cg_iterations);
-  s.set_cg_damping(c.cg_damping);
-  s.set_entropy_coef(c.entropy_coef);
-  s.set_value_learning_rate(c.value_learning_rate);
-  s.set_value_epochs(c.value_epochs);
+void ToSettings(const TrpoConfig& config, pb::TrpoSettings& settings) {
+  TrpoTable().Write(config, settings);
 }
 
 }  // namespace vantage

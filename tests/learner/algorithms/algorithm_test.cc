@@ -2,6 +2,7 @@
 
 #include <google/protobuf/descriptor.h>
 
+#include <cmath>
 #include <set>
 #include <string>
 
@@ -94,6 +95,43 @@ TEST(AlgorithmTest, ValidationNamesTheField) {
   EXPECT_TRUE(config.Validate().ok());
   config.trpo.max_kl = -1;
   EXPECT_EQ(config.Validate().message(), "trpo.max_kl must be > 0");
+}
+
+// Each setting is one row of its algorithm's table: every field of every
+// algorithm's section is written, and each range names its field and
+// holds at its ends (NaN is in none).
+TEST(AlgorithmTest, EverySettingIsWrittenAndRangeChecked) {
+  for (const std::string& name : AlgorithmNames()) {
+    pb::RunConfig run;
+    ASSERT_TRUE(SelectAlgorithm(name, run).ok());
+    pb::RunConfig written;
+    SetAlgorithmSettings(AlgorithmConfigOf(run), written);
+    const auto* section = pb::RunConfig::descriptor()->FindFieldByName(name);
+    const google::protobuf::Message& settings =
+        written.GetReflection()->GetMessage(written, section);
+    std::vector<const google::protobuf::FieldDescriptor*> set;
+    settings.GetReflection()->ListFields(settings, &set);
+    EXPECT_EQ(static_cast<int>(set.size()),
+              settings.GetDescriptor()->field_count())
+        << name << " leaves fields unwritten";
+  }
+  AlgorithmConfig config;
+  config.ppo.clip = 1;
+  EXPECT_EQ(config.Validate().message(), "ppo.clip must be in (0, 1)");
+  config.ppo.clip = 0.999;
+  EXPECT_TRUE(config.Validate().ok());
+  config.ppo.entropy_coef = std::nan("");
+  EXPECT_EQ(config.Validate().message(), "ppo.entropy_coef must be >= 0");
+  config.name = "a2c";
+  config.a2c.rmsprop_alpha = 0;
+  EXPECT_EQ(config.Validate().message(), "a2c.rmsprop_alpha must be in (0, 1)");
+  config.a2c.rmsprop_alpha = 0.5;
+  config.a2c.rmsprop = "adam";
+  EXPECT_THAT(std::string(config.Validate().message()),
+              HasSubstr("a2c.rmsprop must be tensorflow or pytorch"));
+  config.name = "trpo";
+  config.trpo.cg_damping = -0.1;
+  EXPECT_EQ(config.Validate().message(), "trpo.cg_damping must be >= 0");
 }
 
 }  // namespace
