@@ -45,11 +45,12 @@ absl::StatusOr<std::unique_ptr<Environment>> FrameStack::Wrap(
 }
 
 FrameStack::FrameStack(std::unique_ptr<Environment> inner, int64_t frames)
-    : inner_(std::move(inner)),
+    : EnvironmentWrapper(std::move(inner)),
       frames_(frames),
-      spec_(StackedSpec(inner_->spec(), frames)),
+      spec_(StackedSpec(this->inner().spec(), frames)),
       history_(static_cast<size_t>(spec_.observation_size), 0.0),
-      latest_(static_cast<size_t>(inner_->spec().observation_size), 0.0) {}
+      latest_(static_cast<size_t>(this->inner().spec().observation_size), 0.0) {
+}
 
 void FrameStack::Push() {
   std::copy(history_.begin() + latest_.size(), history_.end(),
@@ -66,7 +67,8 @@ absl::Status FrameStack::Reset(uint64_t seed, absl::Span<double> observation) {
       !status.ok()) {
     return status;
   }
-  if (absl::Status status = inner_->Reset(seed, absl::MakeSpan(latest_));
+  if (absl::Status status =
+          mutable_inner().Reset(seed, absl::MakeSpan(latest_));
       !status.ok()) {
     return status;
   }
@@ -82,7 +84,7 @@ absl::StatusOr<StepResult> FrameStack::Step(absl::Span<const double> action,
     return status;
   }
   absl::StatusOr<StepResult> result =
-      inner_->Step(action, absl::MakeSpan(latest_));
+      mutable_inner().Step(action, absl::MakeSpan(latest_));
   if (!result.ok()) return result;
   Push();
   Write(observation);
@@ -90,14 +92,14 @@ absl::StatusOr<StepResult> FrameStack::Step(absl::Span<const double> action,
 }
 
 absl::StatusOr<std::string> FrameStack::SaveState() const {
-  absl::StatusOr<std::string> inner = inner_->SaveState();
-  if (!inner.ok()) return inner.status();
+  absl::StatusOr<std::string> inner_state = inner().SaveState();
+  if (!inner_state.ok()) return inner_state.status();
   StateWriter writer(kStateKind, kStateVersion);
   writer.PutBytes(spec_.name);
   writer.PutI64(frames_);
-  writer.PutI64(inner_->spec().observation_size);
+  writer.PutI64(inner().spec().observation_size);
   writer.PutDoubles(history_);
-  writer.PutBytes(*inner);
+  writer.PutBytes(*inner_state);
   return std::move(writer).Finish();
 }
 
@@ -107,19 +109,20 @@ absl::Status FrameStack::RestoreState(absl::string_view state) {
   reader.ExpectEqual("the environment", reader.GetBytes("name"), spec_.name);
   reader.ExpectEqual("frames", reader.GetI64("frames"), frames_);
   reader.ExpectEqual("observation_size", reader.GetI64("observation_size"),
-                     inner_->spec().observation_size);
+                     inner().spec().observation_size);
   std::vector<double> history = reader.GetDoubles("history", history_.size());
-  const EnvSpec& inner_spec = inner_->spec();
+  const EnvSpec& inner_spec = inner().spec();
   reader.Check(std::all_of(history.begin(), history.end(),
                            [&](double value) {
                              return PlausibleObservation(inner_spec, value);
                            }),
                "history holds a value no observation can have");
-  const absl::string_view inner = reader.GetBytes("inner state");
+  const absl::string_view inner_state = reader.GetBytes("inner state");
   if (absl::Status status = reader.Finish(); !status.ok()) return status;
   // The inner environment restores all or nothing, so nothing has changed
   // if it fails.
-  if (absl::Status status = inner_->RestoreState(inner); !status.ok()) {
+  if (absl::Status status = mutable_inner().RestoreState(inner_state);
+      !status.ok()) {
     return status;
   }
   history_ = std::move(history);

@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "absl/status/statusor.h"
-#include "common/env/environment.h"
+#include "common/env/environment_wrapper.h"
 
 namespace vantage {
 
@@ -24,7 +24,7 @@ EnvSpec StackedSpec(const EnvSpec& spec, int64_t frames);
 // oldest first, so a network without memory sees motion (MinAtar's and the
 // maze's frames show no velocities). A Reset repeats the first observation
 // `frames` times. A failed Reset or Step leaves the history as it was.
-class FrameStack : public Environment {
+class FrameStack : public EnvironmentWrapper {
  public:
   // `frames` in [2, kMaxFrameStack]; anything else is InvalidArgument.
   static absl::StatusOr<std::unique_ptr<Environment>> Wrap(
@@ -37,12 +37,8 @@ class FrameStack : public Environment {
   // The history around the inner state.
   absl::StatusOr<std::string> SaveState() const override;
   absl::Status RestoreState(absl::string_view state) override;
-  absl::StatusOr<Frame> Render(int width, int height) override {
-    return inner_->Render(width, height);
-  }
 
   int64_t frames() const { return frames_; }
-  const Environment& inner() const { return *inner_; }
 
  private:
   FrameStack(std::unique_ptr<Environment> inner, int64_t frames);
@@ -51,7 +47,6 @@ class FrameStack : public Environment {
   void Push();
   void Write(absl::Span<double> observation) const;
 
-  std::unique_ptr<Environment> inner_;
   int64_t frames_;
   EnvSpec spec_;
   // The last `frames_` inner observations, oldest first, back to back.

@@ -14,12 +14,13 @@ constexpr uint32_t kStateVersion = 1;
 }  // namespace
 
 TimeLimit::TimeLimit(std::unique_ptr<Environment> inner)
-    : inner_(std::move(inner)) {}
+    : EnvironmentWrapper(std::move(inner)) {}
 
 absl::Status TimeLimit::Reset(uint64_t seed, absl::Span<double> observation) {
   running_ = false;
   elapsed_steps_ = 0;
-  if (absl::Status status = inner_->Reset(seed, observation); !status.ok()) {
+  if (absl::Status status = mutable_inner().Reset(seed, observation);
+      !status.ok()) {
     return status;
   }
   running_ = true;
@@ -34,7 +35,7 @@ absl::StatusOr<StepResult> TimeLimit::Step(absl::Span<const double> action,
                      ": Step called before Reset or after the "
                      "episode ended"));
   }
-  absl::StatusOr<StepResult> result = inner_->Step(action, observation);
+  absl::StatusOr<StepResult> result = mutable_inner().Step(action, observation);
   if (!result.ok()) return result;
   ++elapsed_steps_;
   const int64_t limit = spec().max_episode_steps;
@@ -46,14 +47,14 @@ absl::StatusOr<StepResult> TimeLimit::Step(absl::Span<const double> action,
 }
 
 absl::StatusOr<std::string> TimeLimit::SaveState() const {
-  absl::StatusOr<std::string> inner = inner_->SaveState();
-  if (!inner.ok()) return inner.status();
+  absl::StatusOr<std::string> inner_state = inner().SaveState();
+  if (!inner_state.ok()) return inner_state.status();
   StateWriter writer(kStateKind, kStateVersion);
   writer.PutBytes(spec().name);
   writer.PutI64(spec().max_episode_steps);
   writer.PutI64(elapsed_steps_);
   writer.PutBool(running_);
-  writer.PutBytes(*inner);
+  writer.PutBytes(*inner_state);
   return std::move(writer).Finish();
 }
 
@@ -66,7 +67,7 @@ absl::Status TimeLimit::RestoreState(absl::string_view state) {
                      limit);
   const int64_t elapsed = reader.GetI64("elapsed_steps");
   const bool running = reader.GetBool("running");
-  const absl::string_view inner = reader.GetBytes("inner state");
+  const absl::string_view inner_state = reader.GetBytes("inner state");
   // A running episode has not reached the limit yet; an ended one may have.
   reader.Check(elapsed >= 0 && (limit <= 0 ||
                                 (running ? elapsed < limit : elapsed <= limit)),
@@ -75,7 +76,8 @@ absl::Status TimeLimit::RestoreState(absl::string_view state) {
   if (absl::Status status = reader.Finish(); !status.ok()) return status;
   // The inner environment restores all or nothing, so nothing has changed
   // if it fails.
-  if (absl::Status status = inner_->RestoreState(inner); !status.ok()) {
+  if (absl::Status status = mutable_inner().RestoreState(inner_state);
+      !status.ok()) {
     return status;
   }
   elapsed_steps_ = elapsed;

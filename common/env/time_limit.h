@@ -5,34 +5,27 @@
 #include <memory>
 #include <string>
 
-#include "common/env/environment.h"
+#include "common/env/environment_wrapper.h"
 
 namespace vantage {
 
 // Truncates episodes after spec().max_episode_steps steps (never marking
 // them terminated), and refuses to step an episode that has not been reset
 // or has already ended.
-class TimeLimit : public Environment {
+class TimeLimit : public EnvironmentWrapper {
  public:
   explicit TimeLimit(std::unique_ptr<Environment> inner);
 
-  const EnvSpec& spec() const override { return inner_->spec(); }
   absl::Status Reset(uint64_t seed, absl::Span<double> observation) override;
   absl::StatusOr<StepResult> Step(absl::Span<const double> action,
                                   absl::Span<double> observation) override;
   // The step count and whether an episode runs, around the inner state.
   absl::StatusOr<std::string> SaveState() const override;
   absl::Status RestoreState(absl::string_view state) override;
-  absl::StatusOr<Frame> Render(int width, int height) override {
-    return inner_->Render(width, height);
-  }
 
   int64_t elapsed_steps() const { return elapsed_steps_; }
-  // The wrapped environment (benchmarks reach the physics through it).
-  const Environment& inner() const { return *inner_; }
 
  private:
-  std::unique_ptr<Environment> inner_;
   int64_t elapsed_steps_ = 0;
   bool running_ = false;
 };

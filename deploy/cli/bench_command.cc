@@ -254,9 +254,8 @@ Command BenchCommand() {
   }
   // The run flags mean what they mean to `vantage train`, but for these.
   command.defaults = RunFlagDefaults(/*with_mode=*/false);
-  command.defaults["env"] = absl::StrCat("actor: ", kActorBenchEnv,
-                                         "; env: required; train: ",
-                                         kTrainBenchEnv);
+  command.defaults["env"] = absl::StrCat(
+      "actor: ", kActorBenchEnv, "; env: required; train: ", kTrainBenchEnv);
   command.defaults["steps"] = absl::StrCat("train: ", kTrainBenchSteps);
   command.defaults["envs"] = absl::StrCat("actor: ", kActorBenchEnvs);
   command.example = "vantage bench env --env=Hopper";

@@ -116,7 +116,8 @@ absl::Status TakeCommandLineFlags(const std::vector<Command>& commands,
     const absl::string_view name = arg.substr(0, equals);
     const bool has_value = equals != absl::string_view::npos;
     if (FlagSourceFlags().count(name) > 0) {
-      if (!has_value && i + 1 < arguments.size()) kept.push_back(arguments[++i]);
+      if (!has_value && i + 1 < arguments.size())
+        kept.push_back(arguments[++i]);
       continue;
     }
     std::optional<FoundFlag> flag = FindFlag(commands, command, name);
@@ -360,8 +361,7 @@ int RunCommandLine(const std::vector<Command>& commands, int argc,
       !status.ok()) {
     return CommandFailure(name, kUsageError, std::string(status.message()));
   }
-  if (absl::Status status =
-          TakeCommandLineFlags(commands, *command, arguments);
+  if (absl::Status status = TakeCommandLineFlags(commands, *command, arguments);
       !status.ok()) {
     return CommandFailure(name, kUsageError, std::string(status.message()));
   }

@@ -50,13 +50,12 @@ ABSL_FLAG(int64_t, max_grpc_memory_mb,
 namespace vantage {
 
 std::vector<std::string> LearnerLimitFlagNames() {
-  return {"max_live_actors",      "max_envs_per_actor",
-          "max_live_env_slots",   "actor_expiry_s",
-          "claim_timeout_s",      "max_unclaimed_per_peer",
-          "idle_stream_timeout_s", "max_abs_observation",
-          "max_abs_action",       "max_abs_reward",
-          "max_abs_log_prob",     "max_server_threads",
-          "max_grpc_memory_mb"};
+  return {
+      "max_live_actors",       "max_envs_per_actor",  "max_live_env_slots",
+      "actor_expiry_s",        "claim_timeout_s",     "max_unclaimed_per_peer",
+      "idle_stream_timeout_s", "max_abs_observation", "max_abs_action",
+      "max_abs_reward",        "max_abs_log_prob",    "max_server_threads",
+      "max_grpc_memory_mb"};
 }
 
 absl::Status ReadLearnerLimits(LearnerServerConfig& server) {

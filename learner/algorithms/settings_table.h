@@ -68,9 +68,8 @@ class SettingsTable {
     for (const Row& row : rows_) {
       const google::protobuf::FieldDescriptor* field = Field(settings, row);
       if (!reflection->HasField(settings, field)) continue;
-      std::visit(
-          [&](auto member) { Get(settings, *field, config.*member); },
-          row.member);
+      std::visit([&](auto member) { Get(settings, *field, config.*member); },
+                 row.member);
     }
   }
 
@@ -145,9 +144,8 @@ class SettingsTable {
 
   // NaN is in no range.
   static bool InRange(double value, const Row& row) {
-    if (row.low.has_value() &&
-        !(row.low->inclusive ? value >= row.low->value
-                             : value > row.low->value)) {
+    if (row.low.has_value() && !(row.low->inclusive ? value >= row.low->value
+                                                    : value > row.low->value)) {
       return false;
     }
     if (row.high.has_value() &&
@@ -166,8 +164,7 @@ class SettingsTable {
       return absl::StrCat(row.high->inclusive ? "<= " : "< ", row.high->value);
     }
     return absl::StrCat("in ", row.low->inclusive ? "[" : "(", row.low->value,
-                        ", ", row.high->value,
-                        row.high->inclusive ? "]" : ")");
+                        ", ", row.high->value, row.high->inclusive ? "]" : ")");
   }
 
   const char* section_;

@@ -107,7 +107,8 @@ absl::StatusOr<pb::RegisterResponse> ActorGateway::Register(
           "the learner serves at most ", config_.limits.max_live_actors,
           " actors and ", config_.limits.max_live_env_slots,
           " env slots at once (now ", actors_.size(), " and ",
-          counters_.live_env_slots, "), and every registration has a call open"));
+          counters_.live_env_slots,
+          "), and every registration has a call open"));
     }
     actor_id = next_actor_id_++;
     Registration& registration = actors_[actor_id];

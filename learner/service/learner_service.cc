@@ -113,9 +113,8 @@ grpc::Status LearnerService::StreamedRegister(
         !read.ok()) {
       return read;
     }
-    absl::StatusOr<pb::RegisterResponse> registered =
-        gateway_.Register(request, PeerHost(context->peer()),
-                          kRegistrationWait);
+    absl::StatusOr<pb::RegisterResponse> registered = gateway_.Register(
+        request, PeerHost(context->peer()), kRegistrationWait);
     if (!registered.ok()) return ToGrpcStatus(registered.status());
     streamer->Write(*registered);
     return grpc::Status::OK;

@@ -477,9 +477,9 @@ TEST_F(AdversarialTest, ActorsThatLeftMakeRoomForNewOnes) {
   std::vector<Registered> left;
   for (int i = 0; i < 7; ++i) {
     left.push_back(RegisterAttacker());
-    const grpc::Status streamed = Stream(
-        left.back().session,
-        {HonestSegment(left.back().actor_id, left.back().version, 0)});
+    const grpc::Status streamed =
+        Stream(left.back().session,
+               {HonestSegment(left.back().actor_id, left.back().version, 0)});
     EXPECT_TRUE(streamed.ok()) << streamed.error_message();
   }
   pb::RegisterRequest request;
@@ -493,9 +493,9 @@ TEST_F(AdversarialTest, ActorsThatLeftMakeRoomForNewOnes) {
                    {HonestSegment(left.front().actor_id, fresh.version, 1)})
                 .error_code(),
             grpc::StatusCode::NOT_FOUND);
-  EXPECT_TRUE(Stream(fresh.session,
-                     {HonestSegment(fresh.actor_id, fresh.version, 0)})
-                  .ok());
+  EXPECT_TRUE(
+      Stream(fresh.session, {HonestSegment(fresh.actor_id, fresh.version, 0)})
+          .ok());
   ExpectTrainingGoesOn();
 }
 

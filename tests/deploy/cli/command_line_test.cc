@@ -103,7 +103,8 @@ TEST(CommandLineTest, EveryRunSettingIsAFlagOfTrain) {
   const Outcome outcome = RunVantage(
       "train --mode=distributed --actors 1 --envs_per_actor=2 --nosync "
       "--max_policy_lag 2 --steps=512 --horizon=128 --hidden 8,8 "
-      "--ppo_normalize_advantages=false --env=InvertedPendulum --run_dir=" + run);
+      "--ppo_normalize_advantages=false --env=InvertedPendulum --run_dir=" +
+      run);
   ASSERT_EQ(outcome.exit_code, 0) << outcome.err;
   const std::string config = ReadFile(run + "/config.json");
   EXPECT_THAT(config, HasSubstr("\"sync\": false"));

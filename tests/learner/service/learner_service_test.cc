@@ -383,9 +383,8 @@ TEST_F(LearnerServiceTest, RegisterWaitsForTheFirstWeights) {
 TEST_F(LearnerServiceTest, RegisterIsUnavailableWhenNoWeightsArrive) {
   Start();
   const auto begin = std::chrono::steady_clock::now();
-  absl::StatusOr<pb::RegisterResponse> response =
-      gateway_->Register(Request(PendulumSpec()), "test",
-                         absl::Milliseconds(100));
+  absl::StatusOr<pb::RegisterResponse> response = gateway_->Register(
+      Request(PendulumSpec()), "test", absl::Milliseconds(100));
   const auto waited = std::chrono::steady_clock::now() - begin;
   EXPECT_TRUE(absl::IsUnavailable(response.status())) << response.status();
   EXPECT_GE(waited, std::chrono::milliseconds(90));
