@@ -24,33 +24,46 @@
 namespace vantage {
 namespace {
 
-using Factory = std::function<absl::StatusOr<std::unique_ptr<Environment>>()>;
+using Factory = std::function<absl::StatusOr<std::unique_ptr<Environment>>(
+    const EnvName& name)>;
+
+// A task that takes no options.
+Factory Plain(absl::StatusOr<std::unique_ptr<Environment>> (*make)()) {
+  return
+      [make](
+          const EnvName& name) -> absl::StatusOr<std::unique_ptr<Environment>> {
+        if (absl::Status status = ApplyEnvOptions(name.task, {}, name.options);
+            !status.ok()) {
+          return status;
+        }
+        return make();
+      };
+}
 
 const std::map<std::string, Factory>& Factories() {
-  static const auto* factories = new std::map<std::string, Factory>{
-      {"Ant", MakeAnt},
-      {"BipedWalkFlat", MakeBipedWalkFlat},
-      {"BipedWalkIncline", MakeBipedWalkIncline},
-      {"BulletHopper", MakeBulletHopper},
-      {"FirstPersonMaze", MakeFirstPersonMaze},
-      {"HalfCheetah", MakeHalfCheetah},
-      {"Hopper", MakeHopper},
-      {"Humanoid", MakeHumanoid},
-      {"InvertedDoublePendulum", MakeInvertedDoublePendulum},
-      {"InvertedPendulum", MakeInvertedPendulum},
-      {"MinAtarAsterix", MakeMinAtarAsterix},
-      {"MinAtarBreakout", MakeMinAtarBreakout},
-      {"MinAtarFreeway", MakeMinAtarFreeway},
-      {"MinAtarSeaquest", MakeMinAtarSeaquest},
-      {"MinAtarSpaceInvaders", MakeMinAtarSpaceInvaders},
-      {"PointMaze", MakePointMaze},
-      {"SparseHalfCheetah", MakeSparseHalfCheetah},
-      {"TerrainBipedFlat", MakeTerrainBipedFlat},
-      {"TerrainBipedIncline", MakeTerrainBipedIncline},
-      {"Ex2SparseHalfCheetah", MakeEx2SparseHalfCheetah},
-      {"TwoDMaze", MakeTwoDMaze},
-      {"Walker2d", MakeWalker2d},
-  };
+  static const auto* factories = [] {
+    auto* all = new std::map<std::string, Factory>{
+        {"BipedWalkFlat", Plain(MakeBipedWalkFlat)},
+        {"BipedWalkIncline", Plain(MakeBipedWalkIncline)},
+        {"BulletHopper", Plain(MakeBulletHopper)},
+        {"FirstPersonMaze", Plain(MakeFirstPersonMaze)},
+        {"Humanoid", Plain(MakeHumanoid)},
+        {"InvertedDoublePendulum", Plain(MakeInvertedDoublePendulum)},
+        {"InvertedPendulum", Plain(MakeInvertedPendulum)},
+        {"MinAtarAsterix", Plain(MakeMinAtarAsterix)},
+        {"MinAtarBreakout", Plain(MakeMinAtarBreakout)},
+        {"MinAtarFreeway", Plain(MakeMinAtarFreeway)},
+        {"MinAtarSeaquest", Plain(MakeMinAtarSeaquest)},
+        {"MinAtarSpaceInvaders", Plain(MakeMinAtarSpaceInvaders)},
+        {"PointMaze", Plain(MakePointMaze)},
+        {"TerrainBipedFlat", Plain(MakeTerrainBipedFlat)},
+        {"TerrainBipedIncline", Plain(MakeTerrainBipedIncline)},
+        {"TwoDMaze", Plain(MakeTwoDMaze)},
+    };
+    for (const std::string& name : GymTaskNames())
+      all->emplace(name, MakeGymTask);
+    return all;
+  }();
   return *factories;
 }
 
@@ -67,19 +80,25 @@ absl::StatusOr<std::unique_ptr<Environment>> MakeEnvironment(
     }
     env = MakeMjcfEnv(std::string(path));
   } else {
-    auto factory = Factories().find(std::string(name));
+    absl::StatusOr<EnvName> parsed = ParseEnvName(name);
+    if (!parsed.ok()) return parsed.status();
+    auto factory = Factories().find(parsed->task);
     if (factory == Factories().end()) {
       return absl::NotFoundError(absl::StrCat(
-          "unknown environment '", name,
+          "unknown environment '", parsed->task,
           "'; registered: ", absl::StrJoin(RegisteredEnvironments(), ", "),
           ", or mjcf:/path/model.xml"));
     }
-    env = factory->second();
+    env = factory->second(*parsed);
   }
   if (!env.ok()) return env.status();
   auto limited = std::make_unique<TimeLimit>(std::move(*env));
   if (options.frame_stack == 1) return limited;
   return FrameStack::Wrap(std::move(limited), options.frame_stack);
+}
+
+std::vector<EnvOptionInfo> EnvironmentOptions(const std::string& name) {
+  return GymTaskOptions(name);
 }
 
 std::vector<std::string> RegisteredEnvironments() {

@@ -8,6 +8,7 @@
 
 #include "absl/status/statusor.h"
 #include "absl/strings/string_view.h"
+#include "actor/envs/env_options.h"
 #include "common/env/environment.h"
 
 namespace vantage {
@@ -19,14 +20,20 @@ struct EnvOptions {
   int64_t frame_stack = 1;
 };
 
-// A registered name ("HalfCheetah", ...) or "mjcf:/path/model.xml", wrapped
-// in its time limit and then as `options` say. An unknown name is an error
-// that lists the valid ones.
+// A registered name ("HalfCheetah", ...), the same with task options
+// ("HalfCheetah:ctrl_cost=0.2,max_episode_steps=500": see env_options.h),
+// or "mjcf:/path/model.xml", wrapped in its time limit and then as
+// `options` say. An unknown name is an error that lists the valid ones, an
+// unknown task option one that lists the task's.
 absl::StatusOr<std::unique_ptr<Environment>> MakeEnvironment(
     absl::string_view name, const EnvOptions& options = {});
 
 // The registered names, sorted (mjcf:PATH not included).
 std::vector<std::string> RegisteredEnvironments();
+
+// The task options a registered name takes, with its defaults (empty for
+// a task without options or an unknown name).
+std::vector<EnvOptionInfo> EnvironmentOptions(const std::string& name);
 
 }  // namespace vantage
 

@@ -141,6 +141,10 @@ int RunEnvs(const std::vector<std::string>&) {
     const EnvSpec& spec = (*env)->spec();
     std::printf("%s obs=[%s] act=%s\n", name.c_str(),
                 spec.ObservationString().c_str(), spec.ActionString().c_str());
+    for (const EnvOptionInfo& option : EnvironmentOptions(name)) {
+      std::printf("  :%s=%s  %s\n", option.name.c_str(),
+                  option.default_value.c_str(), option.help.c_str());
+    }
   }
   return 0;
 }
@@ -332,7 +336,9 @@ Command EnvsCommand() {
   command.usage = "vantage envs";
   command.description =
       "One line per registered environment: its name, observation shape and\n"
-      "action space. Any of them (or mjcf:PATH) is a valid --env.";
+      "action space, then the options it takes (`  :name=default  help`).\n"
+      "Any of them (or mjcf:PATH) is a valid --env, and so is a name with\n"
+      "options: --env=HalfCheetah:ctrl_cost=0.2,max_episode_steps=500.";
   command.example = "vantage envs";
   command.run = RunEnvs;
   return command;

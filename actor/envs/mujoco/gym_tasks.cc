@@ -30,20 +30,14 @@ LocomotionTask HalfCheetahTask() {
   return task;
 }
 
-}  // namespace
-
-absl::StatusOr<std::unique_ptr<Environment>> MakeHalfCheetah() {
-  return Build(HalfCheetahTask(), kHalfCheetahXml);
-}
-
-absl::StatusOr<std::unique_ptr<Environment>> MakeSparseHalfCheetah() {
+LocomotionTask SparseHalfCheetahTask() {
   LocomotionTask task = HalfCheetahTask();
   task.name = "SparseHalfCheetah";
   task.sparse_x_threshold = 5.0;
-  return Build(task, kHalfCheetahXml);
+  return task;
 }
 
-absl::StatusOr<std::unique_ptr<Environment>> MakeEx2SparseHalfCheetah() {
+LocomotionTask Ex2SparseHalfCheetahTask() {
   LocomotionTask task = HalfCheetahTask();
   task.name = "Ex2SparseHalfCheetah";
   task.frame_skip = 1;  // rllab's half_cheetah.xml sets none: dt 0.01 s
@@ -53,10 +47,10 @@ absl::StatusOr<std::unique_ptr<Environment>> MakeEx2SparseHalfCheetah() {
   task.subtree_com = true;  // 8 + 9 + 3 = 20
   task.qpos_normal_noise = 0.01;
   task.qvel_normal_noise = 0.1;
-  return Build(task, kHalfCheetahXml);
+  return task;
 }
 
-absl::StatusOr<std::unique_ptr<Environment>> MakeHopper() {
+LocomotionTask HopperTask() {
   LocomotionTask task;
   task.name = "Hopper";
   task.frame_skip = 4;  // dt 0.008 s
@@ -71,10 +65,10 @@ absl::StatusOr<std::unique_ptr<Environment>> MakeHopper() {
   task.observe_qpos_from = 1;  // 5 + 6 = 11
   task.qvel_clip = 10.0;
   task.reset_noise = 5e-3;
-  return Build(task, kHopperXml);
+  return task;
 }
 
-absl::StatusOr<std::unique_ptr<Environment>> MakeWalker2d() {
+LocomotionTask Walker2dTask() {
   LocomotionTask task;
   task.name = "Walker2d";
   task.frame_skip = 4;  // dt 0.008 s
@@ -89,10 +83,10 @@ absl::StatusOr<std::unique_ptr<Environment>> MakeWalker2d() {
   task.observe_qpos_from = 1;  // 8 + 9 = 17
   task.qvel_clip = 10.0;
   task.reset_noise = 5e-3;
-  return Build(task, kWalker2dXml);
+  return task;
 }
 
-absl::StatusOr<std::unique_ptr<Environment>> MakeAnt() {
+LocomotionTask AntTask() {
   LocomotionTask task;
   task.name = "Ant";
   task.frame_skip = 5;  // dt 0.05 s
@@ -104,7 +98,88 @@ absl::StatusOr<std::unique_ptr<Environment>> MakeAnt() {
   task.observe_qpos_from = 2;  // 13 + 14 = 27
   task.reset_noise = 0.1;
   task.normal_qvel_noise = true;
-  return Build(task, kAntXml);
+  return task;
+}
+
+struct GymTask {
+  const char* name;
+  LocomotionTask (*task)();
+  const char* xml;
+};
+
+const std::vector<GymTask>& GymTasks() {
+  static const auto* tasks = new std::vector<GymTask>{
+      {"Ant", AntTask, kAntXml},
+      {"Ex2SparseHalfCheetah", Ex2SparseHalfCheetahTask, kHalfCheetahXml},
+      {"HalfCheetah", HalfCheetahTask, kHalfCheetahXml},
+      {"Hopper", HopperTask, kHopperXml},
+      {"SparseHalfCheetah", SparseHalfCheetahTask, kHalfCheetahXml},
+      {"Walker2d", Walker2dTask, kWalker2dXml},
+  };
+  return *tasks;
+}
+
+const GymTask* FindGymTask(absl::string_view name) {
+  for (const GymTask& task : GymTasks()) {
+    if (task.name == name) return &task;
+  }
+  return nullptr;
+}
+
+// What --env=TASK:KEY=VALUE may change of a locomotion task.
+std::vector<EnvOption> LocomotionOptions(LocomotionTask& task) {
+  return {
+      {"frame_skip", "physics steps per env step", &task.frame_skip, 1},
+      {"max_episode_steps", "steps before the time limit truncates (0: none)",
+       &task.max_episode_steps, 0},
+      {"forward_weight", "reward per metre per second forward",
+       &task.forward_weight},
+      {"ctrl_cost", "cost per squared action entry", &task.ctrl_cost, 0},
+      {"healthy_reward", "reward per step while healthy", &task.healthy_reward},
+      {"terminate_when_unhealthy",
+       "end the episode when the height or angle rule fails",
+       &task.terminate_when_unhealthy},
+      {"reset_noise", "scale of the noise added to the initial qpos and qvel",
+       &task.reset_noise, 0},
+      {"sparse_x_threshold",
+       "the sparse reward: 1 per step while the forward body is more than "
+       "this far ahead of its start, else 0 (-inf: the dense reward)",
+       &task.sparse_x_threshold},
+      {"sparse_either_way",
+       "the sparse reward pays beyond the threshold either way",
+       &task.sparse_either_way},
+  };
+}
+
+}  // namespace
+
+std::vector<std::string> GymTaskNames() {
+  std::vector<std::string> names;
+  for (const GymTask& task : GymTasks()) names.push_back(task.name);
+  return names;
+}
+
+absl::StatusOr<std::unique_ptr<Environment>> MakeGymTask(const EnvName& name) {
+  const GymTask* entry = FindGymTask(name.task);
+  if (entry == nullptr) {
+    return absl::NotFoundError(
+        absl::StrCat(name.task, " is no Gymnasium locomotion task"));
+  }
+  LocomotionTask task = entry->task();
+  if (absl::Status status =
+          ApplyEnvOptions(name.task, LocomotionOptions(task), name.options);
+      !status.ok()) {
+    return status;
+  }
+  task.name = name.Canonical();
+  return Build(task, entry->xml);
+}
+
+std::vector<EnvOptionInfo> GymTaskOptions(const std::string& name) {
+  const GymTask* entry = FindGymTask(name);
+  if (entry == nullptr) return {};
+  LocomotionTask task = entry->task();
+  return Describe(LocomotionOptions(task));
 }
 
 absl::StatusOr<std::unique_ptr<Environment>> MakeMjcfEnv(

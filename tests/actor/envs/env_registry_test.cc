@@ -312,6 +312,73 @@ TEST(EnvRegistryTest, UnknownNameListsTheRegisteredOnes) {
   EXPECT_THAT(env.status().message(), HasSubstr("mjcf:"));
 }
 
+// A variant is the same task with other options: SparseHalfCheetah is
+// HalfCheetah with the sparse threshold set, step for step, and the spec is
+// named with its options in one spelling.
+TEST(EnvOptionsTest, AVariantIsTheTaskWithOptions) {
+  std::unique_ptr<Environment> alias = Make("SparseHalfCheetah");
+  std::unique_ptr<Environment> optioned =
+      Make("HalfCheetah: sparse_x_threshold=5");
+  ASSERT_NE(alias, nullptr);
+  ASSERT_NE(optioned, nullptr);
+  EXPECT_EQ(optioned->spec().name, "HalfCheetah:sparse_x_threshold=5");
+  StepResult last;
+  EXPECT_EQ(Episode(*alias, 3, 200, &last), Episode(*optioned, 3, 200, &last));
+  std::unique_ptr<Environment> two =
+      Make("Hopper:max_episode_steps=20,ctrl_cost=0.5");
+  ASSERT_NE(two, nullptr);
+  EXPECT_EQ(two->spec().name, "Hopper:ctrl_cost=0.5,max_episode_steps=20");
+  EXPECT_EQ(two->spec().max_episode_steps, 20);
+  // The option changes the task: a dense HalfCheetah pays for speed where
+  // the sparse one pays nothing near the start.
+  std::unique_ptr<Environment> dense = Make("HalfCheetah");
+  std::vector<double> observation(17);
+  ASSERT_TRUE(dense->Reset(1, absl::MakeSpan(observation)).ok());
+  ASSERT_TRUE(optioned->Reset(1, absl::MakeSpan(observation)).ok());
+  const std::vector<double> push(6, 1.0);
+  absl::StatusOr<StepResult> paid =
+      dense->Step(push, absl::MakeSpan(observation));
+  absl::StatusOr<StepResult> silent =
+      optioned->Step(push, absl::MakeSpan(observation));
+  ASSERT_TRUE(paid.ok() && silent.ok());
+  EXPECT_NE(paid->reward, 0.0);
+  EXPECT_EQ(silent->reward, 0.0);
+}
+
+TEST(EnvOptionsTest, BadOptionsAreRefusedByName) {
+  const std::pair<std::string, std::string> cases[] = {
+      {"HalfCheetah:bogus=1",
+       "HalfCheetah has no option 'bogus'; its options: frame_skip,"},
+      {"Hopper:frame_skip=0", "frame_skip=0 is not at least 1"},
+      {"Ant:ctrl_cost=nan", "ctrl_cost=nan is not a finite number"},
+      {"Walker2d:frame_skip=2.5", "frame_skip=2.5 is not an integer"},
+      {"Hopper:ctrl_cost", "'ctrl_cost' is no option"},
+      {"Hopper:ctrl_cost=1,ctrl_cost=2", "ctrl_cost is given twice"},
+      {"MinAtarBreakout:x=1",
+       "MinAtarBreakout has no option 'x'; it takes none"},
+  };
+  for (const auto& [name, message] : cases) {
+    absl::StatusOr<std::unique_ptr<Environment>> env = MakeEnvironment(name);
+    ASSERT_FALSE(env.ok()) << name;
+    EXPECT_TRUE(absl::IsInvalidArgument(env.status())) << env.status();
+    EXPECT_THAT(std::string(env.status().message()), HasSubstr(message))
+        << name;
+  }
+}
+
+TEST(EnvOptionsTest, OptionsAreListedWithTheTasksDefaults) {
+  std::map<std::string, std::string> defaults;
+  for (const EnvOptionInfo& option :
+       EnvironmentOptions("Ex2SparseHalfCheetah")) {
+    defaults[option.name] = option.default_value;
+    EXPECT_FALSE(option.help.empty()) << option.name;
+  }
+  EXPECT_EQ(defaults["frame_skip"], "1");
+  EXPECT_EQ(defaults["max_episode_steps"], "500");
+  EXPECT_EQ(defaults["sparse_either_way"], "true");
+  EXPECT_TRUE(EnvironmentOptions("MinAtarBreakout").empty());
+}
+
 TEST(MujocoGuardTest, MujocoErrorsBecomeStatuses) {
   const absl::Status status = GuardMujoco([] { mju_error("boom"); });
   EXPECT_EQ(status.code(), absl::StatusCode::kInternal);
