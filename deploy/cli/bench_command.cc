@@ -24,7 +24,7 @@
 #include "deploy/cli/command_line.h"
 #include "deploy/cli/run_flags.h"
 #include "deploy/cli/shared_flags.h"
-#include "deploy/run_config.h"
+#include "deploy/run/run_config.h"
 #include "learner/algorithms/algorithm.h"
 
 ABSL_FLAG(int64_t, bench_steps, 2048, "advantages: rollout length T");

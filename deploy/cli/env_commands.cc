@@ -14,9 +14,9 @@
 #include "absl/strings/str_split.h"
 #include "actor/envs/env_registry.h"
 #include "deploy/cli/shared_flags.h"
-#include "deploy/run_config.h"
-#include "deploy/trained_policy.h"
-#include "deploy/video_writer.h"
+#include "deploy/observe/video_writer.h"
+#include "deploy/run/run_config.h"
+#include "deploy/run/trained_policy.h"
 
 ABSL_FLAG(int64_t, episodes, 10, "number of episodes");
 ABSL_FLAG(std::string, checkpoint, "",

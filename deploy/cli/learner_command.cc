@@ -15,8 +15,8 @@
 #include "deploy/cli/shared_flags.h"
 #include "deploy/cli/stop_signal.h"
 #include "deploy/cli/train_command.h"
-#include "deploy/learner_server.h"
-#include "deploy/run_config.h"
+#include "deploy/run/learner_server.h"
+#include "deploy/run/run_config.h"
 #include "learner/service/actor_gateway.h"
 
 ABSL_FLAG(std::string, listen, "127.0.0.1:0",

@@ -5,7 +5,7 @@
 
 namespace vantage {
 
-// `vantage learner`: serves actors over gRPC (deploy/learner_server.h) and
+// `vantage learner`: serves actors over gRPC (deploy/run/learner_server.h) and
 // trains until the run's steps are done or SIGINT/SIGTERM; a line per
 // update on stderr and the RESULT train line at the end. Exit 2 when the
 // run cannot start as asked, 1 when it failed while running (which a

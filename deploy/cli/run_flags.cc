@@ -11,7 +11,7 @@
 #include "absl/strings/str_join.h"
 #include "absl/strings/str_split.h"
 #include "deploy/cli/command_line.h"
-#include "deploy/run_config.h"
+#include "deploy/run/run_config.h"
 #include "learner/algorithms/algorithm_config.h"
 #include "learner/exploration/ex2_config.h"
 

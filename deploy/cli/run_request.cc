@@ -5,8 +5,8 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_join.h"
-#include "deploy/run_config.h"
-#include "deploy/run_directory.h"
+#include "deploy/run/run_config.h"
+#include "deploy/run/run_directory.h"
 #include "learner/algorithms/algorithm_config.h"
 #include "learner/checkpoint_files.h"
 

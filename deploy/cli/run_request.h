@@ -10,9 +10,9 @@
 #include <vector>
 
 #include "absl/status/statusor.h"
-#include "deploy/local_training_config.h"
-#include "deploy/progress_columns.h"
-#include "deploy/run_directory.h"
+#include "deploy/observe/progress_columns.h"
+#include "deploy/run/local_training_config.h"
+#include "deploy/run/run_directory.h"
 #include "proto/run_config.pb.h"
 
 namespace vantage {

@@ -18,10 +18,10 @@
 #include "deploy/cli/security_flags.h"
 #include "deploy/cli/shared_flags.h"
 #include "deploy/cli/stop_signal.h"
-#include "deploy/launcher.h"
-#include "deploy/local_training.h"
-#include "deploy/run_config.h"
-#include "deploy/run_directory.h"
+#include "deploy/run/launcher.h"
+#include "deploy/run/local_training.h"
+#include "deploy/run/run_config.h"
+#include "deploy/run/run_directory.h"
 #include "learner/algorithms/algorithm_config.h"
 
 namespace vantage {
@@ -38,7 +38,7 @@ std::string Duration(double seconds) {
                    : absl::StrCat(s / 60, "m", s % 60, "s");
 }
 
-// One learner and --actors actor processes (deploy/launcher.h).
+// One learner and --actors actor processes (deploy/run/launcher.h).
 int RunDistributed(const ResolvedRun& run) {
   // The children read the files themselves; checked here to fail early.
   absl::StatusOr<SecurityOptions> security = SecurityFromFlags(/*server=*/true);

@@ -7,7 +7,7 @@
 namespace vantage {
 
 // `vantage train`: a whole run on this machine, distributed (a learner and
-// actor processes over loopback gRPC, deploy/launcher.h) or local (one
+// actor processes over loopback gRPC, deploy/run/launcher.h) or local (one
 // process); a progress line while a terminal watches and the RESULT train
 // line at the end.
 Command TrainCommand();

@@ -7,8 +7,8 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_split.h"
-#include "deploy/run_config.h"
-#include "deploy/run_directory.h"
+#include "deploy/run/run_config.h"
+#include "deploy/run/run_directory.h"
 #include "google/protobuf/util/json_util.h"
 #include "google/protobuf/util/message_differencer.h"
 #include "learner/checkpoint_files.h"

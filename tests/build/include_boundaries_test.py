@@ -29,8 +29,8 @@ class ProjectTreeTest(unittest.TestCase):
         self.assertEqual(result.returncode, 0, result.stdout + result.stderr)
 
     def test_the_run_configuration_compiles_without_libtorch(self):
-        for path in ("deploy/run_config.h", "deploy/run_config.cc",
-                     "deploy/progress_columns.h", "deploy/run_directory.h",
+        for path in ("deploy/run/run_config.h", "deploy/run/run_config.cc",
+                     "deploy/observe/progress_columns.h", "deploy/run/run_directory.h",
                      "learner/learner_config.h", "proto/wire_format.h"):
             result = run("--root", REPO, "--explain", path)
             self.assertEqual(result.returncode, 0, result.stderr)

@@ -10,7 +10,7 @@
 #include <cmath>
 #include <cstdio>
 
-#include "deploy/local_training.h"
+#include "deploy/run/local_training.h"
 #include "gtest/gtest.h"
 
 namespace vantage {

@@ -1,4 +1,4 @@
-#include "deploy/local_training.h"
+#include "deploy/run/local_training.h"
 
 #include <ATen/Parallel.h>
 
@@ -10,8 +10,8 @@
 
 #include "absl/strings/str_join.h"
 #include "absl/strings/str_split.h"
-#include "deploy/progress_columns.h"
-#include "deploy/run_directory.h"
+#include "deploy/observe/progress_columns.h"
+#include "deploy/run/run_directory.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
 #include "learner/checkpoint.h"

@@ -1,4 +1,4 @@
-#include "deploy/run_config.h"
+#include "deploy/run/run_config.h"
 
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"

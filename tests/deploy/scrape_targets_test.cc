@@ -1,4 +1,4 @@
-#include "deploy/scrape_targets.h"
+#include "deploy/observe/scrape_targets.h"
 
 #include <unistd.h>
 

@@ -1,4 +1,4 @@
-#include "deploy/video_writer.h"
+#include "deploy/observe/video_writer.h"
 
 #include <filesystem>
 #include <string>

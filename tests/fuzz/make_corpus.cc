@@ -16,7 +16,7 @@
 #include "absl/status/statusor.h"
 #include "absl/strings/str_cat.h"
 #include "common/rollout/segment_queue.h"
-#include "deploy/run_config.h"
+#include "deploy/run/run_config.h"
 #include "learner/checkpoint.h"
 #include "proto/vantage.pb.h"
 #include "proto/wire_format.h"

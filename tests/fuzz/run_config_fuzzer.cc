@@ -10,7 +10,7 @@
 #include <string>
 
 #include "absl/status/statusor.h"
-#include "deploy/run_config.h"
+#include "deploy/run/run_config.h"
 #include "tests/fuzz/fuzz_fixtures.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {

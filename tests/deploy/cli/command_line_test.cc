@@ -15,7 +15,7 @@
 #include "absl/strings/str_split.h"
 #include "absl/strings/strip.h"
 #include "deploy/cli/run_flags.h"
-#include "deploy/run_config.h"
+#include "deploy/run/run_config.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
 #include "learner/algorithms/algorithm.h"

@@ -12,8 +12,8 @@
 
 #include "deploy/cli/run_flags.h"
 #include "deploy/cli/train_command.h"
-#include "deploy/run_config.h"
-#include "deploy/run_directory.h"
+#include "deploy/run/run_config.h"
+#include "deploy/run/run_directory.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
 #include "tests/deploy/cli/run_vantage.h"

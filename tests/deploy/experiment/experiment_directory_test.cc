@@ -7,7 +7,7 @@
 #include "absl/strings/str_cat.h"
 #include "deploy/cli/experiment_command.h"
 #include "deploy/experiment/experiment_grid.h"
-#include "deploy/run_config.h"
+#include "deploy/run/run_config.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
 

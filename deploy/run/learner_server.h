@@ -1,5 +1,5 @@
-#ifndef VANTAGE_DEPLOY_LEARNER_SERVER_H_
-#define VANTAGE_DEPLOY_LEARNER_SERVER_H_
+#ifndef VANTAGE_DEPLOY_RUN_LEARNER_SERVER_H_
+#define VANTAGE_DEPLOY_RUN_LEARNER_SERVER_H_
 
 #include <atomic>
 #include <functional>
@@ -8,7 +8,7 @@
 #include "absl/status/status.h"
 #include "common/env/environment.h"
 #include "common/net/security_options.h"
-#include "deploy/local_training.h"
+#include "deploy/run/local_training.h"
 #include "learner/parallel/gloo_replica_group.h"
 #include "learner/service/actor_gateway.h"
 #include "proto/run_config.pb.h"
@@ -54,4 +54,4 @@ absl::Status RunLearnerServer(
 
 }  // namespace vantage
 
-#endif  // VANTAGE_DEPLOY_LEARNER_SERVER_H_
+#endif  // VANTAGE_DEPLOY_RUN_LEARNER_SERVER_H_

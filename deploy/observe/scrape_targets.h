@@ -1,5 +1,5 @@
-#ifndef VANTAGE_DEPLOY_SCRAPE_TARGETS_H_
-#define VANTAGE_DEPLOY_SCRAPE_TARGETS_H_
+#ifndef VANTAGE_DEPLOY_OBSERVE_SCRAPE_TARGETS_H_
+#define VANTAGE_DEPLOY_OBSERVE_SCRAPE_TARGETS_H_
 
 // A run's Prometheus scrape targets as a file-based service discovery file
 // (a JSON list of {"targets": ["HOST:PORT"], "labels": {...}}), which
@@ -35,4 +35,4 @@ std::string ScrapeAddress(const std::string& host, int port);
 
 }  // namespace vantage
 
-#endif  // VANTAGE_DEPLOY_SCRAPE_TARGETS_H_
+#endif  // VANTAGE_DEPLOY_OBSERVE_SCRAPE_TARGETS_H_

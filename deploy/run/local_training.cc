@@ -1,8 +1,8 @@
-#include "deploy/local_training.h"
+#include "deploy/run/local_training.h"
 
 #include "absl/strings/str_cat.h"
 #include "actor/actor_core.h"
-#include "deploy/training_run.h"
+#include "deploy/run/training_run.h"
 #include "learner/checkpoint.h"
 #include "learner/learner_core.h"
 

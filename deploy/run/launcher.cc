@@ -1,4 +1,4 @@
-#include "deploy/launcher.h"
+#include "deploy/run/launcher.h"
 
 #include <signal.h>
 #include <sys/wait.h>
@@ -21,9 +21,9 @@
 #include "common/net/loopback_port.h"
 #include "common/net/port_file.h"
 #include "common/util/self_process.h"
-#include "deploy/run_config.h"
-#include "deploy/run_directory.h"
-#include "deploy/scrape_targets.h"
+#include "deploy/observe/scrape_targets.h"
+#include "deploy/run/run_config.h"
+#include "deploy/run/run_directory.h"
 #include "learner/algorithms/algorithm_config.h"
 #include "learner/checkpoint_files.h"
 

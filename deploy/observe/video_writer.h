@@ -1,5 +1,5 @@
-#ifndef VANTAGE_DEPLOY_VIDEO_WRITER_H_
-#define VANTAGE_DEPLOY_VIDEO_WRITER_H_
+#ifndef VANTAGE_DEPLOY_OBSERVE_VIDEO_WRITER_H_
+#define VANTAGE_DEPLOY_OBSERVE_VIDEO_WRITER_H_
 
 // Encodes rendered frames into a video file with FFmpeg's libraries: MP4
 // with H.264 (MPEG-4 part 2 if this FFmpeg has no H.264 encoder), or an
@@ -62,4 +62,4 @@ class VideoWriter {
 
 }  // namespace vantage
 
-#endif  // VANTAGE_DEPLOY_VIDEO_WRITER_H_
+#endif  // VANTAGE_DEPLOY_OBSERVE_VIDEO_WRITER_H_

@@ -1,4 +1,4 @@
-#include "deploy/run_recorder.h"
+#include "deploy/run/run_recorder.h"
 
 #include <algorithm>
 

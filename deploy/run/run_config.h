@@ -1,5 +1,5 @@
-#ifndef VANTAGE_DEPLOY_RUN_CONFIG_H_
-#define VANTAGE_DEPLOY_RUN_CONFIG_H_
+#ifndef VANTAGE_DEPLOY_RUN_RUN_CONFIG_H_
+#define VANTAGE_DEPLOY_RUN_RUN_CONFIG_H_
 
 // A training run's settings (proto/run_config.proto): defaults, checks,
 // JSON files, and the component configs they turn into.
@@ -8,7 +8,7 @@
 
 #include "absl/status/statusor.h"
 #include "actor/envs/env_registry.h"
-#include "deploy/local_training_config.h"
+#include "deploy/run/local_training_config.h"
 #include "proto/run_config.pb.h"
 
 namespace vantage {
@@ -41,4 +41,4 @@ EnvOptions EnvOptionsOf(const pb::RunConfig& resolved);
 
 }  // namespace vantage
 
-#endif  // VANTAGE_DEPLOY_RUN_CONFIG_H_
+#endif  // VANTAGE_DEPLOY_RUN_RUN_CONFIG_H_

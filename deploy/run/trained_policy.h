@@ -1,5 +1,5 @@
-#ifndef VANTAGE_DEPLOY_TRAINED_POLICY_H_
-#define VANTAGE_DEPLOY_TRAINED_POLICY_H_
+#ifndef VANTAGE_DEPLOY_RUN_TRAINED_POLICY_H_
+#define VANTAGE_DEPLOY_RUN_TRAINED_POLICY_H_
 
 #include <cstdint>
 #include <memory>
@@ -39,4 +39,4 @@ absl::StatusOr<TrainedPolicy> LoadTrainedPolicy(const std::string& path);
 
 }  // namespace vantage
 
-#endif  // VANTAGE_DEPLOY_TRAINED_POLICY_H_
+#endif  // VANTAGE_DEPLOY_RUN_TRAINED_POLICY_H_

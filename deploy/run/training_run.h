@@ -1,12 +1,12 @@
-#ifndef VANTAGE_DEPLOY_TRAINING_RUN_H_
-#define VANTAGE_DEPLOY_TRAINING_RUN_H_
+#ifndef VANTAGE_DEPLOY_RUN_TRAINING_RUN_H_
+#define VANTAGE_DEPLOY_RUN_TRAINING_RUN_H_
 
 // The life of one training run that local and distributed training share:
 // its run directory created (or opened to resume), its learner created (or
 // loaded from the newest checkpoint that loads), and every update recorded
 // (a progress row, checkpoints). Only where segments come from differs: an
-// in-process actor (deploy/local_training.h) or the gRPC service
-// (deploy/learner_server.h) fills the queue each update consumes.
+// in-process actor (deploy/run/local_training.h) or the gRPC service
+// (deploy/run/learner_server.h) fills the queue each update consumes.
 
 #include <functional>
 #include <memory>
@@ -14,8 +14,8 @@
 
 #include "absl/status/statusor.h"
 #include "common/rollout/segment_queue.h"
-#include "deploy/local_training.h"
-#include "deploy/run_recorder.h"
+#include "deploy/run/local_training.h"
+#include "deploy/run/run_recorder.h"
 #include "learner/checkpoint.h"
 #include "learner/learner_core.h"
 
@@ -63,4 +63,4 @@ class TrainingRun {
 
 }  // namespace vantage
 
-#endif  // VANTAGE_DEPLOY_TRAINING_RUN_H_
+#endif  // VANTAGE_DEPLOY_RUN_TRAINING_RUN_H_

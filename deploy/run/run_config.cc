@@ -1,4 +1,4 @@
-#include "deploy/run_config.h"
+#include "deploy/run/run_config.h"
 
 #include <google/protobuf/util/json_util.h>
 #include <google/protobuf/util/message_differencer.h>

@@ -1,4 +1,4 @@
-#include "deploy/progress_columns.h"
+#include "deploy/observe/progress_columns.h"
 
 #include <cmath>
 #include <cstdint>

@@ -1,5 +1,5 @@
-#ifndef VANTAGE_DEPLOY_LAUNCHER_H_
-#define VANTAGE_DEPLOY_LAUNCHER_H_
+#ifndef VANTAGE_DEPLOY_RUN_LAUNCHER_H_
+#define VANTAGE_DEPLOY_RUN_LAUNCHER_H_
 
 // The main job on one machine: learner processes and N actor processes of
 // this same binary over loopback gRPC, supervised.
@@ -60,4 +60,4 @@ absl::Status RunDistributedTraining(const LaunchConfig& config,
 
 }  // namespace vantage
 
-#endif  // VANTAGE_DEPLOY_LAUNCHER_H_
+#endif  // VANTAGE_DEPLOY_RUN_LAUNCHER_H_

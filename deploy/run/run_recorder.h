@@ -1,5 +1,5 @@
-#ifndef VANTAGE_DEPLOY_RUN_RECORDER_H_
-#define VANTAGE_DEPLOY_RUN_RECORDER_H_
+#ifndef VANTAGE_DEPLOY_RUN_RUN_RECORDER_H_
+#define VANTAGE_DEPLOY_RUN_RUN_RECORDER_H_
 
 #include <chrono>
 #include <cstdint>
@@ -8,7 +8,7 @@
 
 #include "absl/functional/function_ref.h"
 #include "absl/status/statusor.h"
-#include "deploy/run_directory.h"
+#include "deploy/run/run_directory.h"
 #include "learner/checkpoint.h"
 #include "learner/learner_core.h"
 
@@ -63,4 +63,4 @@ class RunRecorder {
 
 }  // namespace vantage
 
-#endif  // VANTAGE_DEPLOY_RUN_RECORDER_H_
+#endif  // VANTAGE_DEPLOY_RUN_RUN_RECORDER_H_

@@ -1,4 +1,4 @@
-#include "deploy/trained_policy.h"
+#include "deploy/run/trained_policy.h"
 
 #include <ATen/ATen.h>
 #include <ATen/CPUGeneratorImpl.h>
@@ -11,8 +11,8 @@
 #include "common/nn/networks.h"
 #include "common/nn/policy_weights.h"
 #include "common/nn/running_mean_std.h"
-#include "deploy/local_training.h"
-#include "deploy/run_config.h"
+#include "deploy/run/local_training.h"
+#include "deploy/run/run_config.h"
 #include "learner/checkpoint.h"
 
 namespace vantage {

@@ -1,4 +1,4 @@
-#include "deploy/run_directory.h"
+#include "deploy/run/run_directory.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,12 +1,12 @@
-#ifndef VANTAGE_DEPLOY_LOCAL_TRAINING_H_
-#define VANTAGE_DEPLOY_LOCAL_TRAINING_H_
+#ifndef VANTAGE_DEPLOY_RUN_LOCAL_TRAINING_H_
+#define VANTAGE_DEPLOY_RUN_LOCAL_TRAINING_H_
 
 #include <atomic>
 #include <functional>
 
 #include "absl/status/status.h"
-#include "deploy/local_training_config.h"
-#include "deploy/progress_columns.h"
+#include "deploy/observe/progress_columns.h"
+#include "deploy/run/local_training_config.h"
 
 namespace vantage {
 
@@ -25,4 +25,4 @@ absl::Status RunLocalTraining(
 
 }  // namespace vantage
 
-#endif  // VANTAGE_DEPLOY_LOCAL_TRAINING_H_
+#endif  // VANTAGE_DEPLOY_RUN_LOCAL_TRAINING_H_

@@ -1,11 +1,11 @@
-#include "deploy/training_run.h"
+#include "deploy/run/training_run.h"
 
 #include <cstdio>
 #include <optional>
 #include <utility>
 
-#include "deploy/run_directory.h"
-#include "deploy/run_resume.h"
+#include "deploy/run/run_directory.h"
+#include "deploy/run/run_resume.h"
 
 namespace vantage {
 

@@ -1,7 +1,7 @@
-#ifndef VANTAGE_DEPLOY_LOCAL_TRAINING_CONFIG_H_
-#define VANTAGE_DEPLOY_LOCAL_TRAINING_CONFIG_H_
+#ifndef VANTAGE_DEPLOY_RUN_LOCAL_TRAINING_CONFIG_H_
+#define VANTAGE_DEPLOY_RUN_LOCAL_TRAINING_CONFIG_H_
 
-// A run of the learning code in this process (deploy/local_training.h) and
+// A run of the learning code in this process (deploy/run/local_training.h) and
 // of each learner process, as the run configuration resolves it; without
 // the actor and learner cores, so that what only reads or checks settings
 // compiles without LibTorch.
@@ -26,7 +26,7 @@ struct LocalTrainingConfig {
   // same segments as a distributed run's make the two runs' progress equal.
   int64_t segment_length = 0;
 
-  // Optional run directory (see deploy/run_directory.h): config.json with
+  // Optional run directory (see deploy/run/run_directory.h): config.json with
   // `config_json`, progress.csv, and a checkpoint every `checkpoint_every`
   // updates and at the end, keeping the newest `keep_checkpoints`.
   std::string run_dir;
@@ -48,4 +48,4 @@ LearnerConfig MakeLearnerConfig(const LocalTrainingConfig& config,
 
 }  // namespace vantage
 
-#endif  // VANTAGE_DEPLOY_LOCAL_TRAINING_CONFIG_H_
+#endif  // VANTAGE_DEPLOY_RUN_LOCAL_TRAINING_CONFIG_H_

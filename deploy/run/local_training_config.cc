@@ -1,4 +1,4 @@
-#include "deploy/local_training_config.h"
+#include "deploy/run/local_training_config.h"
 
 namespace vantage {
 
