@@ -14,6 +14,7 @@
 #include "actor/actor_core.h"
 #include "actor/envs/env_registry.h"
 #include "actor/remote/actor_metrics.h"
+#include "actor/run_settings.h"
 #include "common/net/grpc_security.h"
 #include "common/net/port_file.h"
 #include "common/util/phase_times.h"
@@ -178,9 +179,7 @@ class Session {
     actor_config.env = config_.env;
     // The learner's run config says how it wraps the environment; the
     // registration carried the environment's own spec.
-    if (run.training().has_frame_stack()) {
-      actor_config.env_options.frame_stack = run.training().frame_stack();
-    }
+    actor_config.env_options = EnvOptionsOf(run);
     actor_config.num_envs = config_.num_envs;
     actor_config.segment_length = run.training().segment_length();
     actor_config.seed =
@@ -188,16 +187,12 @@ class Session {
             ? *config_.seed
             : ActorEnvSeed(run.training().seed(), response.actor_id());
     actor_config.actor_id = response.actor_id();
-    actor_config.network.hidden.assign(run.training().hidden().begin(),
-                                       run.training().hidden().end());
-    // A learner from before torsos existed built MLPs.
-    absl::StatusOr<Torso> torso =
-        ParseTorso(run.training().has_torso() ? run.training().torso() : "mlp");
-    if (!torso.ok()) {
-      return absl::InvalidArgumentError(
-          absl::StrCat("the learner's run config: ", torso.status().message()));
+    absl::StatusOr<NetworkConfig> network = PolicyNetworkOf(run);
+    if (!network.ok()) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          "the learner's run config: ", network.status().message()));
     }
-    actor_config.network.torso = *torso;
+    actor_config.network = *network;
     return ActorCore::Create(actor_config);
   }
 

@@ -383,15 +383,6 @@ std::string RunConfigToJson(const pb::RunConfig& config) {
   return json;
 }
 
-EnvOptions EnvOptionsOf(const pb::RunConfig& resolved) {
-  EnvOptions options;
-  // Configs from before frame stacking existed have none.
-  if (resolved.training().has_frame_stack()) {
-    options.frame_stack = resolved.training().frame_stack();
-  }
-  return options;
-}
-
 LocalTrainingConfig ToLocalTrainingConfig(const pb::RunConfig& c) {
   const pb::TrainingSettings& t = c.training();
   LocalTrainingConfig local;
@@ -407,9 +398,8 @@ LocalTrainingConfig ToLocalTrainingConfig(const pb::RunConfig& c) {
   learner.horizon = t.horizon();
   learner.max_policy_lag = c.distributed().max_policy_lag();
   learner.scale_rewards = t.scale_rewards();
-  learner.network.hidden.assign(t.hidden().begin(), t.hidden().end());
-  learner.network.torso = ParseTorso(t.torso()).value_or(Torso::kAuto);
-  learner.network.shared_torso = t.shared_torso();
+  // A resolved config's torso is one ResolveRunConfig checked.
+  learner.network = PolicyNetworkOf(c).value_or(NetworkConfig());
   const pb::AdvantageSettings& a = c.advantage();
   AdvantageConfig& advantage = learner.advantage;
   if (absl::StatusOr<Statistic> statistic = ParseStatistic(a.estimator());

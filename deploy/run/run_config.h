@@ -8,6 +8,7 @@
 
 #include "absl/status/statusor.h"
 #include "actor/envs/env_registry.h"
+#include "actor/run_settings.h"  // EnvOptionsOf, for the run's env makers
 #include "deploy/run/local_training_config.h"
 #include "proto/run_config.pb.h"
 
@@ -36,8 +37,6 @@ std::string RunConfigDifference(const pb::RunConfig& held,
 
 // The local training a resolved config describes.
 LocalTrainingConfig ToLocalTrainingConfig(const pb::RunConfig& resolved);
-// How the run wraps its environments (every maker of its env uses this).
-EnvOptions EnvOptionsOf(const pb::RunConfig& resolved);
 
 }  // namespace vantage
 

@@ -1,0 +1,27 @@
+#ifndef VANTAGE_ACTOR_RUN_SETTINGS_H_
+#define VANTAGE_ACTOR_RUN_SETTINGS_H_
+
+// What an actor takes from a run's configuration: how its environments are
+// wrapped and the policy network it runs. One reading for a local run and
+// for an actor given the learner's run config at registration, so that the
+// rules (frame stacking, configs from before a setting existed) live once.
+
+#include "absl/status/statusor.h"
+#include "actor/envs/env_registry.h"
+#include "common/nn/network_config.h"
+#include "proto/run_config.pb.h"
+
+namespace vantage {
+
+// The run's environment wrapping (a config from before frame stacking
+// existed stacks none).
+EnvOptions EnvOptionsOf(const pb::RunConfig& run);
+
+// The policy network the run's actors run: its hidden sizes and torso (a
+// config from before torsos existed built MLPs); an unknown torso is
+// InvalidArgument naming it.
+absl::StatusOr<NetworkConfig> PolicyNetworkOf(const pb::RunConfig& run);
+
+}  // namespace vantage
+
+#endif  // VANTAGE_ACTOR_RUN_SETTINGS_H_
