@@ -65,10 +65,10 @@ LearnerMetrics::LearnerMetrics()
           "async runs).")),
       registrations_(metrics_.AddCounter("registrations_total",
                                          "Actor registrations granted.")),
-      expirations_(
-          metrics_.AddCounter("registration_expirations_total",
-                              "Registrations expired after their actor left, never "
-                              "claimed, or evicted to make room.")),
+      expirations_(metrics_.AddCounter(
+          "registration_expirations_total",
+          "Registrations expired after their actor left, never "
+          "claimed, or evicted to make room.")),
       rolled_back_updates_(metrics_.AddCounter(
           "rolled_back_updates_total",
           "Updates undone because they produced non-finite numbers.")),
