@@ -217,6 +217,20 @@ bool ActorGateway::MakeRoom(int64_t num_envs) {
            counters_.live_env_slots + num_envs >
                config_.limits.max_live_env_slots;
   };
+  // Nothing is evicted for a registration that would not fit even then.
+  int64_t idle_actors = 0;
+  int64_t idle_slots = 0;
+  for (const auto& [actor_id, registration] : actors_) {
+    if (registration.open_calls > 0) continue;
+    ++idle_actors;
+    idle_slots += registration.num_envs;
+  }
+  if (static_cast<int64_t>(actors_.size()) - idle_actors >=
+          config_.limits.max_live_actors ||
+      counters_.live_env_slots - idle_slots + num_envs >
+          config_.limits.max_live_env_slots) {
+    return false;
+  }
   while (full()) {
     // The registration longest without an open call: an actor that left,
     // or one that registered and never came back.

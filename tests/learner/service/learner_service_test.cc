@@ -646,6 +646,7 @@ TEST_F(LearnerServiceTest, OneHostHoldsFewRegistrationsThatOpenedNoCall) {
 TEST_F(LearnerServiceTest, AFullTableMakesRoomFromTheLongestIdle) {
   GatewayConfig config = DefaultConfig();
   config.limits.max_live_actors = 3;
+  config.limits.max_live_env_slots = 8;
   Start(config);
   gateway_->Publish(MakeWeights(0));
   absl::StatusOr<pb::RegisterResponse> connected = RegisterFrom(*gateway_, "a");
@@ -671,6 +672,14 @@ TEST_F(LearnerServiceTest, AFullTableMakesRoomFromTheLongestIdle) {
               ::testing::ElementsAre(left->actor_id(), silent->actor_id()));
   EXPECT_TRUE(gateway_->ExpireIdle(absl::Now()).empty());
   EXPECT_EQ(gateway_->counters().expirations, 2);
+  // A registration that would not fit even with every idle one gone
+  // evicts none of them.
+  pb::RegisterRequest too_many = Request(PendulumSpec());
+  too_many.set_num_envs(5);  // 6 live slots, 2 of them idle: 9 > 8
+  EXPECT_TRUE(absl::IsResourceExhausted(
+      gateway_->Register(too_many, "e", absl::Seconds(5)).status()));
+  EXPECT_TRUE(gateway_->ExpireIdle(absl::Now()).empty());
+  EXPECT_EQ(gateway_->counters().live_actors, 3);
   // With every registration connected, there is no room to make.
   ASSERT_TRUE(gateway_->Attach(fourth->session()).ok());
   absl::StatusOr<pb::RegisterResponse> refused = RegisterFrom(*gateway_, "e");
