@@ -12,6 +12,7 @@
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
 #include "absl/strings/string_view.h"
+#include "actor/actor_config.h"
 #include "actor/vector_env.h"
 #include "common/nn/mlp_policy_kernel.h"
 #include "common/nn/networks.h"
@@ -20,19 +21,6 @@
 #include "common/rollout/segment_queue.h"
 
 namespace vantage {
-
-struct ActorConfig {
-  std::string env;
-  EnvOptions env_options;
-  int num_envs = 1;
-  int64_t segment_length = 128;
-  uint64_t seed = 0;
-  int64_t actor_id = 0;
-  NetworkConfig network;
-  double observation_clip = 10.0;
-
-  absl::Status Validate() const;
-};
 
 // Runs the policy only: vectorised environments, batched inference with the
 // latest weights (the learner recomputes values itself), segments out.

@@ -22,4 +22,20 @@ absl::StatusOr<NetworkConfig> PolicyNetworkOf(const pb::RunConfig& run) {
   return network;
 }
 
+absl::StatusOr<ActorConfig> ActorConfigOf(const pb::RunConfig& run) {
+  const pb::TrainingSettings& training = run.training();
+  ActorConfig actor;
+  actor.env = training.env();
+  actor.env_options = EnvOptionsOf(run);
+  if (training.has_envs()) actor.num_envs = training.envs();
+  if (training.has_segment_length()) {
+    actor.segment_length = training.segment_length();
+  }
+  actor.seed = training.seed();
+  absl::StatusOr<NetworkConfig> network = PolicyNetworkOf(run);
+  if (!network.ok()) return network.status();
+  actor.network = *std::move(network);
+  return actor;
+}
+
 }  // namespace vantage

@@ -1,12 +1,14 @@
 #ifndef VANTAGE_ACTOR_RUN_SETTINGS_H_
 #define VANTAGE_ACTOR_RUN_SETTINGS_H_
 
-// What an actor takes from a run's configuration: how its environments are
-// wrapped and the policy network it runs. One reading for a local run and
-// for an actor given the learner's run config at registration, so that the
-// rules (frame stacking, configs from before a setting existed) live once.
+// What an actor takes from a run's configuration: its environments, how
+// they are wrapped, its segments and the policy network it runs. One
+// reading for a local run's plan and for an actor given the learner's run
+// config at registration, so that the rules (frame stacking, configs from
+// before a setting existed) live once.
 
 #include "absl/status/statusor.h"
+#include "actor/actor_config.h"
 #include "actor/envs/env_registry.h"
 #include "common/nn/network_config.h"
 #include "proto/run_config.pb.h"
@@ -21,6 +23,11 @@ EnvOptions EnvOptionsOf(const pb::RunConfig& run);
 // config from before torsos existed built MLPs); an unknown torso is
 // InvalidArgument naming it.
 absl::StatusOr<NetworkConfig> PolicyNetworkOf(const pb::RunConfig& run);
+
+// The actor of a resolved run config: the run's env, wrapping, env streams
+// (training.envs), segment length, seed and policy network. A remote actor
+// keeps its own env name, env count and seed (see ActorEnvSeed).
+absl::StatusOr<ActorConfig> ActorConfigOf(const pb::RunConfig& run);
 
 }  // namespace vantage
 

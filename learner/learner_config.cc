@@ -14,11 +14,15 @@ absl::Status LearnerConfig::Validate() const {
   if (absl::Status status = CheckNetworkConfig(network, spec); !status.ok()) {
     return status;
   }
+  return ValidateSettings();
+}
+
+absl::Status LearnerConfig::ValidateSettings() const {
   if (network.shared_torso && !AlgorithmStepsBothNetworksAtOnce(algorithm)) {
-    return absl::InvalidArgumentError(absl::StrCat(
-        "a shared torso needs an algorithm that steps the policy and the "
-        "value network with one optimiser (a2c, ppo); ",
-        algorithm.name, " fits its value network on its own"));
+    return absl::InvalidArgumentError(
+        absl::StrCat("--shared_torso needs ppo or a2c, which step both "
+                     "networks with one optimiser; ",
+                     algorithm.name, " fits its value network alone"));
   }
   if (horizon < 1 || rollouts_per_batch < 1 || total_env_steps < 1) {
     return absl::InvalidArgumentError(

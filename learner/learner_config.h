@@ -49,7 +49,11 @@ struct LearnerConfig {
   // A bonus added to the rewards before advantages (none by default).
   ExplorationConfig exploration;
 
+  // Everything, the spec and the network's fit to it included.
   absl::Status Validate() const;
+  // Every rule that holds without the env's spec (what a run config
+  // decides before any environment exists).
+  absl::Status ValidateSettings() const;
 };
 
 }  // namespace vantage

@@ -175,25 +175,22 @@ class Session {
   absl::StatusOr<std::unique_ptr<ActorCore>> CreateActor(
       const pb::RegisterResponse& response) const {
     const pb::RunConfig& run = response.run_config();
-    ActorConfig actor_config;
-    actor_config.env = config_.env;
-    // The learner's run config says how it wraps the environment; the
-    // registration carried the environment's own spec.
-    actor_config.env_options = EnvOptionsOf(run);
-    actor_config.num_envs = config_.num_envs;
-    actor_config.segment_length = run.training().segment_length();
-    actor_config.seed =
+    // The learner's run config says how it wraps the environment, cuts
+    // segments and acts; the registration carried the environment's own
+    // spec, and this actor's env streams are its own.
+    absl::StatusOr<ActorConfig> actor_config = ActorConfigOf(run);
+    if (!actor_config.ok()) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          "the learner's run config: ", actor_config.status().message()));
+    }
+    actor_config->env = config_.env;
+    actor_config->num_envs = config_.num_envs;
+    actor_config->seed =
         config_.seed.has_value()
             ? *config_.seed
             : ActorEnvSeed(run.training().seed(), response.actor_id());
-    actor_config.actor_id = response.actor_id();
-    absl::StatusOr<NetworkConfig> network = PolicyNetworkOf(run);
-    if (!network.ok()) {
-      return absl::InvalidArgumentError(absl::StrCat(
-          "the learner's run config: ", network.status().message()));
-    }
-    actor_config.network = *network;
-    return ActorCore::Create(actor_config);
+    actor_config->actor_id = response.actor_id();
+    return ActorCore::Create(*actor_config);
   }
 
   // The session's weights subscription and segment stream around Act.

@@ -122,8 +122,8 @@ int RunTrainBench() {
     bench.shape.minibatches = config.ppo().minibatches();
     bench.a2c = algorithm == "a2c";
     bench.spec = (*env)->spec();
-    bench.network = run->local.learner.network;
-    bench.a2c_config = run->local.learner.algorithm.a2c;
+    bench.network = run->plan.learner.network;
+    bench.a2c_config = run->plan.learner.algorithm.a2c;
     bench.streams = config.training().envs();
   }
   const int code = RunTrainBenchmark(bench);

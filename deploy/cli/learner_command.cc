@@ -92,7 +92,8 @@ int RunLearner(const std::vector<std::string>&) {
   absl::StatusOr<std::unique_ptr<Environment>> env = MakeEnvironment(
       resolved->config.training().env(), EnvOptionsOf(resolved->config));
   if (!env.ok()) return Fail(kUsageError, env.status().message());
-  server.training = resolved->local;
+  server.learner = resolved->plan.learner;
+  server.recording = resolved->plan.recording;
   server.run_config = resolved->config;
   server.spec = (*env)->spec();
   server.listen = absl::GetFlag(FLAGS_listen);
@@ -129,7 +130,7 @@ int RunLearner(const std::vector<std::string>&) {
       });
   if (!status.ok()) return Fail(kRuntimeError, status.message());
   if (!primary) return 0;
-  if (!updated && resolved->local.resume && !StopRequested()) {
+  if (!updated && resolved->plan.recording.resume && !StopRequested()) {
     PrintFinishedAlready(*resolved);
     return 0;
   }

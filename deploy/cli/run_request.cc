@@ -90,7 +90,7 @@ absl::Status ApplyResumeIfExists(const RunRequest& request, ResolvedRun& run) {
   if (ListCheckpoints(existing->checkpoint_directory()).empty()) {
     run.start_over = true;
   } else {
-    run.local.resume = true;
+    run.plan.recording.resume = true;
   }
   return absl::OkStatus();
 }
@@ -119,12 +119,14 @@ absl::StatusOr<ResolvedRun> ResolveRunRequest(const RunRequest& request) {
   }
   absl::StatusOr<pb::RunConfig> config = ResolveRunConfig(given);
   if (!config.ok()) return config.status();
+  absl::StatusOr<RunPlan> plan = PlanRun(*config);
+  if (!plan.ok()) return plan.status();
   ResolvedRun run;
   run.config = *config;
-  run.local = ToLocalTrainingConfig(*config);
-  run.local.config_json = RunConfigToJson(*config);
-  run.local.run_dir = request.resume.empty() ? request.run_dir : request.resume;
-  run.local.resume = !request.resume.empty();
+  run.plan = *std::move(plan);
+  run.plan.recording.run_dir =
+      request.resume.empty() ? request.run_dir : request.resume;
+  run.plan.recording.resume = !request.resume.empty();
   if (request.resume_if_exists) {
     if (absl::Status status = ApplyResumeIfExists(request, run); !status.ok()) {
       return status;
@@ -145,7 +147,7 @@ void PrintTrainResult(const pb::RunConfig& config, const ProgressRow& last) {
 
 void PrintFinishedAlready(const ResolvedRun& run) {
   std::printf("%s is finished already (%ld steps); nothing to do\n",
-              run.local.run_dir.c_str(),
+              run.plan.recording.run_dir.c_str(),
               static_cast<long>(run.config.training().steps()));
 }
 

@@ -11,8 +11,8 @@
 
 #include "absl/status/statusor.h"
 #include "deploy/observe/progress_columns.h"
-#include "deploy/run/local_training_config.h"
 #include "deploy/run/run_directory.h"
+#include "deploy/run/run_plan.h"
 #include "proto/run_config.pb.h"
 
 namespace vantage {
@@ -41,7 +41,7 @@ struct RunRequest {
 
 struct ResolvedRun {
   pb::RunConfig config;  // every field set
-  LocalTrainingConfig local;
+  RunPlan plan;          // of `config`, with the request's run directory
   // --resume_if_exists found this run in its directory before its first
   // checkpoint: the directory is cleared and the run starts over.
   bool start_over = false;

@@ -44,14 +44,14 @@ int RunDistributed(const ResolvedRun& run) {
   absl::StatusOr<SecurityOptions> security = SecurityFromFlags(/*server=*/true);
   if (!security.ok()) return Fail(kUsageError, security.status().message());
   LaunchConfig launch;
-  launch.resume = run.local.resume;
+  launch.resume = run.plan.recording.resume;
   launch.run_config = run.config;
-  launch.run_dir = run.local.run_dir;
+  launch.run_dir = run.plan.recording.run_dir;
   launch.work_dir =
-      run.local.run_dir.empty()
+      run.plan.recording.run_dir.empty()
           ? absl::StrCat(std::filesystem::temp_directory_path().string(),
                          "/vantage-launch-", ::getpid())
-          : run.local.run_dir + "/launch";
+          : run.plan.recording.run_dir + "/launch";
   launch.auth_token_file = AuthTokenFileFlag();
   launch.tls_cert = security->tls_cert_file;
   launch.tls_key = security->tls_key_file;
@@ -61,18 +61,18 @@ int RunDistributed(const ResolvedRun& run) {
   std::printf(
       "%s %s with %s, estimator %s (rho %g), %ld steps, seed %lu: "
       "1 learner + %d actors x %d envs over gRPC%s%s\n",
-      run.local.resume ? "resuming" : "training",
+      run.plan.recording.resume ? "resuming" : "training",
       run.config.training().env().c_str(), AlgorithmNameOf(run.config).c_str(),
       run.config.advantage().estimator().c_str(), run.config.advantage().rho(),
       static_cast<long>(run.config.training().steps()),
       static_cast<unsigned long>(run.config.training().seed()),
       run.config.distributed().actors(),
       run.config.distributed().envs_per_actor(),
-      run.local.run_dir.empty() ? "" : ", run directory ",
-      run.local.run_dir.c_str());
+      run.plan.recording.run_dir.empty() ? "" : ", run directory ",
+      run.plan.recording.run_dir.c_str());
   std::fflush(stdout);
   const absl::Status status = RunDistributedTraining(launch, StopRequested());
-  if (run.local.run_dir.empty()) {
+  if (run.plan.recording.run_dir.empty()) {
     std::error_code error;
     std::filesystem::remove_all(launch.work_dir, error);
   }
@@ -82,18 +82,19 @@ int RunDistributed(const ResolvedRun& run) {
 
 int RunLocal(const ResolvedRun& run) {
   const pb::RunConfig& config = run.config;
-  const LocalTrainingConfig& local = run.local;
+  const RecordingConfig& recording = run.plan.recording;
   SetComputeThreads(1);
   std::printf(
       "%s %s with %s, estimator %s (rho %g, ensemble %s), %ld steps, seed "
       "%lu%s%s\n",
-      local.resume ? "resuming" : "training", config.training().env().c_str(),
-      AlgorithmNameOf(config).c_str(), config.advantage().estimator().c_str(),
-      config.advantage().rho(),
+      recording.resume ? "resuming" : "training",
+      config.training().env().c_str(), AlgorithmNameOf(config).c_str(),
+      config.advantage().estimator().c_str(), config.advantage().rho(),
       absl::StrJoin(config.advantage().ensemble(), ",").c_str(),
       static_cast<long>(config.training().steps()),
       static_cast<unsigned long>(config.training().seed()),
-      local.run_dir.empty() ? "" : ", run directory ", local.run_dir.c_str());
+      recording.run_dir.empty() ? "" : ", run directory ",
+      recording.run_dir.c_str());
   std::fflush(stdout);
   const bool terminal = ::isatty(STDOUT_FILENO) == 1;
   ProgressRow last;
@@ -101,7 +102,7 @@ int RunLocal(const ResolvedRun& run) {
   bool updated = false;
   const std::atomic<bool>& stop = StopRequested();
   const absl::Status status = RunLocalTraining(
-      local,
+      run.plan,
       [&](const ProgressRow& progress) {
         last = progress;
         updated = true;
@@ -129,11 +130,11 @@ int RunLocal(const ResolvedRun& run) {
                                config.training().steps(), " steps")
                 : "before its first update in this process";
     std::printf("stopped %s%s%s\n", where.c_str(),
-                local.run_dir.empty() ? "" : "; continue with --resume=",
-                local.run_dir.c_str());
+                recording.run_dir.empty() ? "" : "; continue with --resume=",
+                recording.run_dir.c_str());
     return 0;
   }
-  if (!updated && local.resume) {
+  if (!updated && recording.resume) {
     PrintFinishedAlready(run);
     return 0;
   }
@@ -184,14 +185,15 @@ absl::Status CheckRunCanStart(const ResolvedRun& run) {
   // Before the run directory exists: networks that cannot be built for the
   // environment's observations would leave an empty run behind.
   if (absl::Status status =
-          CheckNetworkConfig(run.local.learner.network, (*env)->spec());
+          CheckNetworkConfig(run.plan.learner.network, (*env)->spec());
       !status.ok()) {
     return status;
   }
-  if (run.local.run_dir.empty()) return absl::OkStatus();
-  if (run.local.resume) return RunDirectory::Open(run.local.run_dir).status();
+  if (run.plan.recording.run_dir.empty()) return absl::OkStatus();
+  if (run.plan.recording.resume)
+    return RunDirectory::Open(run.plan.recording.run_dir).status();
   if (run.start_over) return absl::OkStatus();
-  return RunDirectory::CheckFree(run.local.run_dir);
+  return RunDirectory::CheckFree(run.plan.recording.run_dir);
 }
 
 absl::Status PrepareRunDirectory(const ResolvedRun& run) {
@@ -199,8 +201,8 @@ absl::Status PrepareRunDirectory(const ResolvedRun& run) {
   std::fprintf(stderr,
                "vantage: %s holds this run without a checkpoint; starting it "
                "over\n",
-               run.local.run_dir.c_str());
-  return RunDirectory::Clear(run.local.run_dir);
+               run.plan.recording.run_dir.c_str());
+  return RunDirectory::Clear(run.plan.recording.run_dir);
 }
 
 Command TrainCommand() {

@@ -124,11 +124,11 @@ class LearnerProcess {
                  const std::atomic<bool>& stop)
       : config_(config),
         stop_(stop),
-        own_streams_(config.training.num_envs /
+        recording_(config.recording),
+        own_streams_(config.learner.rollouts_per_batch /
                      std::max(1, config.replicas.world_size)),
         times_({"advantages", "optimisation", "bookkeeping", "publish"}) {
-    training_ = config.training;
-    training_.record = config.replicas.rank == 0;
+    recording_.record = config.replicas.rank == 0;
   }
 
   // Checks the configuration, joins the other replicas and opens the run
@@ -167,7 +167,8 @@ class LearnerProcess {
 
   const LearnerServerConfig& config_;
   const std::atomic<bool>& stop_;
-  LocalTrainingConfig training_;
+  // Only rank 0 writes the run directory.
+  RecordingConfig recording_;
   // This replica's share of the batch.
   const int64_t own_streams_;
   std::shared_ptr<ReplicaGroup> replicas_;
@@ -189,10 +190,9 @@ class LearnerProcess {
 };
 
 LearnerConfig LearnerProcess::LearnerConfigFor(const EnvSpec& spec) const {
-  LearnerConfig learner_config = MakeLearnerConfig(training_, spec);
+  LearnerConfig learner_config = config_.learner;
+  learner_config.spec = spec;
   learner_config.rollouts_per_batch = own_streams_;
-  learner_config.max_segment_steps =
-      config_.run_config.training().segment_length();
   learner_config.value_limits = config_.limits.values;
   return learner_config;
 }
@@ -213,9 +213,9 @@ absl::Status LearnerProcess::RestoreServerState(
 
 absl::Status LearnerProcess::Open() {
   const int world_size = config_.replicas.world_size;
-  if (world_size < 1 || config_.training.num_envs % world_size != 0) {
+  if (world_size < 1 || config_.learner.rollouts_per_batch % world_size != 0) {
     return absl::InvalidArgumentError(absl::StrCat(
-        "the batch of ", config_.training.num_envs,
+        "the batch of ", config_.learner.rollouts_per_batch,
         " env streams does not split over ", world_size, " learners"));
   }
   if (absl::Status status = config_.limits.Validate(); !status.ok()) {
@@ -231,18 +231,18 @@ absl::Status LearnerProcess::Open() {
                  config_.replicas.rendezvous.c_str());
   }
   absl::StatusOr<std::unique_ptr<TrainingRun>> run = TrainingRun::Open(
-      training_, LearnerConfigFor(config_.spec),
+      recording_, LearnerConfigFor(config_.spec),
       [this](const std::string& path, const CheckpointExtras& extras) {
         return RestoreServerState(path, extras);
       },
       replicas_);
   if (!run.ok()) return run.status();
   run_ = *std::move(run);
-  if (training_.resume) {
+  if (recording_.resume) {
     std::fprintf(stderr,
                  "learner: resuming %s from policy version %ld (%ld env "
                  "steps)\n",
-                 training_.run_dir.c_str(),
+                 recording_.run_dir.c_str(),
                  static_cast<long>(run_->learner().policy_version()),
                  static_cast<long>(run_->learner().env_steps()));
   }
@@ -258,7 +258,7 @@ absl::Status LearnerProcess::Serve() {
   // their streams instead of growing memory.
   const int64_t batch_segments =
       own_streams_ *
-      (training_.learner.horizon / std::max<int64_t>(1, segment_length));
+      (config_.learner.horizon / std::max<int64_t>(1, segment_length));
   queue_ = std::make_unique<SegmentQueue>(
       static_cast<size_t>(std::max<int64_t>(8, 2 * batch_segments)));
   GatewayConfig gateway_config;

@@ -8,7 +8,9 @@
 #include "absl/status/status.h"
 #include "common/env/environment.h"
 #include "common/net/security_options.h"
-#include "deploy/run/local_training.h"
+#include "deploy/observe/progress_columns.h"
+#include "deploy/run/recording_config.h"
+#include "learner/learner_config.h"
 #include "learner/parallel/gloo_replica_group.h"
 #include "learner/service/actor_gateway.h"
 #include "proto/run_config.pb.h"
@@ -16,9 +18,11 @@
 namespace vantage {
 
 struct LearnerServerConfig {
-  // The learner's settings, the batch (num_envs env streams of horizon
-  // steps), the run length and the run directory, as in local mode.
-  LocalTrainingConfig training;
+  // The run's learner (its batch: rollouts_per_batch env streams of
+  // horizon steps, over all replicas; the spec is `spec`) and its
+  // recording, as a run's plan gives them (deploy/run/run_plan.h).
+  LearnerConfig learner;
+  RecordingConfig recording;
   pb::RunConfig run_config;  // resolved; actors receive it
   // The run's environment, from the learner's own configuration: actors
   // must register exactly this spec (a resumed run checks that its

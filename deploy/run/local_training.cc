@@ -14,34 +14,29 @@ constexpr char kActorState[] = "actor_state";
 }  // namespace
 
 absl::Status RunLocalTraining(
-    const LocalTrainingConfig& config,
+    const RunPlan& plan,
     const std::function<bool(const ProgressRow&)>& on_update,
     const std::atomic<bool>* stop) {
-  ActorConfig actor_config;
-  actor_config.env = config.env;
-  actor_config.env_options = config.env_options;
-  actor_config.num_envs = config.num_envs;
-  const int64_t segment_length = config.segment_length > 0
-                                     ? config.segment_length
-                                     : config.learner.horizon;
-  if (config.learner.horizon % segment_length != 0) {
+  const int64_t horizon = plan.learner.horizon;
+  if (horizon % plan.actor.segment_length != 0) {
     return absl::InvalidArgumentError(
         "the segment length must divide the horizon");
   }
-  const int64_t rounds = config.learner.horizon / segment_length;
-  actor_config.segment_length = segment_length;
-  actor_config.seed = config.seed;
-  actor_config.network = config.learner.network;
-  actor_config.observation_clip = config.learner.observation_clip;
+  if (plan.actor.num_envs != plan.learner.rollouts_per_batch) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("a local run's batch is its actor's ", plan.actor.num_envs,
+                     " env streams, not ", plan.learner.rollouts_per_batch));
+  }
+  const int64_t rounds = horizon / plan.actor.segment_length;
   absl::StatusOr<std::unique_ptr<ActorCore>> actor =
-      ActorCore::Create(actor_config);
+      ActorCore::Create(plan.actor);
   if (!actor.ok()) return actor.status();
 
-  const LearnerConfig learner_config =
-      MakeLearnerConfig(config, (*actor)->spec());
+  LearnerConfig learner_config = plan.learner;
+  learner_config.spec = (*actor)->spec();
   // The actor continues exactly where the checkpoint's actor was.
   absl::StatusOr<std::unique_ptr<TrainingRun>> run = TrainingRun::Open(
-      config, learner_config,
+      plan.recording, learner_config,
       [&](const std::string& path, const CheckpointExtras& extras) {
         auto state = extras.find(kActorState);
         if (state == extras.end()) {
@@ -59,7 +54,7 @@ absl::Status RunLocalTraining(
   };
 
   // One horizon of segments per version, all queued before the update.
-  SegmentQueue queue(static_cast<size_t>(config.num_envs * rounds));
+  SegmentQueue queue(static_cast<size_t>(plan.actor.num_envs * rounds));
   while (!(*run)->done()) {
     if (stop != nullptr && *stop) return (*run)->CheckpointNow(actor_state);
     if (absl::Status status = (*actor)->SetWeights(learner.CurrentWeights());

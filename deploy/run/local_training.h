@@ -6,11 +6,11 @@
 
 #include "absl/status/status.h"
 #include "deploy/observe/progress_columns.h"
-#include "deploy/run/local_training_config.h"
+#include "deploy/run/run_plan.h"
 
 namespace vantage {
 
-// `--mode=local`: one actor core and one learner core in this process,
+// `--mode=local`: the plan's actor core and learner core in this process,
 // connected by an in-process queue, strictly on-policy: the actor collects
 // one horizon per environment with the latest weights, the learner updates
 // and publishes the next version. `on_update` sees every update (after its
@@ -19,7 +19,7 @@ namespace vantage {
 // `stop` (if given) is set, the run stops after the update in progress with
 // a checkpoint of it, as a signalled learner does, and returns OK.
 absl::Status RunLocalTraining(
-    const LocalTrainingConfig& config,
+    const RunPlan& plan,
     const std::function<bool(const ProgressRow&)>& on_update,
     const std::atomic<bool>* stop = nullptr);
 

@@ -13,6 +13,7 @@
 #include "absl/strings/str_split.h"
 #include "common/advantage/advantage_config.h"
 #include "common/env/frame_stack.h"
+#include "deploy/run/run_plan.h"
 #include "learner/algorithms/algorithm_config.h"
 #include "learner/exploration/ex2_config.h"
 #include "proto/flat_run_config.pb.h"
@@ -40,6 +41,11 @@ absl::Status AlgorithmSettingError(absl::string_view rule) {
 // largest divisor of the horizon up to it, so that a segment never spans
 // two rollouts (which local and --sync runs need).
 constexpr int64_t kSegmentSteps = 128;
+
+// The run's own defaults: what a run that names no task trains and for how
+// long (its other defaults are the components').
+constexpr char kDefaultEnv[] = "InvertedPendulum";
+constexpr int64_t kDefaultSteps = 150000;
 
 int64_t DefaultSegmentLength(int64_t horizon) {
   for (int64_t length = std::min(kSegmentSteps, horizon); length > 1;
@@ -189,10 +195,11 @@ absl::StatusOr<pb::RunConfig> FromFlat(const pb::FlatRunConfig& flat) {
 absl::Status ResolveTraining(const AlgorithmConfig& algorithm,
                              const AlgorithmRunDefaults& run_defaults,
                              pb::TrainingSettings& t) {
-  const LocalTrainingConfig local;
-  if (!t.has_env()) t.set_env(local.env);
-  if (!t.has_seed()) t.set_seed(local.seed);
-  if (!t.has_steps()) t.set_steps(local.total_env_steps);
+  const ActorConfig actor;
+  const LearnerConfig learner;
+  if (!t.has_env()) t.set_env(kDefaultEnv);
+  if (!t.has_seed()) t.set_seed(actor.seed);
+  if (!t.has_steps()) t.set_steps(kDefaultSteps);
   if (t.steps() < 1) return Invalid("steps", "must be >= 1");
   if (t.has_envs() && (t.envs() < 1 || t.envs() > 4096)) {
     return Invalid("envs", "must be in [1, 4096]");
@@ -207,33 +214,26 @@ absl::Status ResolveTraining(const AlgorithmConfig& algorithm,
                      "; change those (see `vantage help train`)"));
   }
   if (t.hidden_size() == 0) {
-    for (int64_t h : local.learner.network.hidden) t.add_hidden(h);
+    for (int64_t h : actor.network.hidden) t.add_hidden(h);
   }
   for (int64_t h : t.hidden()) {
     if (h < 1) return Invalid("hidden", "sizes must be >= 1");
   }
-  if (!t.has_torso()) t.set_torso(TorsoName(local.learner.network.torso));
+  if (!t.has_torso()) t.set_torso(TorsoName(actor.network.torso));
   if (!ParseTorso(t.torso()).ok()) {
     return Invalid("torso", absl::StrCat("'", t.torso(),
                                          "' is not one of auto, mlp, minatar, "
                                          "nature"));
   }
-  if (!t.has_shared_torso()) {
-    t.set_shared_torso(local.learner.network.shared_torso);
-  }
-  if (t.shared_torso() && !AlgorithmStepsBothNetworksAtOnce(algorithm)) {
-    return Invalid(
-        "shared_torso",
-        absl::StrCat("needs ppo or a2c, which step both networks "
-                     "with one optimiser; ",
-                     algorithm.name, " fits its value network alone"));
-  }
-  if (!t.has_frame_stack()) t.set_frame_stack(local.env_options.frame_stack);
+  // Whether the algorithm can share a torso is the learner's rule, checked
+  // with the others once the config is whole.
+  if (!t.has_shared_torso()) t.set_shared_torso(actor.network.shared_torso);
+  if (!t.has_frame_stack()) t.set_frame_stack(actor.env_options.frame_stack);
   if (t.frame_stack() < 1 || t.frame_stack() > kMaxFrameStack) {
     return Invalid("frame_stack",
                    absl::StrCat("must be in [1, ", kMaxFrameStack, "]"));
   }
-  if (!t.has_scale_rewards()) t.set_scale_rewards(local.learner.scale_rewards);
+  if (!t.has_scale_rewards()) t.set_scale_rewards(learner.scale_rewards);
   if (!t.has_segment_length()) {
     t.set_segment_length(DefaultSegmentLength(t.horizon()));
   }
@@ -271,7 +271,7 @@ absl::Status ResolveLocal(pb::RunConfig& c) {
         "--max_policy_lag, --learners, --learner_threads)");
   }
   pb::TrainingSettings& t = *c.mutable_training();
-  if (!t.has_envs()) t.set_envs(LocalTrainingConfig().num_envs);
+  if (!t.has_envs()) t.set_envs(ActorConfig().num_envs);
   if (t.horizon() % t.segment_length() != 0) {
     return Invalid("segment_length",
                    "must divide --horizon in a local run (its actor sends "
@@ -281,9 +281,13 @@ absl::Status ResolveLocal(pb::RunConfig& c) {
 }
 
 absl::Status ResolveRecording(pb::RecordingSettings& r) {
-  const LocalTrainingConfig local;
-  if (!r.has_checkpoint_every()) r.set_checkpoint_every(local.checkpoint_every);
-  if (!r.has_keep_checkpoints()) r.set_keep_checkpoints(local.keep_checkpoints);
+  const RecordingConfig recording;
+  if (!r.has_checkpoint_every()) {
+    r.set_checkpoint_every(recording.checkpoint_every);
+  }
+  if (!r.has_keep_checkpoints()) {
+    r.set_keep_checkpoints(recording.keep_checkpoints);
+  }
   if (r.checkpoint_every() < 1) {
     return Invalid("checkpoint_every", "must be >= 1");
   }
@@ -336,12 +340,16 @@ absl::StatusOr<pb::RunConfig> ResolveRunConfig(const pb::RunConfig& given) {
       !status.ok()) {
     return status;
   }
-  // The estimator's own rules (gamma, lambda, rho, ensemble).
-  const LocalTrainingConfig resolved = ToLocalTrainingConfig(c);
-  if (absl::Status status = resolved.learner.advantage.Validate();
-      !status.ok()) {
+  // The rules of the learner's own config (a shared torso's algorithm),
+  // the estimator's (gamma, lambda, rho, ensemble) among them.
+  absl::StatusOr<RunPlan> plan = PlanRun(c);
+  if (!plan.ok()) return plan.status();
+  if (absl::Status status = plan->learner.advantage.Validate(); !status.ok()) {
     return absl::InvalidArgumentError(
         absl::StrCat("estimator settings: ", status.message()));
+  }
+  if (absl::Status status = plan->learner.ValidateSettings(); !status.ok()) {
+    return status;
   }
   return c;
 }
@@ -381,38 +389,6 @@ std::string RunConfigToJson(const pb::RunConfig& config) {
   std::string json;
   (void)google::protobuf::util::MessageToJsonString(config, &json, options);
   return json;
-}
-
-LocalTrainingConfig ToLocalTrainingConfig(const pb::RunConfig& c) {
-  const pb::TrainingSettings& t = c.training();
-  LocalTrainingConfig local;
-  local.env = t.env();
-  local.env_options = EnvOptionsOf(c);
-  local.num_envs = t.envs();
-  local.total_env_steps = t.steps();
-  local.seed = t.seed();
-  local.segment_length = t.segment_length();
-  local.checkpoint_every = c.recording().checkpoint_every();
-  local.keep_checkpoints = c.recording().keep_checkpoints();
-  LearnerConfig& learner = local.learner;
-  learner.horizon = t.horizon();
-  learner.max_policy_lag = c.distributed().max_policy_lag();
-  learner.scale_rewards = t.scale_rewards();
-  // A resolved config's torso is one ResolveRunConfig checked.
-  learner.network = PolicyNetworkOf(c).value_or(NetworkConfig());
-  const pb::AdvantageSettings& a = c.advantage();
-  AdvantageConfig& advantage = learner.advantage;
-  if (absl::StatusOr<Statistic> statistic = ParseStatistic(a.estimator());
-      statistic.ok()) {
-    advantage.statistic = *statistic;
-  }
-  advantage.rho = a.rho();
-  advantage.gamma = a.gamma();
-  advantage.lambda = a.gae_lambda();
-  advantage.ensemble.assign(a.ensemble().begin(), a.ensemble().end());
-  learner.algorithm = AlgorithmConfigOf(c);
-  learner.exploration = ExplorationConfigOf(c);
-  return local;
 }
 
 std::string RunConfigDifference(const pb::RunConfig& held,

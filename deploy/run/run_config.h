@@ -7,18 +7,17 @@
 #include <string>
 
 #include "absl/status/statusor.h"
-#include "actor/envs/env_registry.h"
 #include "actor/run_settings.h"  // EnvOptionsOf, for the run's env makers
-#include "deploy/run/local_training_config.h"
 #include "proto/run_config.pb.h"
 
 namespace vantage {
 
 // Fills every absent field of the run's sections with its default (taken
-// from the component that owns it: LocalTrainingConfig, LearnerConfig,
-// AdvantageConfig, NetworkConfig, the algorithm's config and its
-// AlgorithmRunDefaults) and checks every value; a message names the field
-// by its `vantage train` flag.
+// from the component that owns it: ActorConfig, LearnerConfig,
+// RecordingConfig, AdvantageConfig, NetworkConfig, the algorithm's config
+// and its AlgorithmRunDefaults) and checks every value; a message names the
+// field by its `vantage train` flag. deploy/run/run_plan.h turns the result
+// into the configs of the parts that run it.
 absl::StatusOr<pb::RunConfig> ResolveRunConfig(const pb::RunConfig& given);
 
 // Parses a JSON RunConfig (unknown keys and wrong types are errors). A
@@ -34,9 +33,6 @@ std::string RunConfigToJson(const pb::RunConfig& config);
 // `wanted`); empty when they are equal.
 std::string RunConfigDifference(const pb::RunConfig& held,
                                 const pb::RunConfig& wanted);
-
-// The local training a resolved config describes.
-LocalTrainingConfig ToLocalTrainingConfig(const pb::RunConfig& resolved);
 
 }  // namespace vantage
 

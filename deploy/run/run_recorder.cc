@@ -32,7 +32,8 @@ absl::StatusOr<ProgressRow> RunRecorder::Record(
     return status;
   }
   const bool last = stats.env_steps >= config_.total_env_steps;
-  if (!last && stats.policy_version % config_.checkpoint_every != 0) return row;
+  if (!last && stats.policy_version % config_.recording.checkpoint_every != 0)
+    return row;
   if (absl::Status status =
           WriteRunCheckpoint(learner, row.elapsed_seconds, extras);
       !status.ok()) {
@@ -57,7 +58,7 @@ absl::Status RunRecorder::WriteRunCheckpoint(
     absl::FunctionRef<absl::StatusOr<CheckpointExtras>()> extras) {
   absl::StatusOr<CheckpointExtras> all = extras();
   if (!all.ok()) return all.status();
-  (*all)[kCheckpointConfig] = config_.config_json;
+  (*all)[kCheckpointConfig] = config_.recording.config_json;
   (*all)[kCheckpointElapsed] = absl::StrCat(elapsed_seconds);
   if (absl::Status status =
           WriteCheckpoint(CheckpointPath(run_->checkpoint_directory(),
@@ -68,7 +69,7 @@ absl::Status RunRecorder::WriteRunCheckpoint(
   }
   checkpointed_version_ = learner.policy_version();
   return PruneCheckpoints(run_->checkpoint_directory(),
-                          config_.keep_checkpoints);
+                          config_.recording.keep_checkpoints);
 }
 
 }  // namespace vantage

@@ -8,6 +8,7 @@
 
 #include "absl/functional/function_ref.h"
 #include "absl/status/statusor.h"
+#include "deploy/run/recording_config.h"
 #include "deploy/run/run_directory.h"
 #include "learner/checkpoint.h"
 #include "learner/learner_core.h"
@@ -19,9 +20,7 @@ inline constexpr char kCheckpointConfig[] = "config";
 inline constexpr char kCheckpointElapsed[] = "elapsed_seconds";
 
 struct RecorderConfig {
-  std::string config_json;  // the resolved run config
-  int checkpoint_every = 10;
-  int keep_checkpoints = 3;
+  RecordingConfig recording;  // its run_dir is the RunDirectory given
   int64_t total_env_steps = 0;
   // Where a resumed run starts: its elapsed time and env steps so far.
   double elapsed_before = 0.0;

@@ -11,8 +11,8 @@
 #include "common/nn/networks.h"
 #include "common/nn/policy_weights.h"
 #include "common/nn/running_mean_std.h"
-#include "deploy/run/local_training.h"
 #include "deploy/run/run_config.h"
+#include "deploy/run/run_plan.h"
 #include "learner/checkpoint.h"
 
 namespace vantage {
@@ -41,9 +41,12 @@ absl::StatusOr<TrainedPolicy> LoadCheckpointFile(const std::string& path) {
   absl::StatusOr<std::unique_ptr<Environment>> env =
       MakeEnvironment(config->training().env(), EnvOptionsOf(*config));
   if (!env.ok()) return env.status();
-  const LocalTrainingConfig local = ToLocalTrainingConfig(*config);
+  absl::StatusOr<RunPlan> plan = PlanRun(*config);
+  if (!plan.ok()) return plan.status();
+  LearnerConfig learner_config = plan->learner;
+  learner_config.spec = (*env)->spec();
   absl::StatusOr<std::unique_ptr<LearnerCore>> learner =
-      ReadCheckpoint(path, MakeLearnerConfig(local, (*env)->spec()));
+      ReadCheckpoint(path, learner_config);
   if (!learner.ok()) return learner.status();
   TrainedPolicy trained;
   trained.config = *config;
@@ -52,9 +55,9 @@ absl::StatusOr<TrainedPolicy> LoadCheckpointFile(const std::string& path) {
   trained.spec = (*env)->spec();
   trained.networks = std::make_shared<TrainedPolicy::Networks>();
   TrainedPolicy::Networks& networks = *trained.networks;
-  networks.policy = PolicyNetwork((*env)->spec(), local.learner.network);
+  networks.policy = PolicyNetwork((*env)->spec(), learner_config.network);
   networks.normalizer = RunningMeanStd((*env)->spec().observation_size);
-  networks.observation_clip = local.learner.observation_clip;
+  networks.observation_clip = learner_config.observation_clip;
   if (absl::Status status = ImportPolicyWeights(
           (*learner)->CurrentWeights(), *networks.policy, networks.normalizer);
       !status.ok()) {

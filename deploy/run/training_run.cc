@@ -16,17 +16,17 @@ TrainingRun::TrainingRun(std::unique_ptr<LearnerCore> learner,
       total_env_steps_(total_env_steps) {}
 
 absl::StatusOr<std::unique_ptr<TrainingRun>> TrainingRun::Open(
-    const LocalTrainingConfig& config, const LearnerConfig& learner_config,
+    const RecordingConfig& recording, const LearnerConfig& learner_config,
     const RestoreExtras& restore, std::shared_ptr<ReplicaGroup> replicas) {
   std::optional<RunDirectory> run;
   std::unique_ptr<LearnerCore> learner;
   double elapsed_before = 0.0;
-  if (config.resume) {
-    absl::StatusOr<RunDirectory> opened = RunDirectory::Open(config.run_dir);
+  if (recording.resume) {
+    absl::StatusOr<RunDirectory> opened = RunDirectory::Open(recording.run_dir);
     if (!opened.ok()) return opened.status();
     run = *std::move(opened);
     absl::StatusOr<ResumePoint> resumed = ResumeFromNewestCheckpoint(
-        *run, /*truncate_progress=*/config.record,
+        *run, /*truncate_progress=*/recording.record,
         [&](const std::string& path, const CheckpointExtras& extras)
             -> absl::StatusOr<std::unique_ptr<LearnerCore>> {
           absl::StatusOr<std::unique_ptr<LearnerCore>> loaded =
@@ -40,11 +40,11 @@ absl::StatusOr<std::unique_ptr<TrainingRun>> TrainingRun::Open(
     if (!resumed.ok()) return resumed.status();
     learner = std::move(resumed->learner);
     elapsed_before = resumed->elapsed_seconds;
-    if (!config.record) run.reset();
+    if (!recording.record) run.reset();
   } else {
-    if (!config.run_dir.empty() && config.record) {
+    if (!recording.run_dir.empty() && recording.record) {
       absl::StatusOr<RunDirectory> created =
-          RunDirectory::Create(config.run_dir, config.config_json);
+          RunDirectory::Create(recording.run_dir, recording.config_json);
       if (!created.ok()) return created.status();
       run = *std::move(created);
     }
@@ -54,13 +54,11 @@ absl::StatusOr<std::unique_ptr<TrainingRun>> TrainingRun::Open(
     learner = *std::move(created);
   }
   RecorderConfig recorder;
-  recorder.config_json = config.config_json;
-  recorder.checkpoint_every = config.checkpoint_every;
-  recorder.keep_checkpoints = config.keep_checkpoints;
-  recorder.total_env_steps = config.total_env_steps;
+  recorder.recording = recording;
+  recorder.total_env_steps = learner_config.total_env_steps;
   recorder.elapsed_before = elapsed_before;
   recorder.steps_before = learner->env_steps();
-  const int64_t total = config.total_env_steps;
+  const int64_t total = learner_config.total_env_steps;
   return std::unique_ptr<TrainingRun>(new TrainingRun(
       std::move(learner), RunRecorder(std::move(run), recorder), total));
 }

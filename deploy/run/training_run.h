@@ -14,7 +14,8 @@
 
 #include "absl/status/statusor.h"
 #include "common/rollout/segment_queue.h"
-#include "deploy/run/local_training.h"
+#include "deploy/observe/progress_columns.h"
+#include "deploy/run/recording_config.h"
 #include "deploy/run/run_recorder.h"
 #include "learner/checkpoint.h"
 #include "learner/learner_core.h"
@@ -32,12 +33,13 @@ class TrainingRun {
   using RestoreExtras = std::function<absl::Status(
       const std::string& path, const CheckpointExtras& extras)>;
 
-  // A new run (its directory, if `config.run_dir` is set, must not hold
-  // one) or, with `config.resume`, the run in `config.run_dir` continued
-  // from its newest checkpoint that loads with `learner` and `restore`.
-  // The learner is one of `replicas`.
+  // A new run (its directory, if `recording.run_dir` is set, must not hold
+  // one) or, with `recording.resume`, the run in `recording.run_dir`
+  // continued from its newest checkpoint that loads with `learner` and
+  // `restore`. The learner is one of `replicas`; its total_env_steps end
+  // the run.
   static absl::StatusOr<std::unique_ptr<TrainingRun>> Open(
-      const LocalTrainingConfig& config, const LearnerConfig& learner,
+      const RecordingConfig& recording, const LearnerConfig& learner,
       const RestoreExtras& restore,
       std::shared_ptr<ReplicaGroup> replicas = SoloReplicaGroup());
 

@@ -12,29 +12,34 @@
 
 #include "deploy/run/local_training.h"
 #include "gtest/gtest.h"
+#include "learner/algorithms/algorithm_config.h"
+#include "tests/fakes/local_plan.h"
 
 namespace vantage {
 namespace {
 
-LocalTrainingConfig Config(const std::string& env, const std::string& algorithm,
-                           int64_t steps, uint64_t seed) {
-  LocalTrainingConfig config;
-  config.env = env;
-  config.total_env_steps = steps;
-  config.seed = seed;
-  config.learner.algorithm.name = algorithm;
-  config.learner.advantage.statistic = *ParseStatistic("maxabs");
-  config.learner.advantage.rho = 0.4;
-  return config;
+// A local run of `algorithm` with its own defaults (horizon, lambda), with
+// maxabs at rho 0.4.
+pb::RunConfig Config(const std::string& env, const std::string& algorithm,
+                     int64_t steps, uint64_t seed) {
+  pb::RunConfig run;
+  run.mutable_training()->set_env(env);
+  run.mutable_training()->set_steps(steps);
+  run.mutable_training()->set_seed(seed);
+  EXPECT_TRUE(SelectAlgorithm(algorithm, run).ok());
+  run.mutable_advantage()->set_estimator("maxabs");
+  run.mutable_advantage()->set_rho(0.4);
+  return run;
 }
 
-LocalTrainingConfig InvertedPendulum(const std::string& algorithm,
-                                     int64_t steps, uint64_t seed) {
+pb::RunConfig InvertedPendulum(const std::string& algorithm, int64_t steps,
+                               uint64_t seed) {
   return Config("InvertedPendulum", algorithm, steps, seed);
 }
 
 // The best mean return of the last 100 episodes over the run.
-double BestMeanReturn(const LocalTrainingConfig& config) {
+double BestMeanReturn(const pb::RunConfig& run) {
+  const RunPlan config = LocalPlan(run);
   at::set_num_threads(1);
   double best = 0.0;
   double last = 0.0;
@@ -60,8 +65,8 @@ double BestMeanReturn(const LocalTrainingConfig& config) {
 
 // The bar: PPO with maxabs, rho 0.4 reaches >= 800 within 300k.
 TEST(LearningTest, PpoMaxAbsBalancesTheInvertedPendulum) {
-  LocalTrainingConfig config = InvertedPendulum("ppo", 300000, 1);
-  config.learner.horizon = 2048;
+  pb::RunConfig config = InvertedPendulum("ppo", 300000, 1);
+  config.mutable_training()->set_horizon(2048);
   EXPECT_GE(BestMeanReturn(config), 800.0);
 }
 
@@ -69,20 +74,18 @@ TEST(LearningTest, PpoMaxAbsBalancesTheInvertedPendulum) {
 // minibatches) on 8 envs, 60k steps: seed 1 reaches about 2x the bar of
 // 150, which is 20x a random policy's return.
 TEST(LearningTest, A2cMaxAbsLearnsTheInvertedPendulum) {
-  LocalTrainingConfig config = InvertedPendulum("a2c", 60000, 1);
-  config.num_envs = 8;
-  config.learner.algorithm.a2c.n = 4;
-  config.learner.horizon = config.learner.algorithm.a2c.horizon();
-  config.learner.advantage.lambda = 1.0;
+  pb::RunConfig config = InvertedPendulum("a2c", 60000, 1);
+  config.mutable_training()->set_envs(8);
+  config.mutable_a2c()->set_n(4);
+  // A2C's own defaults: 20-step rollouts (5n) and lambda 1.
   EXPECT_GE(BestMeanReturn(config), 150.0);
 }
 
 // TRPO (1024-step batches, max KL 0.01), 40k steps: seed 1 reaches about
 // 2x the bar of 150.
 TEST(LearningTest, TrpoMaxAbsLearnsTheInvertedPendulum) {
-  LocalTrainingConfig config = InvertedPendulum("trpo", 40960, 1);
-  config.learner.horizon = 1024;
-  config.learner.advantage.lambda = 0.98;
+  pb::RunConfig config = InvertedPendulum("trpo", 40960, 1);
+  // TRPO's own defaults: 1024-step rollouts and lambda 0.98.
   EXPECT_GE(BestMeanReturn(config), 150.0);
 }
 
@@ -93,12 +96,10 @@ TEST(LearningTest, TrpoMaxAbsLearnsTheInvertedPendulum) {
 // uniformly random policy scores 0.49 a game (1000 games, `vantage
 // rollout`); seed 1 reaches 3.3 within 60k steps.
 TEST(LearningTest, A2cMaxAbsLearnsMinAtarBreakout) {
-  LocalTrainingConfig config = Config("MinAtarBreakout", "a2c", 60000, 1);
-  config.num_envs = 4;
-  config.learner.algorithm.a2c.n = 20;
-  config.learner.horizon = config.learner.algorithm.a2c.horizon();
-  config.learner.advantage.lambda = 1.0;
-  config.learner.advantage.ensemble = {1, 3, 5};
+  pb::RunConfig config = Config("MinAtarBreakout", "a2c", 60000, 1);
+  config.mutable_training()->set_envs(4);
+  config.mutable_a2c()->set_n(20);
+  for (int64_t k : {1, 3, 5}) config.mutable_advantage()->add_ensemble(k);
   EXPECT_GE(BestMeanReturn(config), 2.5);
 }
 

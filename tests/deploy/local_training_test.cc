@@ -15,6 +15,7 @@
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
 #include "learner/checkpoint.h"
+#include "tests/fakes/local_plan.h"
 #include "tests/fakes/run_files.h"
 
 namespace vantage {
@@ -31,47 +32,51 @@ std::string FreshDirectory(const std::string& name) {
   return path;
 }
 
-LocalTrainingConfig SmallRun(const std::string& algorithm, uint64_t seed,
-                             const std::string& run_dir) {
+RunPlan SmallRun(const std::string& algorithm, uint64_t seed,
+                 const std::string& run_dir) {
+  pb::RunConfig run;
+  pb::TrainingSettings& training = *run.mutable_training();
+  training.set_env("Hopper");
+  training.set_envs(kEnvs);
   // A2C's rollouts are 5n steps (n = 4 here).
-  const int64_t horizon = algorithm == "a2c" ? 20 : kHorizon;
-  LocalTrainingConfig config;
-  config.env = "Hopper";
-  config.num_envs = kEnvs;
-  config.total_env_steps = kUpdates * kEnvs * horizon;
-  config.seed = seed;
-  config.learner.horizon = horizon;
-  // "ex2": TRPO with an EX2 bonus small enough to fit on update 3, whose
-  // pool (1000 states) wraps around after four batches.
-  config.learner.algorithm.name = algorithm == "ex2" ? "trpo" : algorithm;
-  if (algorithm == "ex2") {
-    Ex2Config ex2;
-    ex2.hidden = {16};
-    ex2.feature_dim = 8;
-    ex2.replay_min = 300;
-    ex2.replay_size = 1000;
-    ex2.first_train_iterations = 30;
-    ex2.train_iterations = 10;
-    ex2.batch_size = 32;
-    ex2.bonus_coeff = 0.1;
-    config.learner.exploration.ex2 = ex2;
-  }
-  config.learner.algorithm.ppo.minibatches = 8;
-  config.learner.algorithm.ppo.epochs = 2;
-  config.learner.algorithm.a2c.n = 4;
-  config.learner.advantage.statistic = *ParseStatistic("max");
-  config.learner.advantage.rho = 0.5;
+  training.set_steps(kUpdates * kEnvs * (algorithm == "a2c" ? 20 : kHorizon));
+  training.set_seed(seed);
   // Reward scaling carries state across updates (per-stream returns), so
   // the resume tests cover it.
-  config.learner.scale_rewards = true;
-  config.run_dir = run_dir;
-  config.config_json = "{}";
-  config.checkpoint_every = 2;
-  return config;
+  training.set_scale_rewards(true);
+  if (algorithm == "ppo") {
+    training.set_horizon(kHorizon);
+    run.mutable_ppo()->set_minibatches(8);
+    run.mutable_ppo()->set_epochs(2);
+  } else if (algorithm == "a2c") {
+    run.mutable_a2c()->set_n(4);
+  } else {
+    training.set_horizon(kHorizon);
+    run.mutable_trpo();
+  }
+  // "ex2": TRPO with an EX2 bonus small enough to fit on update 3, whose
+  // pool (1000 states) wraps around after four batches.
+  if (algorithm == "ex2") {
+    pb::Ex2Settings& ex2 = *run.mutable_exploration()->mutable_ex2();
+    ex2.add_hidden(16);
+    ex2.set_feature_dim(8);
+    ex2.set_replay_min(300);
+    ex2.set_replay_size(1000);
+    ex2.set_first_train_iterations(30);
+    ex2.set_train_iterations(10);
+    ex2.set_batch_size(32);
+    ex2.set_bonus_coeff(0.1);
+  }
+  run.mutable_advantage()->set_estimator("max");
+  run.mutable_advantage()->set_rho(0.5);
+  run.mutable_recording()->set_checkpoint_every(2);
+  RunPlan plan = LocalPlan(run);
+  plan.recording.run_dir = run_dir;
+  return plan;
 }
 
 // Runs to the end, or stops after update `stop_after` like a killed run.
-void Train(const LocalTrainingConfig& config, int stop_after = kUpdates) {
+void Train(const RunPlan& config, int stop_after = kUpdates) {
   const absl::Status status =
       RunLocalTraining(config, [&](const ProgressRow& row) {
         return row.stats.policy_version < stop_after;
@@ -156,8 +161,8 @@ TEST_P(ResumeTest, ResumedRunEqualsUninterruptedRun) {
   Train(SmallRun(GetParam(), 7, whole));
   Train(SmallRun(GetParam(), 7, broken), /*stop_after=*/5);
   EXPECT_EQ(DeterministicProgress(broken).size(), 1u + 5);
-  LocalTrainingConfig resume = SmallRun(GetParam(), 7, broken);
-  resume.resume = true;
+  RunPlan resume = SmallRun(GetParam(), 7, broken);
+  resume.recording.resume = true;
   Train(resume);
   EXPECT_EQ(DeterministicProgress(broken), DeterministicProgress(whole));
   // Checkpoints at 2, 4 and 6 (the end); the newest 3 are kept.
@@ -189,7 +194,7 @@ TEST(LocalTrainingTest, Ex2ChangesTrainingOnlyThroughTheRewards) {
   const std::string silent = FreshDirectory("silent_ex2");
   const std::string shaped = FreshDirectory("shaped_ex2");
   Train(SmallRun("trpo", 7, plain));
-  LocalTrainingConfig config = SmallRun("ex2", 7, silent);
+  RunPlan config = SmallRun("ex2", 7, silent);
   config.learner.exploration.ex2->bonus_coeff = 0.0;
   Train(config);
   Train(SmallRun("ex2", 7, shaped));
@@ -222,16 +227,16 @@ TEST(LocalTrainingTest, ResumeSkipsADamagedNewestCheckpoint) {
   const std::string newest = CheckpointPath(broken + "/checkpoints", 4);
   ASSERT_TRUE(std::filesystem::exists(newest));
   std::ofstream(newest, std::ios::trunc) << "not a checkpoint";
-  LocalTrainingConfig resume = SmallRun("ppo", 8, broken);
-  resume.resume = true;
+  RunPlan resume = SmallRun("ppo", 8, broken);
+  resume.recording.resume = true;
   Train(resume);
   EXPECT_EQ(DeterministicProgress(broken), DeterministicProgress(whole));
 }
 
 TEST(LocalTrainingTest, ResumeWithoutCheckpointsIsAnError) {
   const std::string dir = FreshDirectory("no_checkpoints");
-  LocalTrainingConfig config = SmallRun("ppo", 1, dir);
-  config.resume = true;
+  RunPlan config = SmallRun("ppo", 1, dir);
+  config.recording.resume = true;
   EXPECT_EQ(
       RunLocalTraining(config, [](const ProgressRow&) { return true; }).code(),
       absl::StatusCode::kNotFound);

@@ -1,5 +1,6 @@
 #include "deploy/run/run_config.h"
 
+#include "deploy/run/run_plan.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
 
@@ -48,14 +49,16 @@ TEST(RunConfigTest, TooManyEnvsPerActorAreRefused) {
 TEST(RunConfigTest, DefaultsAreTheComponentsOwn) {
   absl::StatusOr<pb::RunConfig> config = Resolve("{}");
   ASSERT_TRUE(config.ok()) << config.status();
-  const LocalTrainingConfig local;
   EXPECT_EQ(config->mode(), "distributed");
-  EXPECT_EQ(config->training().env(), local.env);
-  EXPECT_EQ(config->training().steps(), local.total_env_steps);
+  EXPECT_EQ(config->training().env(), "InvertedPendulum");
+  EXPECT_EQ(config->training().steps(), 150000);
+  EXPECT_EQ(config->training().seed(), ActorConfig().seed);
+  EXPECT_EQ(config->training().scale_rewards(), LearnerConfig().scale_rewards);
   EXPECT_EQ(config->advantage().rho(), AdvantageConfig().rho);
   EXPECT_EQ(config->advantage().estimator(), "maxabs");
   EXPECT_EQ(config->ppo().minibatches(), PpoConfig().minibatches);
-  EXPECT_EQ(config->recording().checkpoint_every(), local.checkpoint_every);
+  EXPECT_EQ(config->recording().checkpoint_every(),
+            RecordingConfig().checkpoint_every);
   EXPECT_EQ(config->training().frame_stack(), 1);
   // Only the chosen algorithm's section is there.
   EXPECT_EQ(config->algorithm_case(), pb::RunConfig::kPpo);
@@ -67,7 +70,7 @@ TEST(RunConfigTest, DefaultsAreTheComponentsOwn) {
   absl::StatusOr<pb::RunConfig> local_run = Resolve(R"({"mode": "local"})");
   ASSERT_TRUE(local_run.ok()) << local_run.status();
   EXPECT_FALSE(local_run->has_distributed());
-  EXPECT_EQ(local_run->training().envs(), local.num_envs);
+  EXPECT_EQ(local_run->training().envs(), ActorConfig().num_envs);
 }
 
 TEST(RunConfigTest, FrameStacksAreOneToSixteen) {
@@ -81,7 +84,9 @@ TEST(RunConfigTest, FrameStacksAreOneToSixteen) {
       Resolve(R"({"training": {"env": "MinAtarBreakout", "frame_stack": 4}})");
   ASSERT_TRUE(config.ok()) << config.status();
   EXPECT_EQ(EnvOptionsOf(*config).frame_stack, 4);
-  EXPECT_EQ(ToLocalTrainingConfig(*config).env_options.frame_stack, 4);
+  absl::StatusOr<RunPlan> plan = PlanRun(*config);
+  ASSERT_TRUE(plan.ok()) << plan.status();
+  EXPECT_EQ(plan->actor.env_options.frame_stack, 4);
   // A config from before frame stacking existed stacks nothing.
   EXPECT_EQ(EnvOptionsOf(pb::RunConfig()).frame_stack, 1);
 }
@@ -94,13 +99,48 @@ TEST(RunConfigTest, ASharedTorsoNeedsOneOptimiserOverBothNetworks) {
       R"({"training": {"env": "MinAtarBreakout", "shared_torso": true},
           "a2c": {}})");
   ASSERT_TRUE(shared.ok()) << shared.status();
-  EXPECT_TRUE(ToLocalTrainingConfig(*shared).learner.network.shared_torso);
+  absl::StatusOr<RunPlan> plan = PlanRun(*shared);
+  ASSERT_TRUE(plan.ok()) << plan.status();
+  EXPECT_TRUE(plan->learner.network.shared_torso);
+  EXPECT_TRUE(plan->actor.network.shared_torso);
   EXPECT_EQ(
       Resolve(R"({"training": {"shared_torso": true}, "trpo": {}})")
           .status()
           .message(),
       "--shared_torso needs ppo or a2c, which step both networks with one "
       "optimiser; trpo fits its value network alone");
+}
+
+// One resolved config, one plan: what the actor and the learner both need
+// is read once and agrees.
+TEST(RunConfigTest, ThePlanGivesActorAndLearnerTheSameRun) {
+  absl::StatusOr<pb::RunConfig> config = Resolve(
+      R"({"mode": "local", "training": {"env": "Hopper", "envs": 3,
+          "seed": 9, "horizon": 96, "segment_length": 32, "hidden": [8],
+          "steps": 5000}, "trpo": {"max_kl": 0.02},
+          "recording": {"keep_checkpoints": 5}})");
+  ASSERT_TRUE(config.ok()) << config.status();
+  absl::StatusOr<RunPlan> plan = PlanRun(*config);
+  ASSERT_TRUE(plan.ok()) << plan.status();
+  EXPECT_EQ(plan->actor.env, "Hopper");
+  EXPECT_EQ(plan->actor.num_envs, 3);
+  EXPECT_EQ(plan->learner.rollouts_per_batch, 3);
+  EXPECT_EQ(plan->actor.seed, 9u);
+  EXPECT_EQ(plan->learner.seed, 9u);
+  EXPECT_EQ(plan->actor.segment_length, 32);
+  EXPECT_EQ(plan->learner.max_segment_steps, 32);
+  EXPECT_EQ(plan->learner.horizon, 96);
+  EXPECT_EQ(plan->learner.total_env_steps, 5000);
+  EXPECT_EQ(plan->actor.network.hidden, std::vector<int64_t>{8});
+  EXPECT_EQ(plan->learner.network.hidden, std::vector<int64_t>{8});
+  EXPECT_EQ(plan->actor.observation_clip, plan->learner.observation_clip);
+  EXPECT_EQ(plan->learner.algorithm.name, "trpo");
+  EXPECT_EQ(plan->learner.algorithm.trpo.max_kl, 0.02);
+  EXPECT_EQ(plan->learner.advantage.lambda, 0.98);  // TRPO's own default
+  EXPECT_EQ(plan->recording.keep_checkpoints, 5);
+  EXPECT_EQ(plan->recording.config_json, RunConfigToJson(*config));
+  EXPECT_TRUE(plan->recording.run_dir.empty());
+  EXPECT_TRUE(plan->learner.ValidateSettings().ok());
 }
 
 TEST(RunConfigTest, AResolvedConfigSurvivesItsJson) {

@@ -324,7 +324,7 @@ TEST(SharedTorsoTest, OneTrunkTrainsAndResumesAsOne) {
       TestLearnerConfig(MakeTestActor(1, "MinAtarBreakout")->spec(), "trpo");
   config.network.shared_torso = true;
   EXPECT_THAT(config.Validate().message(),
-              HasSubstr("trpo fits its value network on its own"));
+              HasSubstr("trpo fits its value network alone"));
   // Vectors have nothing to share.
   auto vectors = MakeTestActor();
   config = TestLearnerConfig(vectors->spec(), "ppo");

@@ -72,7 +72,7 @@ TEST(RunRequestTest, TheAlgorithmIsChosenOnce) {
   ASSERT_TRUE(file.ok()) << file.status();
   EXPECT_EQ(file->config.a2c().n(), 8);
   EXPECT_EQ(file->config.training().horizon(), 40);
-  EXPECT_EQ(file->local.learner.algorithm.name, "a2c");
+  EXPECT_EQ(file->plan.learner.algorithm.name, "a2c");
 
   request.flags.mutable_ppo()->set_epochs(3);
   EXPECT_THAT(
@@ -85,7 +85,7 @@ TEST(RunRequestTest, TheAlgorithmIsChosenOnce) {
   EXPECT_EQ(switched->config.ppo().epochs(), 3);
   EXPECT_EQ(switched->config.training().seed(), 4);
   EXPECT_EQ(switched->config.training().horizon(), 2048);
-  EXPECT_EQ(switched->local.learner.algorithm.ppo.epochs, 3);
+  EXPECT_EQ(switched->plan.learner.algorithm.ppo.epochs, 3);
 }
 
 // --exploration=ex2 selects EX2 with its defaults, the --ex2_ flags
@@ -98,30 +98,30 @@ TEST(RunRequestTest, ExplorationIsSelectedByFlagOrFile) {
   ASSERT_TRUE(ex2.ok()) << ex2.status();
   EXPECT_EQ(ex2->config.exploration().ex2().kl_weight(), 0.1);
   EXPECT_EQ(ex2->config.exploration().ex2().hidden_size(), 1);
-  ASSERT_TRUE(ex2->local.learner.exploration.ex2.has_value());
-  EXPECT_EQ(ex2->local.learner.exploration.ex2->train_iterations, 2000);
+  ASSERT_TRUE(ex2->plan.learner.exploration.ex2.has_value());
+  EXPECT_EQ(ex2->plan.learner.exploration.ex2->train_iterations, 2000);
 
   request = RunRequestFromSettings(
       {{"ex2_kl_weight", "0.01"}, {"ex2_hidden", "16,16"}});
   ASSERT_TRUE(request.ok()) << request.status();
   absl::StatusOr<ResolvedRun> flags = ResolveRunRequest(*request);
   ASSERT_TRUE(flags.ok()) << flags.status();
-  EXPECT_EQ(flags->local.learner.exploration.ex2->kl_weight, 0.01);
-  EXPECT_EQ(flags->local.learner.exploration.ex2->hidden,
+  EXPECT_EQ(flags->plan.learner.exploration.ex2->kl_weight, 0.01);
+  EXPECT_EQ(flags->plan.learner.exploration.ex2->hidden,
             (std::vector<int64_t>{16, 16}));
 
   // Without it: no section in config.json, no bonus.
   absl::StatusOr<ResolvedRun> plain = ResolveRunRequest(RunRequest());
   ASSERT_TRUE(plain.ok());
   EXPECT_FALSE(plain->config.has_exploration());
-  EXPECT_FALSE(plain->local.learner.exploration.enabled());
+  EXPECT_FALSE(plain->plan.learner.exploration.enabled());
 
   RunRequest from_file;
   from_file.config_file = WriteTemp(
       "ex2.json", R"({"exploration": {"ex2": {"bonus_coeff": 0.01}}})");
   absl::StatusOr<ResolvedRun> file = ResolveRunRequest(from_file);
   ASSERT_TRUE(file.ok()) << file.status();
-  EXPECT_EQ(file->local.learner.exploration.ex2->bonus_coeff, 0.01);
+  EXPECT_EQ(file->plan.learner.exploration.ex2->bonus_coeff, 0.01);
   request = RunRequestFromSettings({{"exploration", "none"}});
   ASSERT_TRUE(request.ok());
   request->config_file = from_file.config_file;
@@ -190,7 +190,7 @@ TEST(RunRequestTest, ARunThatCannotStartIsRefusedBeforeItStarts) {
   ASSERT_TRUE(run.ok()) << run.status();
   EXPECT_TRUE(CheckRunCanStart(*run).ok());
   // Resuming a directory that holds no run.
-  run->local.resume = true;
+  run->plan.recording.resume = true;
   EXPECT_FALSE(CheckRunCanStart(*run).ok());
 }
 
@@ -205,28 +205,30 @@ TEST(RunRequestTest, ResumeIfExistsStartsResumesOrStartsOver) {
 
   absl::StatusOr<ResolvedRun> fresh = ResolveRunRequest(request);
   ASSERT_TRUE(fresh.ok()) << fresh.status();
-  EXPECT_FALSE(fresh->local.resume);
+  EXPECT_FALSE(fresh->plan.recording.resume);
   EXPECT_FALSE(fresh->start_over);
   EXPECT_TRUE(CheckRunCanStart(*fresh).ok());
 
   // Killed before its first checkpoint: config.json and a row, no checkpoint.
-  ASSERT_TRUE(RunDirectory::Create(dir, fresh->local.config_json).ok());
+  ASSERT_TRUE(
+      RunDirectory::Create(dir, fresh->plan.recording.config_json).ok());
   absl::StatusOr<ResolvedRun> unstarted = ResolveRunRequest(request);
   ASSERT_TRUE(unstarted.ok()) << unstarted.status();
   EXPECT_TRUE(unstarted->start_over);
-  EXPECT_FALSE(unstarted->local.resume);
+  EXPECT_FALSE(unstarted->plan.recording.resume);
   EXPECT_TRUE(CheckRunCanStart(*unstarted).ok());
   ASSERT_TRUE(PrepareRunDirectory(*unstarted).ok());
   EXPECT_FALSE(std::filesystem::exists(dir + "/config.json"));
   EXPECT_TRUE(RunDirectory::CheckFree(dir).ok());
 
-  ASSERT_TRUE(RunDirectory::Create(dir, fresh->local.config_json).ok());
+  ASSERT_TRUE(
+      RunDirectory::Create(dir, fresh->plan.recording.config_json).ok());
   std::ofstream(dir + "/checkpoints/checkpoint-00000002.pt") << "x";
   absl::StatusOr<ResolvedRun> resumed = ResolveRunRequest(request);
   ASSERT_TRUE(resumed.ok()) << resumed.status();
-  EXPECT_TRUE(resumed->local.resume);
+  EXPECT_TRUE(resumed->plan.recording.resume);
   EXPECT_FALSE(resumed->start_over);
-  EXPECT_EQ(resumed->local.run_dir, dir);
+  EXPECT_EQ(resumed->plan.recording.run_dir, dir);
   ASSERT_TRUE(PrepareRunDirectory(*resumed).ok());
   EXPECT_TRUE(std::filesystem::exists(dir + "/checkpoints"));
 

@@ -1,0 +1,28 @@
+#ifndef VANTAGE_DEPLOY_RUN_RECORDING_CONFIG_H_
+#define VANTAGE_DEPLOY_RUN_RECORDING_CONFIG_H_
+
+#include <string>
+
+namespace vantage {
+
+// Where and how a run is recorded (see deploy/run/run_directory.h):
+// config.json with `config_json`, progress.csv, and a checkpoint every
+// `checkpoint_every` updates and at the end, keeping the newest
+// `keep_checkpoints`; no run directory: nothing is written.
+struct RecordingConfig {
+  std::string run_dir;
+  std::string config_json;  // the resolved run config
+  int checkpoint_every = 10;
+  int keep_checkpoints = 3;
+  // Continue the run in run_dir from its newest readable checkpoint (an
+  // unreadable one is reported and the one before it used); the continued
+  // run's progress equals an uninterrupted run's.
+  bool resume = false;
+  // False for the replicas of a data-parallel run other than rank 0: they
+  // read run_dir's checkpoints to resume but write nothing there.
+  bool record = true;
+};
+
+}  // namespace vantage
+
+#endif  // VANTAGE_DEPLOY_RUN_RECORDING_CONFIG_H_
