@@ -14,6 +14,7 @@
 #include <cstdlib>
 #include <optional>
 #include <string>
+#include <type_traits>
 #include <variant>
 #include <vector>
 
@@ -49,15 +50,19 @@ class SettingsTable {
   };
 
   // `section` names the settings in messages ("ppo": "ppo.clip must be
-  // ..."). A row whose field Settings lacks is a programming error: it
-  // stops the program at the first use of the table.
+  // ..."). A row whose field Settings lacks, or a range on a member that is
+  // not a number (a bool, a string), is a programming error: it stops the
+  // program at the first use of the table.
   SettingsTable(const char* section, std::vector<Row> rows)
       : section_(section), rows_(std::move(rows)) {
     for (const Row& row : rows_) {
       if (Settings::descriptor()->FindFieldByName(row.field) == nullptr) {
-        std::fprintf(stderr, "%s settings have no field %s\n", section,
-                     row.field);
-        std::abort();
+        Abort(section, row, "settings have no such field");
+      }
+      const bool number = std::holds_alternative<int Config::*>(row.member) ||
+                          std::holds_alternative<double Config::*>(row.member);
+      if (!number && (row.low.has_value() || row.high.has_value())) {
+        Abort(section, row, "is not a number and can have no range");
       }
     }
   }
@@ -88,7 +93,13 @@ class SettingsTable {
     for (const Row& row : rows_) {
       if (!row.low.has_value() && !row.high.has_value()) continue;
       const double value = std::visit(
-          [&](auto member) { return Number(config.*member); }, row.member);
+          [&](auto member) -> double {
+            using Value = std::decay_t<decltype(config.*member)>;
+            // The constructor allows ranges on numbers only.
+            if constexpr (std::is_arithmetic_v<Value>) return config.*member;
+            return 0.0;
+          },
+          row.member);
       if (InRange(value, row)) continue;
       return absl::InvalidArgumentError(
           absl::StrCat(section_, ".", row.field, " must be ", Range(row)));
@@ -137,10 +148,11 @@ class SettingsTable {
     m.GetReflection()->SetString(&m, &f, value);
   }
 
-  static double Number(int value) { return value; }
-  static double Number(double value) { return value; }
-  static double Number(bool value) { return value ? 1 : 0; }
-  static double Number(const std::string&) { return 0; }
+  [[noreturn]] static void Abort(const char* section, const Row& row,
+                                 const char* what) {
+    std::fprintf(stderr, "%s.%s %s\n", section, row.field, what);
+    std::abort();
+  }
 
   // NaN is in no range.
   static bool InRange(double value, const Row& row) {

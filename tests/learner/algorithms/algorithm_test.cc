@@ -8,6 +8,7 @@
 
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
+#include "learner/algorithms/settings_table.h"
 #include "proto/run_config.pb.h"
 
 namespace vantage {
@@ -132,6 +133,22 @@ TEST(AlgorithmTest, EverySettingIsWrittenAndRangeChecked) {
   config.name = "trpo";
   config.trpo.cg_damping = -0.1;
   EXPECT_EQ(config.Validate().message(), "trpo.cg_damping must be >= 0");
+}
+
+// A table that names a field its settings lack, or puts a range on a
+// setting that is not a number, is a bug caught at its first use.
+TEST(AlgorithmDeathTest, ATableRowMustFitItsSettings) {
+  using Table = SettingsTable<PpoConfig, pb::PpoSettings>;
+  EXPECT_DEATH(Table("ppo", {{"no_such_field", &PpoConfig::clip}}),
+               "ppo.no_such_field settings have no such field");
+  EXPECT_DEATH(Table("ppo", {{"normalize_advantages",
+                              &PpoConfig::normalize_advantages, AtLeast(0)}}),
+               "ppo.normalize_advantages is not a number");
+  Table numbers("ppo",
+                {{"clip", &PpoConfig::clip, Above(0), Below(1)},
+                 {"normalize_advantages", &PpoConfig::normalize_advantages}});
+  PpoConfig ppo;
+  EXPECT_TRUE(numbers.Validate(ppo).ok());
 }
 
 }  // namespace
