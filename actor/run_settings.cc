@@ -7,6 +7,7 @@ EnvOptions EnvOptionsOf(const pb::RunConfig& run) {
   if (run.training().has_frame_stack()) {
     options.frame_stack = run.training().frame_stack();
   }
+  options.python_kwargs = run.training().env_kwargs();
   return options;
 }
 

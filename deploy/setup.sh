@@ -47,7 +47,8 @@ done
 # BLAS through, linked as libblas.so.3 and so run on OpenBLAS too.
 # prometheus (with promtool) serves deploy/prometheus/watch_runs.sh;
 # python3-matplotlib draws `vantage plot`'s figures and python3-scipy computes
-# the statistics of `vantage experiment report`. `vantage rollout
+# the statistics of `vantage experiment report`. Actors embed CPython for
+# Python environments (python3-dev, pybind11-dev, python3-numpy). `vantage rollout
 # --video` renders MuJoCo offscreen on OSMesa (libosmesa6-dev), draws the
 # Bullet characters with Cairo (libcairo2-dev) and encodes with FFmpeg's
 # libraries (libav*-dev, libswscale-dev). libbenchmark-dev: the container
@@ -68,6 +69,7 @@ packages=(
   prometheus-cpp-dev
   libminizip-dev
   prometheus python3-matplotlib python3-scipy
+  python3-dev pybind11-dev python3-numpy
   libosmesa6-dev libcairo2-dev
   libavcodec-dev libavformat-dev libswscale-dev libavutil-dev
 )

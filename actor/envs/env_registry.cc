@@ -18,6 +18,7 @@
 #include "actor/envs/mujoco/pendulum_envs.h"
 #include "actor/envs/mujoco/point_maze_env.h"
 #include "actor/envs/mujoco/twod_maze_env.h"
+#include "actor/envs/python/python_env.h"
 #include "common/env/frame_stack.h"
 #include "common/env/time_limit.h"
 
@@ -73,7 +74,15 @@ absl::StatusOr<std::unique_ptr<Environment>> MakeEnvironment(
     absl::string_view name, const EnvOptions& options) {
   absl::StatusOr<std::unique_ptr<Environment>> env;
   absl::string_view path = name;
-  if (absl::ConsumePrefix(&path, "mjcf:")) {
+  if (!options.python_kwargs.empty() && !IsPythonEnvName(name)) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "--env_kwargs is for Python environments (python:... or gym:...), "
+        "not ",
+        name));
+  }
+  if (IsPythonEnvName(name)) {
+    env = MakePythonEnv(name, options.python_kwargs);
+  } else if (absl::ConsumePrefix(&path, "mjcf:")) {
     if (path.empty()) {
       return absl::InvalidArgumentError(
           "mjcf: needs a path, e.g. --env=mjcf:/path/model.xml");
@@ -87,7 +96,7 @@ absl::StatusOr<std::unique_ptr<Environment>> MakeEnvironment(
       return absl::NotFoundError(absl::StrCat(
           "unknown environment '", parsed->task,
           "'; registered: ", absl::StrJoin(RegisteredEnvironments(), ", "),
-          ", or mjcf:/path/model.xml"));
+          ", or mjcf:/path/model.xml, python:MODULE:CALLABLE, gym:ID"));
     }
     env = factory->second(*parsed);
   }

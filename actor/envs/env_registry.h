@@ -18,11 +18,15 @@ struct EnvOptions {
   // > 1: each observation is the last `frame_stack` ones, oldest first
   // (see common/env/frame_stack.h); 1: as the environment gives them.
   int64_t frame_stack = 1;
+  // A Python environment's factory keyword arguments, a JSON object (see
+  // actor/envs/python/python_env.h); empty: none.
+  std::string python_kwargs;
 };
 
 // A registered name ("HalfCheetah", ...), the same with task options
 // ("HalfCheetah:ctrl_cost=0.2,max_episode_steps=500": see env_options.h),
-// or "mjcf:/path/model.xml", wrapped in its time limit and then as
+// "mjcf:/path/model.xml", "python:MODULE:CALLABLE" or "gym:ID" (see
+// actor/envs/python/python_env.h), wrapped in its time limit and then as
 // `options` say. An unknown name is an error that lists the valid ones, an
 // unknown task option one that lists the task's.
 absl::StatusOr<std::unique_ptr<Environment>> MakeEnvironment(

@@ -184,6 +184,7 @@ class Session {
           "the learner's run config: ", actor_config.status().message()));
     }
     actor_config->env = config_.env;
+    actor_config->env_options.python_kwargs = config_.env_kwargs;
     actor_config->num_envs = config_.num_envs;
     actor_config->seed =
         config_.seed.has_value()
@@ -355,7 +356,7 @@ uint64_t ActorEnvSeed(uint64_t run_seed, int64_t actor_id) {
 absl::Status RunRemoteActor(const RemoteActorConfig& config,
                             const std::atomic<bool>& stop) {
   absl::StatusOr<std::unique_ptr<Environment>> probe =
-      MakeEnvironment(config.env);
+      MakeEnvironment(config.env, EnvOptions{1, config.env_kwargs});
   if (!probe.ok()) return probe.status();
   const EnvSpec spec = (*probe)->spec();
   grpc::ChannelArguments arguments;

@@ -17,6 +17,7 @@ namespace vantage {
 struct RemoteActorConfig {
   std::string learner = "127.0.0.1:50051";  // HOST:PORT
   std::string env = "InvertedPendulum";
+  std::string env_kwargs;  // a Python environment's factory arguments (JSON)
   int num_envs = 1;
   // The environments' seed. Absent: ActorEnvSeed of the run's seed and the
   // actor id of the registration, so that actors started with the same

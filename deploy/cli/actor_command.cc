@@ -28,6 +28,7 @@ int RunActor(const std::vector<std::string>&) {
   RemoteActorConfig config;
   config.learner = absl::GetFlag(FLAGS_learner);
   if (FlagGiven("env")) config.env = absl::GetFlag(FLAGS_env);
+  config.env_kwargs = absl::GetFlag(FLAGS_env_kwargs);
   config.num_envs = absl::GetFlag(FLAGS_envs);
   if (FlagGiven("seed")) config.seed = absl::GetFlag(FLAGS_seed);
   config.name = absl::GetFlag(FLAGS_name);
@@ -64,9 +65,9 @@ Command ActorCommand() {
       "reconnects run out (exit 1). Without --seed its environments' seed\n"
       "comes from the run's seed and the actor id the learner assigns, so\n"
       "actors started alike (a Deployment's pods) reset differently.";
-  command.flags = {
-      "learner",           "env",           "envs", "seed", "name", "metrics",
-      "metrics_port_file", "max_reconnects"};
+  command.flags = {"learner",       "env",  "env_kwargs", "envs",
+                   "seed",          "name", "metrics",    "metrics_port_file",
+                   "max_reconnects"};
   for (const std::string& name : SecurityFlagNames()) {
     command.flags.push_back(name);
   }

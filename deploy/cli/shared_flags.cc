@@ -3,7 +3,11 @@
 #include "absl/flags/flag.h"
 
 ABSL_FLAG(std::string, env, "",
-          "environment name (see `vantage envs`) or mjcf:PATH");
+          "environment name (see `vantage envs`), mjcf:PATH, "
+          "python:MODULE:CALLABLE or gym:ID");
+ABSL_FLAG(std::string, env_kwargs, "",
+          "a Python environment's factory keyword arguments, a JSON object "
+          "(python:... and gym:... environments only)");
 ABSL_FLAG(int, envs, 1, "environments stepped together");
 ABSL_FLAG(uint64_t, seed, 0, "random seed");
 ABSL_FLAG(std::string, learner, "", "the learner's HOST:PORT");

@@ -10,6 +10,7 @@
 #include "absl/flags/declare.h"
 
 ABSL_DECLARE_FLAG(std::string, env);
+ABSL_DECLARE_FLAG(std::string, env_kwargs);
 ABSL_DECLARE_FLAG(int, envs);
 ABSL_DECLARE_FLAG(uint64_t, seed);
 ABSL_DECLARE_FLAG(std::string, learner);

@@ -353,6 +353,7 @@ absl::StatusOr<pid_t> Supervisor::StartActor(int i) {
       "actor",
       "--learner=127.0.0.1:" + ports_[i % learner_count_],
       "--env=" + run_.training().env(),
+      "--env_kwargs=" + run_.training().env_kwargs(),
       absl::StrCat("--envs=", run_.distributed().envs_per_actor()),
       absl::StrCat("--seed=", run_.training().seed() + i),
       absl::StrCat("--name=actor-", i)};

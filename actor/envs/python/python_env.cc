@@ -1,0 +1,499 @@
+#include "actor/envs/python/python_env.h"
+
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <exception>
+#include <utility>
+#include <vector>
+
+#include "absl/strings/match.h"
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_join.h"
+#include "absl/strings/strip.h"
+#include "actor/envs/python/python_runtime.h"
+#include "common/util/state_bytes.h"
+
+namespace py = pybind11;
+
+namespace vantage {
+namespace {
+
+constexpr char kStateKind[] = "python_env";
+constexpr uint32_t kStateVersion = 1;
+
+std::string ShapeText(const std::vector<int64_t>& shape) {
+  return shape.size() == 1 ? absl::StrCat("(", shape[0], ",)")
+                           : absl::StrCat("(", absl::StrJoin(shape, ", "), ")");
+}
+
+// What an observation must look like, from the observation space.
+struct ObservationLayout {
+  std::vector<int64_t> shape;  // as the environment gives it
+  char kind = 'f';             // numpy's kind of the space's dtype
+  // uint8 with three dimensions: an image, height x width x channels as
+  // Gymnasium's image spaces are, sent channels first.
+  bool image = false;
+};
+
+// Runs `call` (which uses Python) with the GIL held; a Python exception
+// becomes the caller's error naming `what`, any other C++ exception from
+// pybind11 (a failed cast) too.
+template <typename Result, typename Call>
+absl::StatusOr<Result> WithPython(const std::string& what, Call&& call) {
+  py::gil_scoped_acquire gil;
+  try {
+    return call();
+  } catch (py::error_already_set& error) {
+    return PythonError(error, what);
+  } catch (const std::exception& error) {
+    return absl::InvalidArgumentError(absl::StrCat(what, ": ", error.what()));
+  }
+}
+
+class PythonEnv final : public Environment {
+ public:
+  static absl::StatusOr<std::unique_ptr<Environment>> Create(
+      const std::string& name, const std::string& kwargs_json) {
+    EnsurePythonInterpreter();
+    std::unique_ptr<PythonEnv> env;
+    {
+      py::gil_scoped_acquire gil;  // its members are Python objects
+      env.reset(new PythonEnv());
+    }
+    env->spec_.name = name;
+    absl::StatusOr<bool> made =
+        WithPython<bool>(absl::StrCat(name, ": the factory"), [&] {
+          env->env_ = PythonBridge().attr("make")(name, kwargs_json);
+          env->reset_ = env->env_.attr("reset");
+          env->step_ = env->env_.attr("step");
+          return true;
+        });
+    if (!made.ok()) return made.status();
+    absl::StatusOr<bool> described = WithPython<bool>(
+        absl::StrCat(name, ": its spaces"), [&] { return env->Describe(); });
+    if (!described.ok()) return described.status();
+    if (absl::Status status = CheckObservationLayout(env->spec_);
+        !status.ok()) {
+      return absl::InvalidArgumentError(
+          absl::StrCat(name, ": ", status.message()));
+    }
+    return std::unique_ptr<Environment>(std::move(env));
+  }
+
+  ~PythonEnv() override {
+    py::gil_scoped_acquire gil;
+    try {
+      if (env_ && py::hasattr(env_, "close")) env_.attr("close")();
+    } catch (py::error_already_set& error) {
+      (void)PythonError(error, absl::StrCat(spec_.name, ": close()"));
+    }
+    step_ = py::object();
+    reset_ = py::object();
+    env_ = py::object();
+  }
+
+  const EnvSpec& spec() const override { return spec_; }
+
+  absl::Status Reset(uint64_t seed, absl::Span<double> observation) override {
+    if (absl::Status status = CheckObservationBuffer(spec_, observation);
+        !status.ok()) {
+      return status;
+    }
+    absl::StatusOr<bool> done = WithPython<bool>(
+        absl::StrCat(spec_.name, ": reset()"), [&]() -> absl::StatusOr<bool> {
+          py::object result = reset_(py::arg("seed") = seed);
+          if (!py::isinstance<py::tuple>(result) || py::len(result) != 2) {
+            return absl::InvalidArgumentError(absl::StrCat(
+                spec_.name, ": reset() returned ",
+                py::str(result.get_type().attr("__name__")).cast<std::string>(),
+                ", not (observation, info)"));
+          }
+          absl::Status written = WriteObservation(result.cast<py::tuple>()[0],
+                                                  "reset()", observation);
+          if (!written.ok()) return written;
+          return true;
+        });
+    if (!done.ok()) return done.status();
+    needs_reset_ = false;
+    return absl::OkStatus();
+  }
+
+  absl::StatusOr<StepResult> Step(absl::Span<const double> action,
+                                  absl::Span<double> observation) override {
+    if (absl::Status status =
+            CheckStep(spec_, needs_reset_, action, observation);
+        !status.ok()) {
+      return status;
+    }
+    absl::StatusOr<StepResult> result = WithPython<StepResult>(
+        absl::StrCat(spec_.name, ": step()"),
+        [&]() -> absl::StatusOr<StepResult> {
+          py::object out = step_(Action(action));
+          if (!py::isinstance<py::tuple>(out) || py::len(out) != 5) {
+            return absl::InvalidArgumentError(absl::StrCat(
+                spec_.name,
+                ": step() must return (observation, reward, terminated, "
+                "truncated, info) as Gymnasium does; it returned ",
+                py::isinstance<py::tuple>(out)
+                    ? absl::StrCat("a tuple of ", py::len(out))
+                    : py::str(out.get_type().attr("__name__"))
+                          .cast<std::string>()));
+          }
+          py::tuple parts = out.cast<py::tuple>();
+          absl::Status written =
+              WriteObservation(parts[0], "step()", observation);
+          if (!written.ok()) return written;
+          StepResult step;
+          step.reward = parts[1].cast<double>();
+          if (!std::isfinite(step.reward)) {
+            return absl::InvalidArgumentError(
+                absl::StrCat(spec_.name, ": step() returned the reward ",
+                             step.reward, ", which is not finite"));
+          }
+          step.terminated = parts[2].cast<bool>();
+          step.truncated = !step.terminated && parts[3].cast<bool>();
+          return step;
+        });
+    if (!result.ok()) {
+      // The episode's state is unknown after an error.
+      needs_reset_ = true;
+      return result.status();
+    }
+    if (result->terminated || result->truncated) needs_reset_ = true;
+    return result;
+  }
+
+  absl::StatusOr<std::string> SaveState() const override {
+    return WithPython<std::string>(
+        absl::StrCat(spec_.name, ": get_state()"),
+        [&]() -> absl::StatusOr<std::string> {
+          if (!py::hasattr(env_, "get_state")) {
+            return absl::UnimplementedError(absl::StrCat(
+                spec_.name,
+                " has no get_state() and set_state(); its episodes restart "
+                "on resume"));
+          }
+          py::bytes pickled = py::module_::import("pickle").attr("dumps")(
+              env_.attr("get_state")());
+          StateWriter writer(kStateKind, kStateVersion);
+          writer.PutBytes(spec_.name);
+          writer.PutBool(needs_reset_);
+          writer.PutBytes(std::string(pickled));
+          return std::move(writer).Finish();
+        });
+  }
+
+  absl::Status RestoreState(absl::string_view state) override {
+    StateReader reader(state, kStateKind, kStateVersion,
+                       absl::StrCat(spec_.name, ": state"));
+    reader.ExpectEqual("the environment", reader.GetBytes("name"), spec_.name);
+    const bool needs_reset = reader.GetBool("needs_reset");
+    const std::string pickled(reader.GetBytes("get_state()"));
+    if (absl::Status status = reader.Finish(); !status.ok()) return status;
+    absl::StatusOr<bool> restored = WithPython<bool>(
+        absl::StrCat(spec_.name, ": set_state()"),
+        [&]() -> absl::StatusOr<bool> {
+          if (!py::hasattr(env_, "set_state")) {
+            return absl::InvalidArgumentError(absl::StrCat(
+                spec_.name, " has get_state() but no set_state()"));
+          }
+          env_.attr("set_state")(
+              py::module_::import("pickle").attr("loads")(py::bytes(pickled)));
+          return true;
+        });
+    if (!restored.ok()) return restored.status();
+    needs_reset_ = needs_reset;
+    return absl::OkStatus();
+  }
+
+  absl::StatusOr<Frame> Render(int width, int height) override {
+    if (width < 1 || height < 1) {
+      return absl::InvalidArgumentError("a frame needs width, height >= 1");
+    }
+    return WithPython<Frame>(
+        absl::StrCat(spec_.name, ": render()"), [&]() -> absl::StatusOr<Frame> {
+          if (!py::hasattr(env_, "render")) {
+            return absl::UnimplementedError(
+                absl::StrCat(spec_.name, " has no render()"));
+          }
+          py::object image = env_.attr("render")();
+          if (image.is_none()) {
+            return absl::UnimplementedError(absl::StrCat(
+                spec_.name,
+                ": render() returned None (make the env with "
+                "render_mode=\"rgb_array\", e.g. through --env_kwargs)"));
+          }
+          auto pixels = py::array_t<uint8_t, py::array::c_style>::ensure(image);
+          if (!pixels || pixels.ndim() != 3 || pixels.shape(2) != 3) {
+            return absl::InvalidArgumentError(absl::StrCat(
+                spec_.name,
+                ": render() must return an RGB array of height x width x 3 "
+                "uint8 values"));
+          }
+          return Resized(pixels, width, height);
+        });
+  }
+
+ private:
+  PythonEnv() = default;
+
+  // The spec from the spaces (GIL held).
+  absl::StatusOr<bool> Describe() {
+    py::module_& bridge = PythonBridge();
+    py::tuple observation = bridge.attr("describe_space")(
+        env_.attr("observation_space"), "observation");
+    if (observation[0].cast<std::string>() != "box") {
+      return absl::InvalidArgumentError(
+          absl::StrCat(spec_.name,
+                       ": the observation space is Discrete; vantage takes box "
+                       "observations (one-hot encode it into a Box)"));
+    }
+    if (absl::Status status = DescribeObservations(observation); !status.ok()) {
+      return status;
+    }
+    py::tuple action =
+        bridge.attr("describe_space")(env_.attr("action_space"), "action");
+    if (absl::Status status = DescribeActions(action); !status.ok()) {
+      return status;
+    }
+    spec_.max_episode_steps =
+        bridge.attr("max_episode_steps")(env_).cast<int64_t>();
+    spec_.control_dt = 1.0 / 30;
+    py::object metadata = py::getattr(env_, "metadata", py::none());
+    if (py::isinstance<py::dict>(metadata) && metadata.contains("render_fps") &&
+        !metadata["render_fps"].is_none()) {
+      const double fps = metadata["render_fps"].cast<double>();
+      if (fps > 0) spec_.control_dt = 1.0 / fps;
+    }
+    return true;
+  }
+
+  absl::Status DescribeObservations(const py::tuple& space) {
+    layout_.shape = space[2].cast<std::vector<int64_t>>();
+    const std::string dtype = space[3].cast<std::string>();
+    layout_.kind = dtype.size() > 1 ? dtype[1] : '?';
+    if (std::string("fiub").find(layout_.kind) == std::string::npos) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          spec_.name, ": observations of dtype ", dtype,
+          " are not numbers; vantage takes float, int, uint or bool boxes"));
+    }
+    int64_t size = 1;
+    for (int64_t d : layout_.shape) {
+      if (d < 1) {
+        return absl::InvalidArgumentError(
+            absl::StrCat(spec_.name, ": the observation shape ",
+                         ShapeText(layout_.shape), " has an empty dimension"));
+      }
+      size *= d;
+    }
+    spec_.observation_size = size;
+    layout_.image = dtype == "|u1" && layout_.shape.size() == 3;
+    if (layout_.image) {
+      spec_.observation_shape = {layout_.shape[2], layout_.shape[0],
+                                 layout_.shape[1]};
+      const std::vector<double> high = space[5].cast<std::vector<double>>();
+      const double top = *std::max_element(high.begin(), high.end());
+      spec_.observation_high =
+          static_cast<int64_t>(std::clamp(top, 1.0, 255.0));
+    }
+    return absl::OkStatus();
+  }
+
+  absl::Status DescribeActions(const py::tuple& space) {
+    if (space[0].cast<std::string>() == "discrete") {
+      spec_.discrete = true;
+      spec_.action_size = space[1].cast<int64_t>();
+      if (spec_.action_size < 1) {
+        return absl::InvalidArgumentError(
+            absl::StrCat(spec_.name, ": the action space has no actions"));
+      }
+      return absl::OkStatus();
+    }
+    const std::string dtype = space[3].cast<std::string>();
+    if (dtype.size() < 2 || dtype[1] != 'f') {
+      return absl::InvalidArgumentError(absl::StrCat(
+          spec_.name, ": a box action space of dtype ", dtype,
+          "; vantage's continuous actions are floats (use Discrete for a "
+          "choice)"));
+    }
+    action_dtype_ = py::dtype(dtype);
+    action_shape_ = space[2].cast<std::vector<int64_t>>();
+    spec_.action_low = space[4].cast<std::vector<double>>();
+    spec_.action_high = space[5].cast<std::vector<double>>();
+    spec_.action_size = static_cast<int64_t>(spec_.action_low.size());
+    for (int64_t i = 0; i < spec_.action_size; ++i) {
+      if (!std::isfinite(spec_.action_low[i]) ||
+          !std::isfinite(spec_.action_high[i]) ||
+          spec_.action_low[i] > spec_.action_high[i]) {
+        return absl::InvalidArgumentError(absl::StrCat(
+            spec_.name, ": the action space's bounds at ", i, " are [",
+            spec_.action_low[i], ", ", spec_.action_high[i],
+            "]; vantage needs finite bounds"));
+      }
+    }
+    if (spec_.action_size < 1) {
+      return absl::InvalidArgumentError(
+          absl::StrCat(spec_.name, ": the action space has no dimensions"));
+    }
+    return absl::OkStatus();
+  }
+
+  // The action as the env takes it: an int, or an array of the space's
+  // shape and dtype, clipped to its bounds (GIL held).
+  py::object Action(absl::Span<const double> action) const {
+    if (spec_.discrete) return py::int_(static_cast<int64_t>(action[0]));
+    py::array out(action_dtype_, action_shape_);
+    const size_t n = action.size();
+    if (action_dtype_.itemsize() == 4) {
+      auto* values = static_cast<float*>(out.mutable_data());
+      for (size_t i = 0; i < n; ++i) {
+        values[i] = static_cast<float>(
+            std::clamp(action[i], spec_.action_low[i], spec_.action_high[i]));
+      }
+    } else if (action_dtype_.itemsize() == 8) {
+      auto* values = static_cast<double*>(out.mutable_data());
+      for (size_t i = 0; i < n; ++i) {
+        values[i] =
+            std::clamp(action[i], spec_.action_low[i], spec_.action_high[i]);
+      }
+    } else {
+      py::array_t<double> wide(action_shape_);
+      for (size_t i = 0; i < n; ++i) {
+        wide.mutable_data()[i] =
+            std::clamp(action[i], spec_.action_low[i], spec_.action_high[i]);
+      }
+      return wide.attr("astype")(action_dtype_);
+    }
+    return std::move(out);
+  }
+
+  // Checks an observation against the space and writes it flat (images
+  // channels first) into `out` (GIL held).
+  absl::Status WriteObservation(py::handle value, const char* call,
+                                absl::Span<double> out) const {
+    py::array array = py::array::ensure(value);
+    if (!array) {
+      return absl::InvalidArgumentError(
+          absl::StrCat(spec_.name, ": ", call,
+                       " returned an observation that is not an array"));
+    }
+    std::vector<int64_t> shape(array.shape(), array.shape() + array.ndim());
+    if (shape != layout_.shape) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          spec_.name, ": ", call, " returned an observation of shape ",
+          ShapeText(shape), "; the observation space's is ",
+          ShapeText(layout_.shape)));
+    }
+    const char kind = array.dtype().kind();
+    const bool fits = layout_.image ? array.dtype().is(py::dtype::of<uint8_t>())
+                                    : kind == layout_.kind;
+    if (!fits) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          spec_.name, ": ", call, " returned an observation of dtype ",
+          py::str(array.dtype()).cast<std::string>(),
+          "; the observation space's is ", layout_.image ? "uint8" : "of kind ",
+          layout_.image ? "" : std::string(1, layout_.kind)));
+    }
+    if (layout_.image) {
+      auto pixels = py::array_t<uint8_t, py::array::c_style>::ensure(array);
+      const int64_t h = shape[0], w = shape[1], c = shape[2];
+      const uint8_t* in = pixels.data();
+      for (int64_t y = 0; y < h; ++y) {
+        for (int64_t x = 0; x < w; ++x) {
+          for (int64_t k = 0; k < c; ++k) {
+            out[(k * h + y) * w + x] = in[(y * w + x) * c + k];
+          }
+        }
+      }
+      return absl::OkStatus();
+    }
+    auto values =
+        py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(
+            array);
+    std::memcpy(out.data(), values.data(), out.size() * sizeof(double));
+    for (size_t i = 0; i < out.size(); ++i) {
+      if (!std::isfinite(out[i])) {
+        return absl::InvalidArgumentError(absl::StrCat(
+            spec_.name, ": ", call, " returned an observation whose value ", i,
+            " is ", out[i], ", which is not finite"));
+      }
+    }
+    return absl::OkStatus();
+  }
+
+  // `pixels` (height x width x 3) scaled to width x height, nearest pixel.
+  static Frame Resized(const py::array_t<uint8_t, py::array::c_style>& pixels,
+                       int width, int height) {
+    const int64_t in_h = pixels.shape(0), in_w = pixels.shape(1);
+    Frame frame;
+    frame.width = width;
+    frame.height = height;
+    frame.rgb.resize(static_cast<size_t>(3) * width * height);
+    const uint8_t* in = pixels.data();
+    for (int y = 0; y < height; ++y) {
+      const int64_t sy = y * in_h / height;
+      for (int x = 0; x < width; ++x) {
+        const int64_t sx = x * in_w / width;
+        std::memcpy(&frame.rgb[(static_cast<size_t>(y) * width + x) * 3],
+                    in + (sy * in_w + sx) * 3, 3);
+      }
+    }
+    return frame;
+  }
+
+  EnvSpec spec_;
+  ObservationLayout layout_;
+  py::dtype action_dtype_ = py::dtype::of<float>();
+  std::vector<int64_t> action_shape_;
+  py::object env_;
+  py::object reset_;
+  py::object step_;
+  bool needs_reset_ = true;
+};
+
+}  // namespace
+
+bool IsPythonEnvName(absl::string_view name) {
+  return absl::StartsWith(name, "python:") || absl::StartsWith(name, "gym:");
+}
+
+absl::StatusOr<std::unique_ptr<Environment>> MakePythonEnv(
+    absl::string_view name, const std::string& kwargs_json) {
+  const std::string target(name);
+  absl::string_view rest = name;
+  if (absl::ConsumePrefix(&rest, "python:")) {
+    const size_t colon = rest.rfind(':');
+    if (colon == absl::string_view::npos || colon == 0 ||
+        colon + 1 == rest.size()) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          "'", name,
+          "' names no factory: use python:MODULE:CALLABLE (MODULE an "
+          "importable module or a .py file)"));
+    }
+  } else if (absl::ConsumePrefix(&rest, "gym:") && rest.empty()) {
+    return absl::InvalidArgumentError("gym: needs an id, e.g. gym:CartPole-v1");
+  }
+  return PythonEnv::Create(target, kwargs_json);
+}
+
+absl::StatusOr<double> PlainPythonStepsPerSecond(
+    absl::string_view name, const std::string& kwargs_json,
+    const std::vector<double>& action, int64_t steps) {
+  EnsurePythonInterpreter();
+  const std::string target(name);
+  return WithPython<double>(absl::StrCat(target, ": plain Python loop"), [&] {
+    py::object env = PythonBridge().attr("make")(target, kwargs_json);
+    const double rate =
+        PythonBridge().attr("plain_loop")(env, action, steps).cast<double>();
+    if (py::hasattr(env, "close")) env.attr("close")();
+    return rate;
+  });
+}
+
+}  // namespace vantage

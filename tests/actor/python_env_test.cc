@@ -1,0 +1,281 @@
+// Python environments through the embedded interpreter: the test tree's
+// CartPole, Pendulum and image env (tests/python_envs, on PYTHONPATH with a
+// stand-in gymnasium package), their specs, seeds, state and every error
+// the bridge names.
+
+#include "actor/envs/python/python_env.h"
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "absl/strings/str_cat.h"
+#include "actor/envs/env_registry.h"
+#include "actor/vector_env.h"
+#include "gmock/gmock.h"
+#include "gtest/gtest.h"
+
+namespace vantage {
+namespace {
+
+using ::testing::HasSubstr;
+
+std::unique_ptr<Environment> Make(const std::string& name,
+                                  const std::string& kwargs = "") {
+  EnvOptions options;
+  options.python_kwargs = kwargs;
+  absl::StatusOr<std::unique_ptr<Environment>> env =
+      MakeEnvironment(name, options);
+  EXPECT_TRUE(env.ok()) << env.status();
+  return env.ok() ? *std::move(env) : nullptr;
+}
+
+std::string Error(const std::string& name, const std::string& kwargs = "") {
+  EnvOptions options;
+  options.python_kwargs = kwargs;
+  absl::StatusOr<std::unique_ptr<Environment>> env =
+      MakeEnvironment(name, options);
+  if (!env.ok()) return std::string(env.status().message());
+  std::vector<double> observation((*env)->spec().observation_size);
+  if (absl::Status status = (*env)->Reset(1, absl::MakeSpan(observation));
+      !status.ok()) {
+    return std::string(status.message());
+  }
+  for (int i = 0; i < 3; ++i) {
+    absl::StatusOr<StepResult> step =
+        (*env)->Step({0.0}, absl::MakeSpan(observation));
+    if (!step.ok()) return std::string(step.status().message());
+  }
+  return "";
+}
+
+TEST(PythonEnvTest, CartPoleDescribesItselfThroughItsSpaces) {
+  for (const std::string& name :
+       {std::string("python:cartpole:make"),
+        std::string("python:tests/python_envs/cartpole.py:make"),
+        std::string("gym:CartPole-v1")}) {
+    std::unique_ptr<Environment> env = Make(name);
+    ASSERT_NE(env, nullptr) << name;
+    const EnvSpec& spec = env->spec();
+    EXPECT_EQ(spec.name, name);
+    EXPECT_EQ(spec.observation_size, 4);
+    EXPECT_TRUE(spec.observation_shape.empty());
+    EXPECT_FALSE(spec.byte_observations());
+    EXPECT_TRUE(spec.discrete);
+    EXPECT_EQ(spec.action_size, 2);
+    EXPECT_EQ(spec.max_episode_steps, 500);
+    EXPECT_DOUBLE_EQ(spec.control_dt, 1.0 / 50);
+  }
+}
+
+// A pole left alone falls: terminated (not truncated) within 500 steps,
+// reward 1 a step; with max_episode_steps=5 from the kwargs the env
+// truncates first.
+TEST(PythonEnvTest, StepsTerminatesAndTakesKwargs) {
+  std::unique_ptr<Environment> env = Make("python:cartpole:make");
+  ASSERT_NE(env, nullptr);
+  std::vector<double> observation(4);
+  ASSERT_TRUE(env->Reset(3, absl::MakeSpan(observation)).ok());
+  for (double value : observation) EXPECT_LE(std::abs(value), 0.05);
+  int steps = 0;
+  StepResult last;
+  while (steps < 500) {
+    absl::StatusOr<StepResult> step =
+        env->Step({1.0}, absl::MakeSpan(observation));
+    ASSERT_TRUE(step.ok()) << step.status();
+    EXPECT_EQ(step->reward, 1.0);
+    ++steps;
+    last = *step;
+    if (step->terminated || step->truncated) break;
+  }
+  EXPECT_TRUE(last.terminated);
+  EXPECT_LT(steps, 100);
+  EXPECT_FALSE(env->Step({1.0}, absl::MakeSpan(observation)).ok());
+
+  std::unique_ptr<Environment> short_env =
+      Make("python:cartpole:make", R"({"max_episode_steps": 5})");
+  ASSERT_NE(short_env, nullptr);
+  EXPECT_EQ(short_env->spec().max_episode_steps, 5);
+  ASSERT_TRUE(short_env->Reset(3, absl::MakeSpan(observation)).ok());
+  for (int i = 0; i < 5; ++i) {
+    absl::StatusOr<StepResult> step =
+        short_env->Step({i % 2 == 0 ? 0.0 : 1.0}, absl::MakeSpan(observation));
+    ASSERT_TRUE(step.ok()) << step.status();
+    EXPECT_EQ(step->truncated, i == 4);
+    EXPECT_FALSE(step->terminated);
+  }
+}
+
+std::vector<double> Rollout(const std::string& name, uint64_t seed) {
+  absl::StatusOr<std::unique_ptr<VectorEnv>> envs =
+      VectorEnv::Create(name, 3, seed);
+  EXPECT_TRUE(envs.ok()) << envs.status();
+  if (!envs.ok()) return {};
+  EXPECT_TRUE((*envs)->Reset().ok());
+  std::vector<double> seen;
+  const EnvSpec& spec = (*envs)->spec();
+  for (int t = 0; t < 300; ++t) {
+    std::vector<double> actions;
+    for (int i = 0; i < 3; ++i) {
+      if (spec.discrete) {
+        actions.push_back((t + i) % static_cast<int>(spec.action_size));
+      } else {
+        actions.push_back(std::sin(0.1 * t + i));
+      }
+    }
+    EXPECT_TRUE((*envs)->Step(actions).ok());
+    seen.insert(seen.end(), (*envs)->observations().begin(),
+                (*envs)->observations().end());
+  }
+  return seen;
+}
+
+TEST(PythonEnvTest, TheSameSeedGivesTheSameEpisodes) {
+  for (const std::string& name :
+       {std::string("python:cartpole:make"), std::string("gym:Pendulum-v1"),
+        std::string("python:image_env:make")}) {
+    const std::vector<double> first = Rollout(name, 11);
+    EXPECT_EQ(first, Rollout(name, 11)) << name;
+    EXPECT_NE(first, Rollout(name, 12)) << name;
+  }
+}
+
+TEST(PythonEnvTest, ABoxActionIsClippedToItsBounds) {
+  std::unique_ptr<Environment> env = Make("python:pendulum:make");
+  ASSERT_NE(env, nullptr);
+  const EnvSpec& spec = env->spec();
+  EXPECT_FALSE(spec.discrete);
+  EXPECT_EQ(spec.action_size, 1);
+  EXPECT_EQ(spec.action_low, std::vector<double>{-2.0});
+  EXPECT_EQ(spec.action_high, std::vector<double>{2.0});
+  EXPECT_EQ(spec.max_episode_steps, 200);
+  std::vector<double> a(3), b(3);
+  std::unique_ptr<Environment> other = Make("python:pendulum:make");
+  ASSERT_TRUE(env->Reset(5, absl::MakeSpan(a)).ok());
+  ASSERT_TRUE(other->Reset(5, absl::MakeSpan(b)).ok());
+  absl::StatusOr<StepResult> far = env->Step({50.0}, absl::MakeSpan(a));
+  absl::StatusOr<StepResult> bound = other->Step({2.0}, absl::MakeSpan(b));
+  ASSERT_TRUE(far.ok() && bound.ok());
+  EXPECT_EQ(a, b);
+  EXPECT_EQ(far->reward, bound->reward);
+}
+
+// Gymnasium's images are height x width x channels; vantage's are
+// channels first, and travel as bytes.
+TEST(PythonEnvTest, ImagesAreBytesChannelsFirst) {
+  std::unique_ptr<Environment> env = Make("python:image_env:make");
+  ASSERT_NE(env, nullptr);
+  const EnvSpec& spec = env->spec();
+  EXPECT_EQ(spec.observation_shape, (std::vector<int64_t>{3, 10, 10}));
+  EXPECT_EQ(spec.observation_size, 300);
+  EXPECT_EQ(spec.observation_high, 255);
+  std::vector<double> observation(300);
+  ASSERT_TRUE(env->Reset(1, absl::MakeSpan(observation)).ok());
+  // The green corner: channel 1, row 9, column 9.
+  EXPECT_EQ(observation[(1 * 10 + 9) * 10 + 9], 255.0);
+  double red = 0;
+  for (int i = 0; i < 100; ++i) red += observation[i];
+  EXPECT_EQ(red, 255.0);  // one red dot
+}
+
+TEST(PythonEnvTest, ACartPoleStateRestoresExactly) {
+  std::unique_ptr<Environment> env = Make("python:cartpole:make");
+  ASSERT_NE(env, nullptr);
+  std::vector<double> observation(4);
+  ASSERT_TRUE(env->Reset(9, absl::MakeSpan(observation)).ok());
+  ASSERT_TRUE(env->Step({1.0}, absl::MakeSpan(observation)).ok());
+  absl::StatusOr<std::string> state = env->SaveState();
+  ASSERT_TRUE(state.ok()) << state.status();
+  std::vector<double> first, second;
+  for (int i = 0; i < 5; ++i) {
+    ASSERT_TRUE(env->Step({0.0}, absl::MakeSpan(observation)).ok());
+    first.insert(first.end(), observation.begin(), observation.end());
+  }
+  std::unique_ptr<Environment> restored = Make("python:cartpole:make");
+  ASSERT_TRUE(restored->RestoreState(*state).ok());
+  for (int i = 0; i < 5; ++i) {
+    ASSERT_TRUE(restored->Step({0.0}, absl::MakeSpan(observation)).ok());
+    second.insert(second.end(), observation.begin(), observation.end());
+  }
+  EXPECT_EQ(first, second);
+  EXPECT_FALSE(restored->RestoreState("not a state").ok());
+  // Pendulum offers no get_state().
+  std::unique_ptr<Environment> pendulum = Make("python:pendulum:make");
+  EXPECT_EQ(pendulum->SaveState().status().code(),
+            absl::StatusCode::kUnimplemented);
+}
+
+TEST(PythonEnvTest, RendersAnRgbFrameOfTheAskedSize) {
+  std::unique_ptr<Environment> env = Make("python:cartpole:make");
+  std::vector<double> observation(4);
+  ASSERT_TRUE(env->Reset(1, absl::MakeSpan(observation)).ok());
+  absl::StatusOr<Frame> frame = env->Render(64, 32);
+  ASSERT_TRUE(frame.ok()) << frame.status();
+  EXPECT_EQ(frame->width, 64);
+  EXPECT_EQ(frame->height, 32);
+  EXPECT_EQ(frame->rgb.size(), 64u * 32 * 3);
+  EXPECT_EQ(Make("python:pendulum:make")->Render(8, 8).status().code(),
+            absl::StatusCode::kUnimplemented);
+}
+
+TEST(PythonEnvTest, EveryErrorNamesTheEnvTheCallAndTheCause) {
+  EXPECT_THAT(Error("python:no_such_module:make"),
+              HasSubstr("python:no_such_module:make: the factory: "
+                        "ModuleNotFoundError: No module named "
+                        "'no_such_module'"));
+  EXPECT_THAT(Error("python:cartpole:no_such_factory"),
+              HasSubstr("AttributeError"));
+  EXPECT_THAT(Error("python:broken_envs:not_callable"),
+              HasSubstr("is not callable"));
+  EXPECT_THAT(Error("python:broken_envs:raises_in_factory"),
+              HasSubstr("the factory: RuntimeError: no simulator licence "
+                        "(broken_envs.py:"));
+  EXPECT_THAT(Error("python:broken_envs:raises_in_step"),
+              HasSubstr("python:broken_envs:raises_in_step: step(): "
+                        "ValueError: the simulator crashed on 0 "
+                        "(broken_envs.py:"));
+  EXPECT_THAT(Error("python:broken_envs:raises_in_step"),
+              HasSubstr("in fail)"));
+  EXPECT_THAT(Error("python:broken_envs:wrong_shape"),
+              HasSubstr("reset() returned an observation of shape (3,); the "
+                        "observation space's is (4,)"));
+  EXPECT_THAT(Error("python:broken_envs:wrong_dtype"),
+              HasSubstr("reset() returned an observation of dtype int64"));
+  EXPECT_THAT(Error("python:broken_envs:nan_observation"),
+              HasSubstr("step() returned an observation whose value 1 is nan"));
+  EXPECT_THAT(Error("python:broken_envs:infinite_reward"),
+              HasSubstr("step() returned the reward inf, which is not finite"));
+  EXPECT_THAT(Error("python:broken_envs:old_gym_api"),
+              HasSubstr("step() must return (observation, reward, terminated, "
+                        "truncated, info) as Gymnasium does; it returned a "
+                        "tuple of 4"));
+  EXPECT_THAT(Error("python:broken_envs:dict_observations"),
+              HasSubstr("the observation space is a Dict space; vantage takes "
+                        "a box or a discrete space: flatten it"));
+  EXPECT_THAT(Error("python:cartpole"), HasSubstr("names no factory"));
+  EXPECT_THAT(Error("gym:"), HasSubstr("gym: needs an id"));
+  EXPECT_THAT(Error("python:cartpole:make", "[1, 2]"),
+              HasSubstr("--env_kwargs must be a JSON object"));
+  EXPECT_THAT(Error("python:cartpole:make", R"({"no_such": 1})"),
+              HasSubstr("TypeError"));
+  EXPECT_THAT(Error("Hopper", R"({"a": 1})"),
+              HasSubstr("--env_kwargs is for Python environments"));
+  // An action outside n never reaches Python.
+  std::unique_ptr<Environment> env = Make("python:cartpole:make");
+  std::vector<double> observation(4);
+  ASSERT_TRUE(env->Reset(1, absl::MakeSpan(observation)).ok());
+  EXPECT_THAT(
+      std::string(
+          env->Step({2.0}, absl::MakeSpan(observation)).status().message()),
+      HasSubstr("discrete action 2 is not an integer in [0, 2)"));
+}
+
+TEST(PythonEnvTest, APlainPythonLoopIsTimedForTheBench) {
+  absl::StatusOr<double> rate =
+      PlainPythonStepsPerSecond("python:cartpole:make", "", {1.0}, 2000);
+  ASSERT_TRUE(rate.ok()) << rate.status();
+  EXPECT_GT(*rate, 0.0);
+}
+
+}  // namespace
+}  // namespace vantage

@@ -1,0 +1,85 @@
+"""Environments that break the API in one way each, for the bridge's
+error messages."""
+
+import numpy as np
+
+from spaces import Box, Dict, Discrete
+from cartpole import CartPole
+
+
+def raises_in_factory():
+    raise RuntimeError("no simulator licence")
+
+
+class RaisesInStep(CartPole):
+    def step(self, action):
+        return self.fail(action)
+
+    def fail(self, action):
+        raise ValueError(f"the simulator crashed on {action}")
+
+
+class WrongShape(CartPole):
+    def reset(self, seed=None, options=None):
+        return np.zeros(3, dtype=np.float32), {}
+
+
+class WrongDtype(CartPole):
+    def reset(self, seed=None, options=None):
+        return np.zeros(4, dtype=np.int64), {}
+
+
+class NanObservation(CartPole):
+    def step(self, action):
+        obs, reward, terminated, truncated, info = super().step(action)
+        obs[1] = np.nan
+        return obs, reward, terminated, truncated, info
+
+
+class InfiniteReward(CartPole):
+    def step(self, action):
+        obs, _, terminated, truncated, info = super().step(action)
+        return obs, float("inf"), terminated, truncated, info
+
+
+class OldGymApi(CartPole):
+    def step(self, action):
+        obs, reward, terminated, truncated, info = super().step(action)
+        return obs, reward, terminated or truncated, info
+
+
+class DictObservations(CartPole):
+    def __init__(self):
+        super().__init__()
+        self.observation_space = Dict({"a": Box(-1, 1, shape=(2,))})
+
+
+def raises_in_step():
+    return RaisesInStep()
+
+
+def wrong_shape():
+    return WrongShape()
+
+
+def wrong_dtype():
+    return WrongDtype()
+
+
+def nan_observation():
+    return NanObservation()
+
+
+def infinite_reward():
+    return InfiniteReward()
+
+
+def old_gym_api():
+    return OldGymApi()
+
+
+def dict_observations():
+    return DictObservations()
+
+
+not_callable = 3
