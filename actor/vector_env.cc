@@ -1,9 +1,14 @@
 #include "actor/vector_env.h"
 
 #include <algorithm>
+#include <cstdio>
+#include <set>
+#include <string>
 #include <utility>
 
+#include "absl/status/status.h"
 #include "absl/strings/str_cat.h"
+#include "absl/synchronization/mutex.h"
 #include "actor/envs/env_registry.h"
 #include "common/util/state_bytes.h"
 
@@ -12,6 +17,16 @@ namespace {
 
 constexpr char kStateKind[] = "vector_env";
 constexpr uint32_t kStateVersion = 1;
+
+// Each distinct message once per process on stderr: every checkpoint of a
+// run repeats what the first one said.
+void SayOnce(absl::string_view message) {
+  static absl::Mutex mutex(absl::kConstInit);
+  static auto* said = new std::set<std::string>;
+  absl::MutexLock lock(&mutex);
+  if (!said->insert(std::string(message)).second) return;
+  std::fprintf(stderr, "%s\n", std::string(message).c_str());
+}
 
 absl::string_view AsBytes(const std::vector<uint8_t>& flags) {
   return absl::string_view(reinterpret_cast<const char*>(flags.data()),
@@ -133,9 +148,16 @@ absl::StatusOr<std::string> VectorEnv::SaveState() const {
     writer.PutI64(episode.length);
     writer.PutBool(episode.truncated);
   }
-  // The environments' states come last, one field each.
+  // The environments' states come last, one field each; empty for one
+  // that cannot save itself (a Python env without get_state()), whose
+  // episode restarts when the state is restored.
   for (const std::unique_ptr<Environment>& env : envs_) {
     absl::StatusOr<std::string> state = env->SaveState();
+    if (absl::IsUnimplemented(state.status())) {
+      SayOnce(state.status().message());
+      writer.PutBytes("");
+      continue;
+    }
     if (!state.ok()) return state.status();
     writer.PutBytes(*state);
   }
@@ -200,15 +222,21 @@ absl::Status VectorEnv::RestoreState(absl::string_view state) {
   // Each environment restores all or nothing, but one may refuse after
   // others took their new state: keep what they had to roll them back.
   std::vector<std::string> backups;
-  for (const std::unique_ptr<Environment>& env : envs_) {
-    absl::StatusOr<std::string> backup = env->SaveState();
+  for (size_t i = 0; i < m; ++i) {
+    if (env_states[i].empty()) {
+      backups.emplace_back();
+      continue;
+    }
+    absl::StatusOr<std::string> backup = envs_[i]->SaveState();
     if (!backup.ok()) return backup.status();
     backups.push_back(std::move(*backup));
   }
   for (size_t i = 0; i < m; ++i) {
+    if (env_states[i].empty()) continue;
     absl::Status status = envs_[i]->RestoreState(env_states[i]);
     if (status.ok()) continue;
     for (size_t j = 0; j < i; ++j) {
+      if (env_states[j].empty()) continue;
       if (absl::Status undo = envs_[j]->RestoreState(backups[j]); !undo.ok()) {
         return absl::InternalError(absl::StrCat(
             "env ", i, " refused its state (", status.message(),
@@ -227,6 +255,14 @@ absl::Status VectorEnv::RestoreState(absl::string_view state) {
   episode_returns_ = std::move(returns);
   episode_lengths_ = std::move(lengths);
   finished_ = std::move(finished);
+  for (size_t i = 0; i < m; ++i) {
+    if (!env_states[i].empty()) continue;
+    SayOnce(absl::StrCat(spec().name,
+                         " saved no state: its episodes restart on resume"));
+    if (absl::Status status = ResetOne(static_cast<int>(i)); !status.ok()) {
+      return status;
+    }
+  }
   return absl::OkStatus();
 }
 

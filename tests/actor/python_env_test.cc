@@ -205,6 +205,38 @@ TEST(PythonEnvTest, ACartPoleStateRestoresExactly) {
             absl::StatusCode::kUnimplemented);
 }
 
+// In a checkpoint's actor state: CartPole (get_state) continues exactly;
+// Pendulum (none) restarts its episodes and the state still restores.
+TEST(PythonEnvTest, AVectorOfThemResumesExactlyOrRestartsItsEpisodes) {
+  for (const std::string& name : {std::string("python:cartpole:make"),
+                                  std::string("python:pendulum:make")}) {
+    const bool exact = name == "python:cartpole:make";
+    absl::StatusOr<std::unique_ptr<VectorEnv>> envs =
+        VectorEnv::Create(name, 2, 4);
+    ASSERT_TRUE(envs.ok()) << envs.status();
+    ASSERT_TRUE((*envs)->Reset().ok());
+    const std::vector<double> action(2, 0.0);
+    for (int t = 0; t < 7; ++t) ASSERT_TRUE((*envs)->Step(action).ok());
+    absl::StatusOr<std::string> state = (*envs)->SaveState();
+    ASSERT_TRUE(state.ok()) << state.status();
+    ASSERT_TRUE((*envs)->Step(action).ok());
+    const std::vector<double> next((*envs)->observations().begin(),
+                                   (*envs)->observations().end());
+    absl::StatusOr<std::unique_ptr<VectorEnv>> resumed =
+        VectorEnv::Create(name, 2, 4);
+    ASSERT_TRUE(resumed.ok());
+    ASSERT_TRUE((*resumed)->RestoreState(*state).ok()) << name;
+    ASSERT_TRUE((*resumed)->Step(action).ok());
+    const std::vector<double> resumed_next((*resumed)->observations().begin(),
+                                           (*resumed)->observations().end());
+    if (exact) {
+      EXPECT_EQ(resumed_next, next);
+    } else {
+      EXPECT_NE(resumed_next, next);
+    }
+  }
+}
+
 TEST(PythonEnvTest, RendersAnRgbFrameOfTheAskedSize) {
   std::unique_ptr<Environment> env = Make("python:cartpole:make");
   std::vector<double> observation(4);
