@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "actor/envs/env_registry.h"
+#include "actor/envs/python/python_env.h"
 #include "actor/vector_env.h"
 #include "bench/fastest.h"
 #include "bench/raw_physics.h"
@@ -17,10 +18,29 @@ namespace {
 
 constexpr int kVectorEnvs = 16;
 
+// The fastest of five timed plain Python loops of the environment under the
+// benchmark's action, as the benchmarks keep the fastest repetition.
+absl::StatusOr<double> FastestPlainPythonLoop(
+    const std::string& env_name, const std::string& env_kwargs,
+    const std::vector<double>& action) {
+  double fastest = 0.0;
+  for (int repetition = 0; repetition < 5; ++repetition) {
+    absl::StatusOr<double> rate =
+        PlainPythonStepsPerSecond(env_name, env_kwargs, action, 20000);
+    if (!rate.ok()) return rate.status();
+    fastest = std::max(fastest, *rate);
+  }
+  return fastest;
+}
+
 }  // namespace
 
-int RunEnvBenchmark(const std::string& env_name) {
-  absl::StatusOr<std::unique_ptr<Environment>> made = MakeEnvironment(env_name);
+int RunEnvBenchmark(const std::string& env_name,
+                    const std::string& env_kwargs) {
+  EnvOptions options;
+  options.python_kwargs = env_kwargs;
+  absl::StatusOr<std::unique_ptr<Environment>> made =
+      MakeEnvironment(env_name, options);
   if (!made.ok()) {
     std::fprintf(stderr, "vantage bench env: %s\n",
                  std::string(made.status().message()).c_str());
@@ -53,7 +73,7 @@ int RunEnvBenchmark(const std::string& env_name) {
   })->Apply(UseFastestOfRepetitions);
 
   absl::StatusOr<std::unique_ptr<VectorEnv>> vector =
-      VectorEnv::Create(env_name, kVectorEnvs, 0);
+      VectorEnv::Create(env_name, kVectorEnvs, 0, options);
   if (!vector.ok() || !(*vector)->Reset().ok()) return 1;
   std::vector<double> actions;
   for (int i = 0; i < kVectorEnvs; ++i) {
@@ -79,6 +99,20 @@ int RunEnvBenchmark(const std::string& env_name) {
   benchmark::RunSpecifiedBenchmarks(&collector);
   const double stepped = 1.0 / collector.Seconds("env");
   const double vec16 = kVectorEnvs / collector.Seconds("vec16");
+  if (IsPythonEnvName(env_name)) {
+    absl::StatusOr<double> plain =
+        FastestPlainPythonLoop(env_name, env_kwargs, action);
+    if (!plain.ok()) {
+      std::fprintf(stderr, "vantage bench env: %s\n",
+                   std::string(plain.status().message()).c_str());
+      return 1;
+    }
+    std::printf(
+        "RESULT env name=%s python_steps_per_s=%.0f env_steps_per_s=%.0f "
+        "vec16_steps_per_s=%.0f ratio=%.3f\n",
+        env_name.c_str(), *plain, stepped, vec16, stepped / *plain);
+    return 0;
+  }
   if (physics == nullptr) {
     std::printf(
         "RESULT env name=%s env_steps_per_s=%.0f vec16_steps_per_s=%.0f\n",

@@ -12,8 +12,13 @@ namespace vantage {
 // of the environment through the interface (time limit and resets included)
 // and of a 16-env VectorEnv; ends with `RESULT env name=NAME
 // raw_steps_per_s=<x> env_steps_per_s=<y> vec16_steps_per_s=<z>
-// ratio=<vec16/raw>`. Returns the exit code.
-int RunEnvBenchmark(const std::string& env_name);
+// ratio=<vec16/raw>`. A Python environment (python:... or gym:..., with
+// `env_kwargs`) is held against the same environment stepped by a plain
+// Python loop under the same action instead: `RESULT env name=NAME
+// python_steps_per_s=<p> env_steps_per_s=<y> vec16_steps_per_s=<z>
+// ratio=<y/p>`. Returns the exit code.
+int RunEnvBenchmark(const std::string& env_name,
+                    const std::string& env_kwargs = "");
 
 }  // namespace vantage
 

@@ -159,7 +159,11 @@ const std::map<std::string, std::function<int()>>& Benchmarks() {
          }
          return RunActorBenchmark(env, envs, seconds);
        }},
-      {"env", [] { return RunEnvBenchmark(absl::GetFlag(FLAGS_env)); }},
+      {"env",
+       [] {
+         return RunEnvBenchmark(absl::GetFlag(FLAGS_env),
+                                absl::GetFlag(FLAGS_env_kwargs));
+       }},
       {"ingest",
        [] {
          const int clients = absl::GetFlag(FLAGS_bench_clients);
@@ -232,7 +236,8 @@ Command BenchCommand() {
   command.description =
       "advantages: the path-ensemble estimators against GAE; env: the\n"
       "environment layer against raw physics (a MinAtar game: its bare\n"
-      "rules; the raycast maze: its own rates only); learner: a PPO update\n"
+      "rules; the raycast maze: its own rates only; a Python env: the same\n"
+      "env in a plain Python loop); learner: a PPO update\n"
       "against a bare LibTorch loop; ingest: the learner's segment ingest in\n"
       "actors; actor: a streaming actor against raw physics; connections: a\n"
       "learner's memory and threads per connected actor against its idle\n"

@@ -13,6 +13,7 @@
 #include "absl/strings/str_replace.h"
 #include "absl/strings/str_split.h"
 #include "actor/envs/env_registry.h"
+#include "deploy/cli/command_line.h"
 #include "deploy/cli/shared_flags.h"
 #include "deploy/observe/video_writer.h"
 #include "deploy/run/run_config.h"
@@ -296,10 +297,15 @@ int RunRollout(const std::vector<std::string>&) {
     return Fail("rollout",
                 absl::InvalidArgumentError("--episodes must be >= 1"));
   }
-  // A trained policy sees the environment as its run wrapped it.
-  absl::StatusOr<std::unique_ptr<Environment>> made = MakeEnvironment(
-      request->env,
-      trained->has_value() ? EnvOptionsOf((*trained)->config) : EnvOptions{});
+  // A trained policy sees the environment as its run wrapped it (and made
+  // it, for a Python env, unless --env_kwargs says otherwise).
+  EnvOptions options =
+      trained->has_value() ? EnvOptionsOf((*trained)->config) : EnvOptions{};
+  if (FlagGiven("env_kwargs")) {
+    options.python_kwargs = absl::GetFlag(FLAGS_env_kwargs);
+  }
+  absl::StatusOr<std::unique_ptr<Environment>> made =
+      MakeEnvironment(request->env, options);
   if (!made.ok()) return Fail("rollout", made.status());
   Environment& env = **made;
   const EnvSpec& spec = env.spec();
@@ -360,8 +366,9 @@ Command RolloutCommand() {
       "at the control frequency, one frame after each reset and each step,\n"
       "and prints `video: FILE (N frames, WxH, F fps)`; the episodes and\n"
       "the RESULT line are the same with or without it (docs/videos.md).";
-  command.flags = {"env",        "episodes", "seed",       "checkpoint",
-                   "stochastic", "video",    "video_size", "video_episodes"};
+  command.flags = {"env",   "env_kwargs", "episodes",
+                   "seed",  "checkpoint", "stochastic",
+                   "video", "video_size", "video_episodes"};
   command.defaults = {{"env", "the checkpoint's, else required"}};
   command.example =
       "vantage rollout --checkpoint=runs/hopper --episodes=5 "

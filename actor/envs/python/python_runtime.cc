@@ -93,7 +93,10 @@ def max_episode_steps(env):
 
 def describe_error(error_type, value, trace):
     lines = traceback.format_exception(error_type, value, trace)
-    frames = traceback.extract_tb(trace)
+    # The deepest frame of a real file: the user's code, not importlib's
+    # or this bridge's.
+    frames = [frame for frame in traceback.extract_tb(trace)
+              if not frame.filename.startswith("<")]
     where = ""
     if frames:
         last = frames[-1]
