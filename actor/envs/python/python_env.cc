@@ -41,18 +41,21 @@ struct ObservationLayout {
   bool image = false;
 };
 
-// Runs `call` (which uses Python) with the GIL held; a Python exception
-// becomes the caller's error naming `what`, any other C++ exception from
-// pybind11 (a failed cast) too.
-template <typename Result, typename Call>
-absl::StatusOr<Result> WithPython(const std::string& what, Call&& call) {
+// Runs `body` (which uses Python) with the GIL held; a Python exception
+// becomes the caller's error naming the env `name` and its `call`, any
+// other C++ exception from pybind11 (a failed cast) too. The names are
+// joined only for an error: stepping builds no strings.
+template <typename Result, typename Body>
+absl::StatusOr<Result> WithPython(const std::string& name, const char* call,
+                                  Body&& body) {
   py::gil_scoped_acquire gil;
   try {
-    return call();
+    return body();
   } catch (py::error_already_set& error) {
-    return PythonError(error, what);
+    return PythonError(error, absl::StrCat(name, ": ", call));
   } catch (const std::exception& error) {
-    return absl::InvalidArgumentError(absl::StrCat(what, ": ", error.what()));
+    return absl::InvalidArgumentError(
+        absl::StrCat(name, ": ", call, ": ", error.what()));
   }
 }
 
@@ -67,16 +70,15 @@ class PythonEnv final : public Environment {
       env.reset(new PythonEnv());
     }
     env->spec_.name = name;
-    absl::StatusOr<bool> made =
-        WithPython<bool>(absl::StrCat(name, ": the factory"), [&] {
-          env->env_ = PythonBridge().attr("make")(name, kwargs_json);
-          env->reset_ = env->env_.attr("reset");
-          env->step_ = env->env_.attr("step");
-          return true;
-        });
+    absl::StatusOr<bool> made = WithPython<bool>(name, "the factory", [&] {
+      env->env_ = PythonBridge().attr("make")(name, kwargs_json);
+      env->reset_ = env->env_.attr("reset");
+      env->step_ = env->env_.attr("step");
+      return true;
+    });
     if (!made.ok()) return made.status();
-    absl::StatusOr<bool> described = WithPython<bool>(
-        absl::StrCat(name, ": its spaces"), [&] { return env->Describe(); });
+    absl::StatusOr<bool> described =
+        WithPython<bool>(name, "its spaces", [&] { return env->Describe(); });
     if (!described.ok()) return described.status();
     if (absl::Status status = CheckObservationLayout(env->spec_);
         !status.ok()) {
@@ -105,8 +107,8 @@ class PythonEnv final : public Environment {
         !status.ok()) {
       return status;
     }
-    absl::StatusOr<bool> done = WithPython<bool>(
-        absl::StrCat(spec_.name, ": reset()"), [&]() -> absl::StatusOr<bool> {
+    absl::StatusOr<bool> done =
+        WithPython<bool>(spec_.name, "reset()", [&]() -> absl::StatusOr<bool> {
           py::object result = reset_(py::arg("seed") = seed);
           if (!py::isinstance<py::tuple>(result) || py::len(result) != 2) {
             return absl::InvalidArgumentError(absl::StrCat(
@@ -132,8 +134,7 @@ class PythonEnv final : public Environment {
       return status;
     }
     absl::StatusOr<StepResult> result = WithPython<StepResult>(
-        absl::StrCat(spec_.name, ": step()"),
-        [&]() -> absl::StatusOr<StepResult> {
+        spec_.name, "step()", [&]() -> absl::StatusOr<StepResult> {
           py::object out = step_(Action(action));
           if (!py::isinstance<py::tuple>(out) || py::len(out) != 5) {
             return absl::InvalidArgumentError(absl::StrCat(
@@ -171,8 +172,7 @@ class PythonEnv final : public Environment {
 
   absl::StatusOr<std::string> SaveState() const override {
     return WithPython<std::string>(
-        absl::StrCat(spec_.name, ": get_state()"),
-        [&]() -> absl::StatusOr<std::string> {
+        spec_.name, "get_state()", [&]() -> absl::StatusOr<std::string> {
           if (!py::hasattr(env_, "get_state")) {
             return absl::UnimplementedError(absl::StrCat(
                 spec_.name,
@@ -197,8 +197,7 @@ class PythonEnv final : public Environment {
     const std::string pickled(reader.GetBytes("get_state()"));
     if (absl::Status status = reader.Finish(); !status.ok()) return status;
     absl::StatusOr<bool> restored = WithPython<bool>(
-        absl::StrCat(spec_.name, ": set_state()"),
-        [&]() -> absl::StatusOr<bool> {
+        spec_.name, "set_state()", [&]() -> absl::StatusOr<bool> {
           if (!py::hasattr(env_, "set_state")) {
             return absl::InvalidArgumentError(absl::StrCat(
                 spec_.name, " has get_state() but no set_state()"));
@@ -217,7 +216,7 @@ class PythonEnv final : public Environment {
       return absl::InvalidArgumentError("a frame needs width, height >= 1");
     }
     return WithPython<Frame>(
-        absl::StrCat(spec_.name, ": render()"), [&]() -> absl::StatusOr<Frame> {
+        spec_.name, "render()", [&]() -> absl::StatusOr<Frame> {
           if (!py::hasattr(env_, "render")) {
             return absl::UnimplementedError(
                 absl::StrCat(spec_.name, " has no render()"));
@@ -413,10 +412,20 @@ class PythonEnv final : public Environment {
       }
       return absl::OkStatus();
     }
-    auto values =
-        py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(
-            array);
-    std::memcpy(out.data(), values.data(), out.size() * sizeof(double));
+    // float32 and float64 (nearly every env) are read where they lie;
+    // other dtypes and strided arrays through one converted copy.
+    const bool packed = array.flags() & py::array::c_style;
+    if (packed && array.dtype().is(py::dtype::of<float>())) {
+      const float* in = static_cast<const float*>(array.data());
+      std::copy(in, in + out.size(), out.begin());
+    } else if (packed && array.dtype().is(py::dtype::of<double>())) {
+      std::memcpy(out.data(), array.data(), out.size() * sizeof(double));
+    } else {
+      auto values =
+          py::array_t<double,
+                      py::array::c_style | py::array::forcecast>::ensure(array);
+      std::memcpy(out.data(), values.data(), out.size() * sizeof(double));
+    }
     for (size_t i = 0; i < out.size(); ++i) {
       if (!std::isfinite(out[i])) {
         return absl::InvalidArgumentError(absl::StrCat(
@@ -487,7 +496,7 @@ absl::StatusOr<double> PlainPythonStepsPerSecond(
     const std::vector<double>& action, int64_t steps) {
   EnsurePythonInterpreter();
   const std::string target(name);
-  return WithPython<double>(absl::StrCat(target, ": plain Python loop"), [&] {
+  return WithPython<double>(target, "plain Python loop", [&] {
     py::object env = PythonBridge().attr("make")(target, kwargs_json);
     const double rate =
         PythonBridge().attr("plain_loop")(env, action, steps).cast<double>();
