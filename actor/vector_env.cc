@@ -164,6 +164,38 @@ absl::StatusOr<std::string> VectorEnv::SaveState() const {
   return std::move(writer).Finish();
 }
 
+absl::Status VectorEnv::RestoreEnvironments(
+    const std::vector<absl::string_view>& env_states) {
+  // Each environment restores all or nothing, but one may refuse after
+  // others took their new state: keep what they had to roll them back.
+  std::vector<std::string> backups;
+  for (size_t i = 0; i < env_states.size(); ++i) {
+    if (env_states[i].empty()) {
+      backups.emplace_back();
+      continue;
+    }
+    absl::StatusOr<std::string> backup = envs_[i]->SaveState();
+    if (!backup.ok()) return backup.status();
+    backups.push_back(std::move(*backup));
+  }
+  for (size_t i = 0; i < env_states.size(); ++i) {
+    if (env_states[i].empty()) continue;
+    absl::Status status = envs_[i]->RestoreState(env_states[i]);
+    if (status.ok()) continue;
+    for (size_t j = 0; j < i; ++j) {
+      if (env_states[j].empty()) continue;
+      if (absl::Status undo = envs_[j]->RestoreState(backups[j]); !undo.ok()) {
+        return absl::InternalError(absl::StrCat(
+            "env ", i, " refused its state (", status.message(),
+            ") and rolling back env ", j, " failed: ", undo.message()));
+      }
+    }
+    return absl::Status(status.code(),
+                        absl::StrCat("env ", i, ": ", status.message()));
+  }
+  return absl::OkStatus();
+}
+
 absl::Status VectorEnv::RestoreState(absl::string_view state) {
   const size_t m = envs_.size();
   StateReader reader(state, kStateKind, kStateVersion,
@@ -219,32 +251,8 @@ absl::Status VectorEnv::RestoreState(absl::string_view state) {
                "a negative episode length");
   if (absl::Status status = reader.Finish(); !status.ok()) return status;
 
-  // Each environment restores all or nothing, but one may refuse after
-  // others took their new state: keep what they had to roll them back.
-  std::vector<std::string> backups;
-  for (size_t i = 0; i < m; ++i) {
-    if (env_states[i].empty()) {
-      backups.emplace_back();
-      continue;
-    }
-    absl::StatusOr<std::string> backup = envs_[i]->SaveState();
-    if (!backup.ok()) return backup.status();
-    backups.push_back(std::move(*backup));
-  }
-  for (size_t i = 0; i < m; ++i) {
-    if (env_states[i].empty()) continue;
-    absl::Status status = envs_[i]->RestoreState(env_states[i]);
-    if (status.ok()) continue;
-    for (size_t j = 0; j < i; ++j) {
-      if (env_states[j].empty()) continue;
-      if (absl::Status undo = envs_[j]->RestoreState(backups[j]); !undo.ok()) {
-        return absl::InternalError(absl::StrCat(
-            "env ", i, " refused its state (", status.message(),
-            ") and rolling back env ", j, " failed: ", undo.message()));
-      }
-    }
-    return absl::Status(status.code(),
-                        absl::StrCat("env ", i, ": ", status.message()));
+  if (absl::Status status = RestoreEnvironments(env_states); !status.ok()) {
+    return status;
   }
   seeds_ = seeds;
   observations_ = std::move(observations);

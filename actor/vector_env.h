@@ -65,6 +65,10 @@ class VectorEnv {
   absl::Status RestoreState(absl::string_view state);
 
  private:
+  // Each environment's state (an empty one: none saved, left as it is),
+  // all or nothing: one that refuses rolls the others back.
+  absl::Status RestoreEnvironments(
+      const std::vector<absl::string_view>& env_states);
   VectorEnv(std::vector<std::unique_ptr<Environment>> envs, uint64_t seed);
   absl::Status ResetOne(int index);
 
