@@ -355,10 +355,15 @@ uint64_t ActorEnvSeed(uint64_t run_seed, int64_t actor_id) {
 
 absl::Status RunRemoteActor(const RemoteActorConfig& config,
                             const std::atomic<bool>& stop) {
+  // The environment's own spec (unwrapped: the learner's run config says
+  // how to wrap it), which the registration carries.
+  EnvOptions own;
+  own.python_kwargs = config.env_kwargs;
   absl::StatusOr<std::unique_ptr<Environment>> probe =
-      MakeEnvironment(config.env, EnvOptions{1, config.env_kwargs});
+      MakeEnvironment(config.env, own);
   if (!probe.ok()) return probe.status();
   const EnvSpec spec = (*probe)->spec();
+  probe->reset();
   grpc::ChannelArguments arguments;
   arguments.SetMaxReceiveMessageSize(config.max_message_bytes);
   arguments.SetMaxSendMessageSize(config.max_message_bytes);

@@ -96,6 +96,8 @@ int RunLearner(const std::vector<std::string>&) {
   server.recording = resolved->plan.recording;
   server.run_config = resolved->config;
   server.spec = (*env)->spec();
+  // Only its spec is needed: a Python env is closed again here.
+  env->reset();
   server.listen = absl::GetFlag(FLAGS_listen);
   server.port_file = absl::GetFlag(FLAGS_port_file);
   server.security = *std::move(security);

@@ -100,6 +100,18 @@ TEST(PythonEnvTrainingTest, RolloutsRepeatWithTheirSeed) {
   EXPECT_NE(digest(first.out), digest(RunVantage(args + "--seed=4").out));
 }
 
+// An env with render() is filmed: one frame after the reset and each step.
+TEST(PythonEnvTrainingTest, AnEnvThatRendersIsFilmed) {
+  const std::string video = FreshDirectory("python_video") + ".mp4";
+  const Outcome outcome = RunVantage(
+      "rollout --env=python:cartpole:make --episodes=1 --seed=1 --video=" +
+      video);
+  ASSERT_EQ(outcome.exit_code, 0) << outcome.err;
+  EXPECT_THAT(outcome.out, HasSubstr("mean_length=10.0"));
+  EXPECT_THAT(outcome.out, HasSubstr("(11 frames, 480x320, 50 fps)"));
+  EXPECT_GT(std::filesystem::file_size(video), 0u);
+}
+
 RunPlan SmallRun(const std::string& env, const std::string& run_dir) {
   pb::RunConfig run;
   run.mutable_training()->set_env(env);

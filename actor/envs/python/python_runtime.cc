@@ -32,6 +32,9 @@ def _load_module(name):
         if not os.path.isfile(path):
             raise ModuleNotFoundError(f"no Python file {path}")
         module_name = os.path.splitext(os.path.basename(path))[0]
+        # Its siblings import as they would beside a script.
+        if os.path.dirname(path) not in sys.path:
+            sys.path.insert(1, os.path.dirname(path))
         spec = importlib.util.spec_from_file_location(module_name, path)
         module = importlib.util.module_from_spec(spec)
         sys.modules[module_name] = module
