@@ -184,7 +184,11 @@ class Session {
           "the learner's run config: ", actor_config.status().message()));
     }
     actor_config->env = config_.env;
-    actor_config->env_options.python_kwargs = config_.env_kwargs;
+    // An actor started without --env_kwargs (by Slurm or a Deployment)
+    // makes its Python envs as the run does.
+    if (!config_.env_kwargs.empty()) {
+      actor_config->env_options.python_kwargs = config_.env_kwargs;
+    }
     actor_config->num_envs = config_.num_envs;
     actor_config->seed =
         config_.seed.has_value()

@@ -17,7 +17,9 @@ namespace vantage {
 struct RemoteActorConfig {
   std::string learner = "127.0.0.1:50051";  // HOST:PORT
   std::string env = "InvertedPendulum";
-  std::string env_kwargs;  // a Python environment's factory arguments (JSON)
+  // A Python environment's factory arguments (JSON); empty: the learner's
+  // run config's, once registered (its spec is probed without them).
+  std::string env_kwargs;
   int num_envs = 1;
   // The environments' seed. Absent: ActorEnvSeed of the run's seed and the
   // actor id of the registration, so that actors started with the same
