@@ -139,8 +139,8 @@ must vantage rollout \
   --episodes=2 --seed=1
 [[ "${out}" == *"RESULT rollout"* ]] || fail "a Python env did not roll out in the image: ${out}"
 must ls /usr/local/share/vantage
-[[ "$(tr '\n' ' ' <<<"${out}")" == "configs deploy " ]] ||
-  fail "/usr/local/share/vantage holds '${out}', not only configs and deploy"
+[[ "$(tr '\n' ' ' <<<"${out}")" == "configs deploy examples " ]] ||
+  fail "/usr/local/share/vantage holds '${out}', not only configs, deploy and examples"
 
 size="$(buildah images --format '{{.Size}}' "${tag}")"
 mountpoint="$(buildah mount "${container}")" || fail "buildah mount failed"
