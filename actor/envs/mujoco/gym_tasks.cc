@@ -151,6 +151,133 @@ std::vector<EnvOption> LocomotionOptions(LocomotionTask& task) {
   };
 }
 
+absl::Status BadCustomEntry(absl::string_view path, absl::string_view key,
+                            absl::string_view why) {
+  return absl::InvalidArgumentError(
+      absl::StrCat(path, ": <custom> entry '", key, "' ", why));
+}
+
+absl::Status ApplyCustomTexts(const mjModel* m, const std::string& path,
+                              LocomotionTask& task) {
+  for (int i = 0; i < m->ntext; ++i) {
+    const std::string key = m->names + m->name_textadr[i];
+    const std::string value = m->text_data + m->text_adr[i];
+    if (key == "vantage_forward_body") {
+      if (mj_name2id(m, mjOBJ_BODY, value.c_str()) < 0) {
+        return BadCustomEntry(path, key,
+                              absl::StrCat("names body '", value,
+                                           "', which the model does not have"));
+      }
+      task.forward_body = value;
+    } else if (absl::StartsWith(key, "vantage_")) {
+      return BadCustomEntry(path, key,
+                            "is not a vantage text setting (known: "
+                            "vantage_forward_body)");
+    }
+  }
+  return absl::OkStatus();
+}
+
+// One vantage_ <numeric> entry, with the shape checks its settings share.
+struct CustomNumeric {
+  const std::string& path;
+  std::string key;
+  const mjtNum* values;
+  int size;
+
+  absl::Status Bad(absl::string_view why) const {
+    return BadCustomEntry(path, key, why);
+  }
+
+  absl::StatusOr<double> One() const {
+    if (size != 1) return Bad("needs exactly one number");
+    return values[0];
+  }
+
+  // `max` must be exact as a double, so that every value this accepts
+  // converts to an integer exactly.
+  absl::StatusOr<int64_t> PositiveInteger(int64_t max) const {
+    absl::StatusOr<double> value = One();
+    if (!value.ok()) return value.status();
+    if (*value < 1 || *value > static_cast<double>(max) ||
+        *value != std::floor(*value)) {
+      return Bad(absl::StrCat("needs a whole number in [1, ", max, "]"));
+    }
+    return static_cast<int64_t>(*value);
+  }
+};
+
+// Sets `has_healthy_z` for vantage_healthy_z, whose height rule needs a
+// forward body: that can only be checked once every entry is read.
+absl::Status ApplyCustomNumeric(const CustomNumeric& entry,
+                                LocomotionTask& task, bool& has_healthy_z) {
+  const std::string& key = entry.key;
+  if (key == "vantage_forward_weight") {
+    absl::StatusOr<double> value = entry.One();
+    if (!value.ok()) return value.status();
+    task.forward_weight = *value;
+  } else if (key == "vantage_ctrl_cost") {
+    absl::StatusOr<double> value = entry.One();
+    if (!value.ok()) return value.status();
+    if (*value < 0) return entry.Bad("must be >= 0");
+    task.ctrl_cost = *value;
+  } else if (key == "vantage_alive_bonus") {
+    absl::StatusOr<double> value = entry.One();
+    if (!value.ok()) return value.status();
+    task.healthy_reward = *value;
+  } else if (key == "vantage_healthy_z") {
+    if (entry.size != 2 || !(entry.values[0] < entry.values[1])) {
+      return entry.Bad("needs two numbers lo < hi");
+    }
+    task.min_z = entry.values[0];
+    task.max_z = entry.values[1];
+    task.terminate_when_unhealthy = true;
+    has_healthy_z = true;
+  } else if (key == "vantage_frame_skip") {
+    absl::StatusOr<int64_t> value =
+        entry.PositiveInteger(std::numeric_limits<int>::max());
+    if (!value.ok()) return value.status();
+    task.frame_skip = static_cast<int>(*value);
+  } else if (key == "vantage_max_steps") {
+    // Above 2^53 not every whole number is a double.
+    absl::StatusOr<int64_t> value = entry.PositiveInteger(int64_t{1} << 53);
+    if (!value.ok()) return value.status();
+    task.max_episode_steps = *value;
+  } else {
+    return entry.Bad(
+        "is not a vantage setting (known: vantage_forward_weight, "
+        "vantage_ctrl_cost, vantage_alive_bonus, vantage_healthy_z, "
+        "vantage_frame_skip, vantage_max_steps)");
+  }
+  return absl::OkStatus();
+}
+
+// Runs after ApplyCustomTexts: vantage_healthy_z checks the forward body.
+absl::Status ApplyCustomNumerics(const mjModel* m, const std::string& path,
+                                 LocomotionTask& task) {
+  bool has_healthy_z = false;
+  for (int i = 0; i < m->nnumeric; ++i) {
+    const CustomNumeric entry{path, m->names + m->name_numericadr[i],
+                              m->numeric_data + m->numeric_adr[i],
+                              m->numeric_size[i]};
+    if (!absl::StartsWith(entry.key, "vantage_")) continue;
+    for (int j = 0; j < entry.size; ++j) {
+      if (!std::isfinite(entry.values[j])) {
+        return entry.Bad("has a non-finite value");
+      }
+    }
+    if (absl::Status status = ApplyCustomNumeric(entry, task, has_healthy_z);
+        !status.ok()) {
+      return status;
+    }
+  }
+  if (has_healthy_z && task.forward_body.empty()) {
+    return BadCustomEntry(path, "vantage_healthy_z",
+                          "needs vantage_forward_body");
+  }
+  return absl::OkStatus();
+}
+
 }  // namespace
 
 std::vector<std::string> GymTaskNames() {
@@ -190,89 +317,11 @@ absl::StatusOr<std::unique_ptr<Environment>> MakeMjcfEnv(
   LocomotionTask task;
   task.name = absl::StrCat("mjcf:", path);
   task.forward_body.clear();
-  const auto bad = [&](absl::string_view key, absl::string_view why) {
-    return absl::InvalidArgumentError(
-        absl::StrCat(path, ": <custom> entry '", key, "' ", why));
-  };
-  for (int i = 0; i < m->ntext; ++i) {
-    const std::string key = m->names + m->name_textadr[i];
-    const std::string value = m->text_data + m->text_adr[i];
-    if (key == "vantage_forward_body") {
-      if (mj_name2id(m, mjOBJ_BODY, value.c_str()) < 0) {
-        return bad(key, absl::StrCat("names body '", value,
-                                     "', which the model does not have"));
-      }
-      task.forward_body = value;
-    } else if (absl::StartsWith(key, "vantage_")) {
-      return bad(key,
-                 "is not a vantage text setting (known: "
-                 "vantage_forward_body)");
-    }
+  if (absl::Status status = ApplyCustomTexts(m, path, task); !status.ok()) {
+    return status;
   }
-  bool has_healthy_z = false;
-  for (int i = 0; i < m->nnumeric; ++i) {
-    const std::string key = m->names + m->name_numericadr[i];
-    if (!absl::StartsWith(key, "vantage_")) continue;
-    const mjtNum* values = m->numeric_data + m->numeric_adr[i];
-    const int size = m->numeric_size[i];
-    for (int j = 0; j < size; ++j) {
-      if (!std::isfinite(values[j])) return bad(key, "has a non-finite value");
-    }
-    const auto one = [&]() -> absl::StatusOr<double> {
-      if (size != 1) return bad(key, "needs exactly one number");
-      return values[0];
-    };
-    // `max` must be exact as a double, so that every value this accepts
-    // converts to an integer exactly.
-    const auto positive_integer = [&](int64_t max) -> absl::StatusOr<int64_t> {
-      absl::StatusOr<double> value = one();
-      if (!value.ok()) return value.status();
-      if (*value < 1 || *value > static_cast<double>(max) ||
-          *value != std::floor(*value)) {
-        return bad(key, absl::StrCat("needs a whole number in [1, ", max, "]"));
-      }
-      return static_cast<int64_t>(*value);
-    };
-    if (key == "vantage_forward_weight") {
-      absl::StatusOr<double> value = one();
-      if (!value.ok()) return value.status();
-      task.forward_weight = *value;
-    } else if (key == "vantage_ctrl_cost") {
-      absl::StatusOr<double> value = one();
-      if (!value.ok()) return value.status();
-      if (*value < 0) return bad(key, "must be >= 0");
-      task.ctrl_cost = *value;
-    } else if (key == "vantage_alive_bonus") {
-      absl::StatusOr<double> value = one();
-      if (!value.ok()) return value.status();
-      task.healthy_reward = *value;
-    } else if (key == "vantage_healthy_z") {
-      if (size != 2 || !(values[0] < values[1])) {
-        return bad(key, "needs two numbers lo < hi");
-      }
-      task.min_z = values[0];
-      task.max_z = values[1];
-      task.terminate_when_unhealthy = true;
-      has_healthy_z = true;
-    } else if (key == "vantage_frame_skip") {
-      absl::StatusOr<int64_t> value =
-          positive_integer(std::numeric_limits<int>::max());
-      if (!value.ok()) return value.status();
-      task.frame_skip = static_cast<int>(*value);
-    } else if (key == "vantage_max_steps") {
-      // Above 2^53 not every whole number is a double.
-      absl::StatusOr<int64_t> value = positive_integer(int64_t{1} << 53);
-      if (!value.ok()) return value.status();
-      task.max_episode_steps = *value;
-    } else {
-      return bad(key,
-                 "is not a vantage setting (known: vantage_forward_weight, "
-                 "vantage_ctrl_cost, vantage_alive_bonus, vantage_healthy_z, "
-                 "vantage_frame_skip, vantage_max_steps)");
-    }
-  }
-  if (has_healthy_z && task.forward_body.empty()) {
-    return bad("vantage_healthy_z", "needs vantage_forward_body");
+  if (absl::Status status = ApplyCustomNumerics(m, path, task); !status.ok()) {
+    return status;
   }
   if (m->nu == 0) {
     return absl::InvalidArgumentError(
