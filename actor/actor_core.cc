@@ -119,80 +119,124 @@ void ActorCore::Act(const at::Tensor& observations_row, float* actions,
   actions_.assign(actions, actions + m * width);
 }
 
+// One CollectSegments call's buffers, time-major ([steps(+1), m, ...]),
+// and what each slot's segment gathers besides.
+struct ActorCore::Rollout {
+  Rollout(int64_t steps, int64_t m, int64_t obs, int64_t act,
+          at::ScalarType observation_dtype)
+      : steps(steps),
+        m(m),
+        obs(obs),
+        act(act),
+        observation_dtype(observation_dtype),
+        observations(at::empty({steps + 1, m, obs}, observation_dtype)),
+        actions(at::empty({steps, m, act}, at::kFloat)),
+        log_probs(at::empty({steps, m}, at::kFloat)),
+        rewards(at::empty({steps, m}, at::kFloat)),
+        terminated(at::empty({steps, m}, at::kBool)),
+        truncated(at::empty({steps, m}, at::kBool)),
+        finals(m),
+        segments(m) {}
+
+  const int64_t steps;
+  const int64_t m;
+  const int64_t obs;
+  const int64_t act;
+  const at::ScalarType observation_dtype;
+  at::Tensor observations;
+  at::Tensor actions;
+  at::Tensor log_probs;
+  at::Tensor rewards;
+  at::Tensor terminated;
+  at::Tensor truncated;
+  // Per slot: the observations its truncated episodes ended on.
+  std::vector<std::vector<at::Tensor>> finals;
+  std::vector<Segment> segments;
+};
+
 absl::Status ActorCore::CollectSegments(SegmentSink& sink) {
   if (!has_weights_) {
     return absl::FailedPreconditionError(
         "the actor has no policy weights yet; SetWeights first");
   }
-  const int64_t m = envs_->size();
-  const int64_t steps = config_.segment_length;
-  const int64_t obs = spec().observation_size;
-  const int64_t act = spec().discrete ? 1 : spec().action_size;
-  const at::ScalarType observation_dtype =
-      spec().byte_observations() ? at::kByte : at::kFloat;
-  at::Tensor observations = at::empty({steps + 1, m, obs}, observation_dtype);
-  at::Tensor actions = at::empty({steps, m, act}, at::kFloat);
-  at::Tensor log_probs = at::empty({steps, m}, at::kFloat);
-  at::Tensor rewards = at::empty({steps, m}, at::kFloat);
-  at::Tensor terminated = at::empty({steps, m}, at::kBool);
-  at::Tensor truncated = at::empty({steps, m}, at::kBool);
-  std::vector<std::vector<at::Tensor>> finals(m);
-  std::vector<Segment> segments(m);
+  Rollout rollout(config_.segment_length, envs_->size(),
+                  spec().observation_size,
+                  spec().discrete ? 1 : spec().action_size,
+                  spec().byte_observations() ? at::kByte : at::kFloat);
 
   at::NoGradGuard no_grad;
-  StoreObservations(envs_->observations(), observations[0]);
-  for (int64_t t = 0; t < steps; ++t) {
-    const auto inference_start = std::chrono::steady_clock::now();
-    Act(observations[t], actions.data_ptr<float>() + t * m * act,
-        log_probs.data_ptr<float>() + t * m);
-    const auto env_start = std::chrono::steady_clock::now();
-    if (absl::Status status = envs_->Step(actions_); !status.ok()) {
+  StoreObservations(envs_->observations(), rollout.observations[0]);
+  for (int64_t t = 0; t < rollout.steps; ++t) {
+    if (absl::Status status = CollectStep(t, rollout); !status.ok()) {
       return status;
     }
-    const auto env_end = std::chrono::steady_clock::now();
-    inference_seconds_ +=
-        std::chrono::duration<double>(env_start - inference_start).count();
-    env_seconds_ += std::chrono::duration<double>(env_end - env_start).count();
-    // Plain stores: a tensor op per element would cost more than a step.
-    float* reward_row = rewards.data_ptr<float>() + t * m;
-    bool* terminated_row = terminated.data_ptr<bool>() + t * m;
-    bool* truncated_row = truncated.data_ptr<bool>() + t * m;
-    for (int64_t i = 0; i < m; ++i) {
-      reward_row[i] = static_cast<float>(envs_->rewards()[i]);
-      terminated_row[i] = envs_->terminated()[i] != 0;
-      truncated_row[i] = envs_->truncated()[i] != 0;
-    }
-    for (const FinishedEpisode& episode : envs_->finished()) {
-      Segment& segment = segments[episode.env_index];
-      segment.episode_returns.push_back(episode.episode_return);
-      segment.episode_lengths.push_back(episode.length);
-      if (episode.truncated) {
-        finals[episode.env_index].push_back(
-            ObservationTensor(
-                spec(),
-                envs_->final_observations().data() + episode.env_index * obs, 1)
-                .squeeze(0));
-      }
-    }
-    StoreObservations(envs_->observations(), observations[t + 1]);
   }
-  env_steps_ += m * steps;
+  env_steps_ += rollout.m * rollout.steps;
+  return SendSegments(rollout, sink);
+}
 
+absl::Status ActorCore::CollectStep(int64_t t, Rollout& rollout) {
+  const int64_t m = rollout.m;
+  const auto inference_start = std::chrono::steady_clock::now();
+  Act(rollout.observations[t],
+      rollout.actions.data_ptr<float>() + t * m * rollout.act,
+      rollout.log_probs.data_ptr<float>() + t * m);
+  const auto env_start = std::chrono::steady_clock::now();
+  if (absl::Status status = envs_->Step(actions_); !status.ok()) {
+    return status;
+  }
+  const auto env_end = std::chrono::steady_clock::now();
+  inference_seconds_ +=
+      std::chrono::duration<double>(env_start - inference_start).count();
+  env_seconds_ += std::chrono::duration<double>(env_end - env_start).count();
+  RecordStep(t, rollout);
+  return absl::OkStatus();
+}
+
+void ActorCore::RecordStep(int64_t t, Rollout& rollout) {
+  const int64_t m = rollout.m;
+  // Plain stores: a tensor op per element would cost more than a step.
+  float* reward_row = rollout.rewards.data_ptr<float>() + t * m;
+  bool* terminated_row = rollout.terminated.data_ptr<bool>() + t * m;
+  bool* truncated_row = rollout.truncated.data_ptr<bool>() + t * m;
   for (int64_t i = 0; i < m; ++i) {
-    Segment& segment = segments[i];
+    reward_row[i] = static_cast<float>(envs_->rewards()[i]);
+    terminated_row[i] = envs_->terminated()[i] != 0;
+    truncated_row[i] = envs_->truncated()[i] != 0;
+  }
+  for (const FinishedEpisode& episode : envs_->finished()) {
+    Segment& segment = rollout.segments[episode.env_index];
+    segment.episode_returns.push_back(episode.episode_return);
+    segment.episode_lengths.push_back(episode.length);
+    if (episode.truncated) {
+      rollout.finals[episode.env_index].push_back(
+          ObservationTensor(spec(),
+                            envs_->final_observations().data() +
+                                episode.env_index * rollout.obs,
+                            1)
+              .squeeze(0));
+    }
+  }
+  StoreObservations(envs_->observations(), rollout.observations[t + 1]);
+}
+
+absl::Status ActorCore::SendSegments(Rollout& rollout, SegmentSink& sink) {
+  for (int64_t i = 0; i < rollout.m; ++i) {
+    Segment& segment = rollout.segments[i];
     segment.actor_id = stream_actor_id_;
     segment.env_slot = i;
     segment.sequence = next_sequence_[i]++;
     segment.policy_version = version_;
-    segment.observations = observations.select(1, i).clone();
-    segment.actions = actions.select(1, i).clone();
-    segment.behaviour_log_probs = log_probs.select(1, i).clone();
-    segment.rewards = rewards.select(1, i).clone();
-    segment.terminated = terminated.select(1, i).clone();
-    segment.truncated = truncated.select(1, i).clone();
-    segment.final_observations = finals[i].empty()
-                                     ? at::empty({0, obs}, observation_dtype)
-                                     : at::stack(finals[i]);
+    segment.observations = rollout.observations.select(1, i).clone();
+    segment.actions = rollout.actions.select(1, i).clone();
+    segment.behaviour_log_probs = rollout.log_probs.select(1, i).clone();
+    segment.rewards = rollout.rewards.select(1, i).clone();
+    segment.terminated = rollout.terminated.select(1, i).clone();
+    segment.truncated = rollout.truncated.select(1, i).clone();
+    segment.final_observations =
+        rollout.finals[i].empty()
+            ? at::empty({0, rollout.obs}, rollout.observation_dtype)
+            : at::stack(rollout.finals[i]);
     if (absl::Status status = sink.Send(std::move(segment)); !status.ok()) {
       return status;
     }

@@ -76,6 +76,15 @@ class ActorCore {
   // keep them, for LibTorch), into actions_ too.
   void Act(const at::Tensor& observations_row, float* actions,
            float* log_probs);
+  // CollectSegments' buffers, defined in the .cc: only its steps use them.
+  struct Rollout;
+  // Acts and steps every environment once, timing both, and records step t.
+  absl::Status CollectStep(int64_t t, Rollout& rollout);
+  // Step t's rewards, episode ends and finished episodes, and the next
+  // observations.
+  void RecordStep(int64_t t, Rollout& rollout);
+  // One segment per slot, numbered in the slot's sequence.
+  absl::Status SendSegments(Rollout& rollout, SegmentSink& sink);
 
   const ActorConfig config_;
   std::unique_ptr<VectorEnv> envs_;
