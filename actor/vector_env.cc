@@ -196,7 +196,29 @@ absl::Status VectorEnv::RestoreEnvironments(
   return absl::OkStatus();
 }
 
+// A state blob read and checked but not yet applied: nothing may change
+// before the environments have accepted their states.
+struct VectorEnv::SavedState {
+  std::mt19937_64 seeds;
+  std::vector<double> observations;
+  std::vector<double> final_observations;
+  std::vector<double> rewards;
+  absl::string_view terminated;
+  absl::string_view truncated;
+  std::vector<double> returns;
+  std::vector<int64_t> lengths;
+  std::vector<FinishedEpisode> finished;
+  std::vector<absl::string_view> env_states;
+};
+
 absl::Status VectorEnv::RestoreState(absl::string_view state) {
+  absl::StatusOr<SavedState> saved = ReadState(state);
+  if (!saved.ok()) return saved.status();
+  return ApplyState(*saved);
+}
+
+absl::StatusOr<VectorEnv::SavedState> VectorEnv::ReadState(
+    absl::string_view state) const {
   const size_t m = envs_.size();
   StateReader reader(state, kStateKind, kStateVersion,
                      absl::StrCat("vector of ", spec().name, ": state"));
@@ -207,21 +229,42 @@ absl::Status VectorEnv::RestoreState(absl::string_view state) {
                      observation_size_);
   reader.ExpectEqual("the action width", reader.GetI64("action_width"),
                      action_width_);
-  const std::mt19937_64 seeds = reader.GetEngine("episode seeds");
+  SavedState saved;
+  saved.seeds = reader.GetEngine("episode seeds");
   const size_t values = m * observation_size_;
-  std::vector<double> observations = reader.GetDoubles("observations", values);
-  std::vector<double> final_observations =
-      reader.GetDoubles("final_observations", values);
-  std::vector<double> rewards = reader.GetDoubles("rewards", m);
-  const absl::string_view terminated = reader.GetBytes("terminated");
-  const absl::string_view truncated = reader.GetBytes("truncated");
-  std::vector<double> returns = reader.GetDoubles("episode_returns", m);
-  std::vector<int64_t> lengths = reader.GetI64s("episode_lengths", m);
+  saved.observations = reader.GetDoubles("observations", values);
+  saved.final_observations = reader.GetDoubles("final_observations", values);
+  saved.rewards = reader.GetDoubles("rewards", m);
+  saved.terminated = reader.GetBytes("terminated");
+  saved.truncated = reader.GetBytes("truncated");
+  saved.returns = reader.GetDoubles("episode_returns", m);
+  saved.lengths = reader.GetI64s("episode_lengths", m);
+  saved.finished = ReadFinishedEpisodes(reader);
+  for (size_t i = 0; i < m; ++i) {
+    saved.env_states.push_back(
+        reader.GetBytes(absl::StrCat("env ", i, " state")));
+  }
+  const auto flags_ok = [m](absl::string_view flags) {
+    return flags.size() == m &&
+           std::all_of(flags.begin(), flags.end(),
+                       [](char flag) { return flag == 0 || flag == 1; });
+  };
+  reader.Check(flags_ok(saved.terminated) && flags_ok(saved.truncated),
+               absl::StrCat("the step flags are not ", m, " bools each"));
+  reader.Check(std::all_of(saved.lengths.begin(), saved.lengths.end(),
+                           [](int64_t length) { return length >= 0; }),
+               "a negative episode length");
+  if (absl::Status status = reader.Finish(); !status.ok()) return status;
+  return saved;
+}
+
+std::vector<FinishedEpisode> VectorEnv::ReadFinishedEpisodes(
+    StateReader& reader) const {
   const int64_t finished_count = reader.GetI64("finished episodes");
   reader.Check(
       finished_count >= 0 && finished_count <= size(),
-      absl::StrCat(finished_count, " episodes finished in one step of ", m,
-                   " environments"));
+      absl::StrCat(finished_count, " episodes finished in one step of ",
+                   envs_.size(), " environments"));
   std::vector<FinishedEpisode> finished;
   for (int64_t i = 0; reader.status().ok() && i < finished_count; ++i) {
     const int64_t index = reader.GetI64("finished env_index");
@@ -235,36 +278,25 @@ absl::Status VectorEnv::RestoreState(absl::string_view state) {
     episode.env_index = static_cast<int>(index);
     finished.push_back(episode);
   }
-  std::vector<absl::string_view> env_states;
-  for (size_t i = 0; i < m; ++i) {
-    env_states.push_back(reader.GetBytes(absl::StrCat("env ", i, " state")));
-  }
-  const auto flags_ok = [m](absl::string_view flags) {
-    return flags.size() == m &&
-           std::all_of(flags.begin(), flags.end(),
-                       [](char flag) { return flag == 0 || flag == 1; });
-  };
-  reader.Check(flags_ok(terminated) && flags_ok(truncated),
-               absl::StrCat("the step flags are not ", m, " bools each"));
-  reader.Check(std::all_of(lengths.begin(), lengths.end(),
-                           [](int64_t length) { return length >= 0; }),
-               "a negative episode length");
-  if (absl::Status status = reader.Finish(); !status.ok()) return status;
+  return finished;
+}
 
-  if (absl::Status status = RestoreEnvironments(env_states); !status.ok()) {
+absl::Status VectorEnv::ApplyState(SavedState& saved) {
+  if (absl::Status status = RestoreEnvironments(saved.env_states);
+      !status.ok()) {
     return status;
   }
-  seeds_ = seeds;
-  observations_ = std::move(observations);
-  final_observations_ = std::move(final_observations);
-  rewards_ = std::move(rewards);
-  terminated_.assign(terminated.begin(), terminated.end());
-  truncated_.assign(truncated.begin(), truncated.end());
-  episode_returns_ = std::move(returns);
-  episode_lengths_ = std::move(lengths);
-  finished_ = std::move(finished);
-  for (size_t i = 0; i < m; ++i) {
-    if (!env_states[i].empty()) continue;
+  seeds_ = saved.seeds;
+  observations_ = std::move(saved.observations);
+  final_observations_ = std::move(saved.final_observations);
+  rewards_ = std::move(saved.rewards);
+  terminated_.assign(saved.terminated.begin(), saved.terminated.end());
+  truncated_.assign(saved.truncated.begin(), saved.truncated.end());
+  episode_returns_ = std::move(saved.returns);
+  episode_lengths_ = std::move(saved.lengths);
+  finished_ = std::move(saved.finished);
+  for (size_t i = 0; i < envs_.size(); ++i) {
+    if (!saved.env_states[i].empty()) continue;
     SayOnce(absl::StrCat(spec().name,
                          " saved no state: its episodes restart on resume"));
     if (absl::Status status = ResetOne(static_cast<int>(i)); !status.ok()) {

@@ -16,6 +16,8 @@
 
 namespace vantage {
 
+class StateReader;
+
 struct FinishedEpisode {
   int env_index = 0;
   double episode_return = 0.0;
@@ -65,6 +67,14 @@ class VectorEnv {
   absl::Status RestoreState(absl::string_view state);
 
  private:
+  // RestoreState's blob read and checked, before anything is changed
+  // (defined in the .cc).
+  struct SavedState;
+  // Reads and checks a state without changing anything.
+  absl::StatusOr<SavedState> ReadState(absl::string_view state) const;
+  std::vector<FinishedEpisode> ReadFinishedEpisodes(StateReader& reader) const;
+  // Restores the environments first, as only they can still refuse.
+  absl::Status ApplyState(SavedState& saved);
   // Each environment's state (an empty one: none saved, left as it is),
   // all or nothing: one that refuses rolls the others back.
   absl::Status RestoreEnvironments(
