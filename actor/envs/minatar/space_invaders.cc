@@ -76,64 +76,12 @@ GameStep SpaceInvaders::Act(MinAtarAction action, std::mt19937_64&) {
     step.terminal = true;
     return step;
   }
-  if (action == MinAtarAction::kFire && shot_timer_ == 0) {
-    At(friendly_bullets_, kBottom, cannon_) = 1;
-    shot_timer_ = kShotCoolDown;
-  } else if (action == MinAtarAction::kLeft) {
-    cannon_ = std::max(0, cannon_ - 1);
-  } else if (action == MinAtarAction::kRight) {
-    cannon_ = std::min(kBottom, cannon_ + 1);
-  }
-
-  // As MinAtar moves them (numpy.roll): a bullet leaving the grid wraps
-  // round and is cleared at once, so it simply disappears.
-  friendly_bullets_ = Rolled(friendly_bullets_, -1, 0);
-  for (int x = 0; x < kN; ++x) At(friendly_bullets_, kBottom, x) = 0;
-  enemy_bullets_ = Rolled(enemy_bullets_, 1, 0);
-  for (int x = 0; x < kN; ++x) At(enemy_bullets_, 0, x) = 0;
-  if (At(enemy_bullets_, kBottom, cannon_)) terminal_ = true;
-
+  MoveCannon(action);
+  MoveBullets();
   if (At(aliens_, kBottom, cannon_)) terminal_ = true;
-  if (move_timer_ == 0) {
-    move_timer_ = std::min(aliens(), move_interval_);
-    if ((alien_direction_ < 0 && ColumnHas(aliens_, 0)) ||
-        (alien_direction_ > 0 && ColumnHas(aliens_, kBottom))) {
-      alien_direction_ = -alien_direction_;
-      if (RowHas(aliens_, kBottom)) terminal_ = true;
-      aliens_ = Rolled(aliens_, 1, 0);
-    } else {
-      aliens_ = Rolled(aliens_, 0, alien_direction_);
-    }
-    if (At(aliens_, kBottom, cannon_)) terminal_ = true;
-  }
-
-  if (shot_timer_alien_ == 0) {
-    shot_timer_alien_ = kAlienShotInterval;
-    // The lowest alien of the column nearest the cannon (ties: the column
-    // to the left).
-    int column = -1;
-    for (int distance = 0; distance < kN && column < 0; ++distance) {
-      for (int x : {cannon_ - distance, cannon_ + distance}) {
-        if (OnGrid(x) && ColumnHas(aliens_, x)) {
-          column = x;
-          break;
-        }
-      }
-    }
-    if (column >= 0) {
-      int row = kBottom;
-      while (!At(aliens_, row, column)) --row;
-      At(enemy_bullets_, row, column) = 1;
-    }
-  }
-
-  for (int i = 0; i < kMinAtarCells; ++i) {
-    if (aliens_[i] && friendly_bullets_[i]) {
-      aliens_[i] = 0;
-      friendly_bullets_[i] = 0;
-      step.reward += 1.0;
-    }
-  }
+  if (move_timer_ == 0) MoveAliens();
+  if (shot_timer_alien_ == 0) AliensFire();
+  step.reward += HitAliens();
 
   if (shot_timer_ > 0) --shot_timer_;
   --move_timer_;
@@ -145,6 +93,72 @@ GameStep SpaceInvaders::Act(MinAtarAction action, std::mt19937_64&) {
   }
   step.terminal = terminal_;
   return step;
+}
+
+void SpaceInvaders::MoveCannon(MinAtarAction action) {
+  if (action == MinAtarAction::kFire && shot_timer_ == 0) {
+    At(friendly_bullets_, kBottom, cannon_) = 1;
+    shot_timer_ = kShotCoolDown;
+  } else if (action == MinAtarAction::kLeft) {
+    cannon_ = std::max(0, cannon_ - 1);
+  } else if (action == MinAtarAction::kRight) {
+    cannon_ = std::min(kBottom, cannon_ + 1);
+  }
+}
+
+void SpaceInvaders::MoveBullets() {
+  // As MinAtar moves them (numpy.roll): a bullet leaving the grid wraps
+  // round and is cleared at once, so it simply disappears.
+  friendly_bullets_ = Rolled(friendly_bullets_, -1, 0);
+  for (int x = 0; x < kN; ++x) At(friendly_bullets_, kBottom, x) = 0;
+  enemy_bullets_ = Rolled(enemy_bullets_, 1, 0);
+  for (int x = 0; x < kN; ++x) At(enemy_bullets_, 0, x) = 0;
+  if (At(enemy_bullets_, kBottom, cannon_)) terminal_ = true;
+}
+
+void SpaceInvaders::MoveAliens() {
+  move_timer_ = std::min(aliens(), move_interval_);
+  if ((alien_direction_ < 0 && ColumnHas(aliens_, 0)) ||
+      (alien_direction_ > 0 && ColumnHas(aliens_, kBottom))) {
+    alien_direction_ = -alien_direction_;
+    if (RowHas(aliens_, kBottom)) terminal_ = true;
+    aliens_ = Rolled(aliens_, 1, 0);
+  } else {
+    aliens_ = Rolled(aliens_, 0, alien_direction_);
+  }
+  if (At(aliens_, kBottom, cannon_)) terminal_ = true;
+}
+
+void SpaceInvaders::AliensFire() {
+  shot_timer_alien_ = kAlienShotInterval;
+  // The lowest alien of the column nearest the cannon (ties: the column
+  // to the left).
+  int column = -1;
+  for (int distance = 0; distance < kN && column < 0; ++distance) {
+    for (int x : {cannon_ - distance, cannon_ + distance}) {
+      if (OnGrid(x) && ColumnHas(aliens_, x)) {
+        column = x;
+        break;
+      }
+    }
+  }
+  if (column >= 0) {
+    int row = kBottom;
+    while (!At(aliens_, row, column)) --row;
+    At(enemy_bullets_, row, column) = 1;
+  }
+}
+
+int SpaceInvaders::HitAliens() {
+  int hits = 0;
+  for (int i = 0; i < kMinAtarCells; ++i) {
+    if (aliens_[i] && friendly_bullets_[i]) {
+      aliens_[i] = 0;
+      friendly_bullets_[i] = 0;
+      ++hits;
+    }
+  }
+  return hits;
 }
 
 void SpaceInvaders::Observe(absl::Span<uint8_t> grid) const {

@@ -32,6 +32,15 @@ class SpaceInvaders : public MinAtarGame {
  private:
   using Grid = std::array<uint8_t, kMinAtarCells>;
 
+  // Act's phases, in MinAtar's order, which decides what a collision hits.
+  void MoveCannon(MinAtarAction action);
+  void MoveBullets();
+  void MoveAliens();
+  void AliensFire();
+  // Removes each alien a friendly bullet reached, with the bullet; returns
+  // how many.
+  int HitAliens();
+
   const bool ramping_;
   int cannon_ = 0;
   Grid friendly_bullets_{};
