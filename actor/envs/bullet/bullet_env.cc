@@ -22,6 +22,14 @@ bool BitEqual(absl::Span<const double> a, absl::Span<const double> b) {
           std::memcmp(a.data(), b.data(), a.size() * sizeof(double)) == 0);
 }
 
+// The state's fields are runs of doubles; their lengths decide how many.
+bool ReadDoubles(absl::string_view bytes, std::vector<double>* out) {
+  if (bytes.size() % sizeof(double) != 0) return false;
+  out->resize(bytes.size() / sizeof(double));
+  if (!out->empty()) std::memcpy(out->data(), bytes.data(), bytes.size());
+  return true;
+}
+
 }  // namespace
 
 BulletEnv::BulletEnv(EnvSpec spec, PlanarModel model, std::vector<double> gears,
@@ -214,38 +222,64 @@ absl::StatusOr<std::string> BulletEnv::SaveState() const {
   return std::move(writer).Finish();
 }
 
+// A state read and checked, not yet applied.
+struct BulletEnv::SavedState {
+  bool needs_reset = false;
+  uint64_t seed = 0;
+  std::vector<double> log;
+  std::vector<double> q;
+  std::vector<double> qd;
+};
+
 absl::Status BulletEnv::RestoreState(absl::string_view state) {
   const std::string context = absl::StrCat(spec_.name, ": Bullet state");
+  absl::StatusOr<SavedState> saved = ReadState(state, context);
+  if (!saved.ok()) return saved.status();
+  if (saved->needs_reset) {
+    world_.reset();
+    log_.clear();
+    needs_reset_ = true;
+    return absl::OkStatus();
+  }
+  return ReplayState(*saved, context);
+}
+
+absl::StatusOr<BulletEnv::SavedState> BulletEnv::ReadState(
+    absl::string_view state, const std::string& context) const {
   StateReader reader(state, kStateKind, kStateVersion, context);
   reader.ExpectEqual("the environment", reader.GetBytes("name"), spec_.name);
   reader.Check(reader.GetU64("signature") == Signature(),
                "the state was saved by a task with another model or rules");
-  const bool needs_reset = reader.GetBool("needs_reset");
-  const uint64_t seed = reader.GetU64("seed");
+  SavedState saved;
+  saved.needs_reset = reader.GetBool("needs_reset");
+  saved.seed = reader.GetU64("seed");
   const absl::string_view log_bytes = reader.GetBytes("action log");
   const absl::string_view q_bytes = reader.GetBytes("positions");
   const absl::string_view qd_bytes = reader.GetBytes("velocities");
   if (absl::Status status = reader.Finish(); !status.ok()) return status;
-  // The fields are runs of doubles; their lengths decide how many.
-  const auto doubles = [](absl::string_view bytes, std::vector<double>* out) {
-    if (bytes.size() % sizeof(double) != 0) return false;
-    out->resize(bytes.size() / sizeof(double));
-    if (!out->empty()) std::memcpy(out->data(), bytes.data(), bytes.size());
-    return true;
-  };
-  std::vector<double> log, q, qd;
   const size_t width = gears_.size();
   const size_t dofs = model_.links.size() + 2;
-  bool ok = doubles(log_bytes, &log) && doubles(q_bytes, &q) &&
-            doubles(qd_bytes, &qd) && log.size() % width == 0;
-  ok = ok && (needs_reset ? log.empty() && q.empty() && qd.empty()
-                          : q.size() == dofs && qd.size() == dofs);
+  bool ok = ReadDoubles(log_bytes, &saved.log) &&
+            ReadDoubles(q_bytes, &saved.q) &&
+            ReadDoubles(qd_bytes, &saved.qd) && saved.log.size() % width == 0;
+  ok = ok && (saved.needs_reset
+                  ? saved.log.empty() && saved.q.empty() && saved.qd.empty()
+                  : saved.q.size() == dofs && saved.qd.size() == dofs);
   if (!ok) {
     return absl::InvalidArgumentError(absl::StrCat(
         context,
         ": the action log, positions or velocities have impossible "
         "sizes"));
   }
+  if (absl::Status status = CheckActionLog(saved.log, context); !status.ok()) {
+    return status;
+  }
+  return saved;
+}
+
+absl::Status BulletEnv::CheckActionLog(const std::vector<double>& log,
+                                       const std::string& context) const {
+  const size_t width = gears_.size();
   for (size_t i = 0; i < log.size(); ++i) {
     const size_t j = i % width;
     if (!(log[i] >= spec_.action_low[j] && log[i] <= spec_.action_high[j])) {
@@ -254,25 +288,23 @@ absl::Status BulletEnv::RestoreState(absl::string_view state) {
                        " (", log[i], ") is not a clipped action"));
     }
   }
-  if (needs_reset) {
-    world_.reset();
-    log_.clear();
-    needs_reset_ = true;
-    return absl::OkStatus();
-  }
+  return absl::OkStatus();
+}
 
+absl::Status BulletEnv::ReplayState(const SavedState& saved,
+                                    const std::string& context) {
   // Replaying changes the environment; if the result is not the saved one,
   // go back by replaying this environment's own state.
   absl::StatusOr<std::string> before = SaveState();
   if (!before.ok()) return before.status();
-  absl::Status status = Replay(seed, log);
+  absl::Status status = Replay(saved.seed, saved.log);
   if (status.ok()) {
     std::vector<double> replayed_q, replayed_qd;
     for (int i = 0; i < world_->num_dofs(); ++i) {
       replayed_q.push_back(world_->q(i));
       replayed_qd.push_back(world_->qd(i));
     }
-    if (BitEqual(replayed_q, q) && BitEqual(replayed_qd, qd)) {
+    if (BitEqual(replayed_q, saved.q) && BitEqual(replayed_qd, saved.qd)) {
       return absl::OkStatus();
     }
     status = absl::InvalidArgumentError(

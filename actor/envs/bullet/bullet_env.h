@@ -94,6 +94,18 @@ class BulletEnv : public Environment {
   absl::Status Replay(uint64_t seed, absl::Span<const double> log);
   // What a state must match: the model, gears, frame skip and task.
   uint64_t Signature() const;
+  // RestoreState's blob read and checked, before anything is changed
+  // (defined in the .cc).
+  struct SavedState;
+  absl::StatusOr<SavedState> ReadState(absl::string_view state,
+                                       const std::string& context) const;
+  // Replay applies logged actions as already clipped: one outside the
+  // bounds can only come from a bad blob.
+  absl::Status CheckActionLog(const std::vector<double>& log,
+                              const std::string& context) const;
+  // Replays the saved episode; one that does not end bit for bit where the
+  // saved one did is undone.
+  absl::Status ReplayState(const SavedState& saved, const std::string& context);
 
   EnvSpec spec_;
   PlanarModel model_;
