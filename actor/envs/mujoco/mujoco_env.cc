@@ -177,9 +177,37 @@ absl::StatusOr<std::string> MujocoEnv::SaveState() const {
   return std::move(writer).Finish();
 }
 
+// A state read and checked, not yet applied.
+struct MujocoEnv::SavedState {
+  double time = 0.0;
+  std::vector<double> energy;
+  // ne, nf, nefc, ncon.
+  std::vector<int64_t> counts;
+  // solver_iter, solver_nnz.
+  std::vector<int64_t> solver;
+  std::vector<double> fwdinv;
+  // lastinfo and number of each warning.
+  std::vector<int64_t> warnings;
+  std::string buffer;
+  std::mt19937_64 rng;
+  bool needs_reset = false;
+  absl::string_view task;
+};
+
 absl::Status MujocoEnv::RestoreState(absl::string_view state) {
+  absl::StatusOr<SavedState> saved = ReadState(state);
+  if (!saved.ok()) return saved.status();
+  if (absl::Status status = RestoreTaskState(saved->task); !status.ok()) {
+    return status;
+  }
+  ApplyState(*saved);
+  return absl::OkStatus();
+}
+
+absl::StatusOr<MujocoEnv::SavedState> MujocoEnv::ReadState(
+    absl::string_view state) const {
   const mjModel* m = model_.get();
-  mjData* d = data_.get();
+  const mjData* d = data_.get();
   StateReader reader(state, kStateKind, kStateVersion,
                      absl::StrCat(spec_.name, ": MuJoCo state"));
   reader.ExpectEqual("the environment", reader.GetBytes("name"), spec_.name);
@@ -190,60 +218,64 @@ absl::Status MujocoEnv::RestoreState(absl::string_view state) {
   reader.Check(fingerprint == model_fingerprint_,
                "the state was saved with another MuJoCo model (the "
                "fingerprints differ)");
-  const double time = reader.GetDouble("time");
-  const std::vector<double> energy = reader.GetDoubles("energy", 2);
-  const std::vector<int64_t> counts = reader.GetI64s("constraint counts", 4);
-  const std::vector<int64_t> solver = reader.GetI64s("solver counts", 2);
-  const std::vector<double> fwdinv = reader.GetDoubles("solver_fwdinv", 2);
-  const std::vector<int64_t> warnings =
-      reader.GetI64s("warnings", 2 * mjNWARNING);
-  const std::string buffer =
-      reader.GetPacked("buffer", static_cast<size_t>(d->nbuffer));
-  const std::mt19937_64 rng = reader.GetEngine("reset generator");
-  const bool needs_reset = reader.GetBool("needs_reset");
-  const absl::string_view task = reader.GetBytes("task state");
-  reader.Check(std::isfinite(time), "time is not finite");
-  // Counts out of range would make later reads of the contact and
-  // constraint arrays overrun the buffer.
-  const int64_t ne = counts[0];
-  const int64_t nf = counts[1];
-  const int64_t nefc = counts[2];
-  const int64_t ncon = counts[3];
+  SavedState saved;
+  saved.time = reader.GetDouble("time");
+  saved.energy = reader.GetDoubles("energy", 2);
+  saved.counts = reader.GetI64s("constraint counts", 4);
+  saved.solver = reader.GetI64s("solver counts", 2);
+  saved.fwdinv = reader.GetDoubles("solver_fwdinv", 2);
+  saved.warnings = reader.GetI64s("warnings", 2 * mjNWARNING);
+  saved.buffer = reader.GetPacked("buffer", static_cast<size_t>(d->nbuffer));
+  saved.rng = reader.GetEngine("reset generator");
+  saved.needs_reset = reader.GetBool("needs_reset");
+  saved.task = reader.GetBytes("task state");
+  reader.Check(std::isfinite(saved.time), "time is not finite");
+  CheckCounts(saved, reader);
+  if (absl::Status status = reader.Finish(); !status.ok()) return status;
+  return saved;
+}
+
+void MujocoEnv::CheckCounts(const SavedState& saved,
+                            StateReader& reader) const {
+  const mjModel* m = model_.get();
+  const int64_t ne = saved.counts[0];
+  const int64_t nf = saved.counts[1];
+  const int64_t nefc = saved.counts[2];
+  const int64_t ncon = saved.counts[3];
   reader.Check(ne >= 0 && nf >= 0 && ne + nf <= nefc && nefc <= m->njmax &&
                    ncon >= 0 && ncon <= m->nconmax,
                absl::StrCat("impossible constraint counts ne=", ne, " nf=", nf,
                             " nefc=", nefc, " ncon=", ncon));
-  reader.Check(solver[0] >= 0 && solver[0] <= mjNSOLVER && solver[1] >= 0 &&
-                   solver[1] <= std::numeric_limits<int>::max(),
+  reader.Check(saved.solver[0] >= 0 && saved.solver[0] <= mjNSOLVER &&
+                   saved.solver[1] >= 0 &&
+                   saved.solver[1] <= std::numeric_limits<int>::max(),
                "impossible solver counts");
   bool warnings_fit = true;
-  for (int64_t value : warnings) {
+  for (int64_t value : saved.warnings) {
     warnings_fit &= value >= std::numeric_limits<int>::min() &&
                     value <= std::numeric_limits<int>::max();
   }
   reader.Check(warnings_fit, "warning counters out of range");
-  if (absl::Status status = reader.Finish(); !status.ok()) return status;
-  if (absl::Status status = RestoreTaskState(task); !status.ok()) {
-    return status;
-  }
+}
 
-  d->time = time;
-  std::copy(energy.begin(), energy.end(), d->energy);
-  d->ne = static_cast<int>(ne);
-  d->nf = static_cast<int>(nf);
-  d->nefc = static_cast<int>(nefc);
-  d->ncon = static_cast<int>(ncon);
-  d->solver_iter = static_cast<int>(solver[0]);
-  d->solver_nnz = static_cast<int>(solver[1]);
-  std::copy(fwdinv.begin(), fwdinv.end(), d->solver_fwdinv);
+void MujocoEnv::ApplyState(const SavedState& saved) {
+  mjData* d = data_.get();
+  d->time = saved.time;
+  std::copy(saved.energy.begin(), saved.energy.end(), d->energy);
+  d->ne = static_cast<int>(saved.counts[0]);
+  d->nf = static_cast<int>(saved.counts[1]);
+  d->nefc = static_cast<int>(saved.counts[2]);
+  d->ncon = static_cast<int>(saved.counts[3]);
+  d->solver_iter = static_cast<int>(saved.solver[0]);
+  d->solver_nnz = static_cast<int>(saved.solver[1]);
+  std::copy(saved.fwdinv.begin(), saved.fwdinv.end(), d->solver_fwdinv);
   for (int i = 0; i < mjNWARNING; ++i) {
-    d->warning[i].lastinfo = static_cast<int>(warnings[2 * i]);
-    d->warning[i].number = static_cast<int>(warnings[2 * i + 1]);
+    d->warning[i].lastinfo = static_cast<int>(saved.warnings[2 * i]);
+    d->warning[i].number = static_cast<int>(saved.warnings[2 * i + 1]);
   }
-  std::memcpy(d->buffer, buffer.data(), buffer.size());
-  rng_ = rng;
-  needs_reset_ = needs_reset;
-  return absl::OkStatus();
+  std::memcpy(d->buffer, saved.buffer.data(), saved.buffer.size());
+  rng_ = saved.rng;
+  needs_reset_ = saved.needs_reset;
 }
 
 absl::Status MujocoEnv::RestoreTaskState(absl::string_view state) {

@@ -12,6 +12,7 @@
 namespace vantage {
 
 class MujocoRenderer;
+class StateReader;
 
 // The shared part of every MuJoCo task: seeding, resetting, clipping the
 // action into ctrl, frame skip, and turning MuJoCo errors and numerical
@@ -78,6 +79,15 @@ class MujocoEnv : public Environment {
   void PerturbState(std::mt19937_64& rng, double scale, bool normal_qvel);
 
  private:
+  // RestoreState's blob read and checked, before anything is changed
+  // (defined in the .cc).
+  struct SavedState;
+  absl::StatusOr<SavedState> ReadState(absl::string_view state) const;
+  // Counts out of range would make later reads of the contact and
+  // constraint arrays overrun the buffer, or not fit mjData's ints.
+  void CheckCounts(const SavedState& saved, StateReader& reader) const;
+  void ApplyState(const SavedState& saved);
+
   EnvSpec spec_;
   MjModelPtr model_;
   MjDataPtr data_;
