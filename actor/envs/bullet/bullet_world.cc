@@ -90,12 +90,7 @@ LinkInertia InertiaOf(const PlanarLink& link, double density) {
   return result;
 }
 
-}  // namespace
-
-absl::Status ValidatePlanarModel(const PlanarModel& model) {
-  if (model.links.empty()) {
-    return absl::InvalidArgumentError("planar model: no links");
-  }
+absl::Status ValidateWorldSettings(const PlanarModel& model) {
   if (!(model.timestep > 0.0) || model.solver_iterations < 1 ||
       !(model.density > 0.0) || !(std::abs(model.slope) < kPi / 4)) {
     return absl::InvalidArgumentError(
@@ -115,46 +110,80 @@ absl::Status ValidatePlanarModel(const PlanarModel& model) {
       }
     }
   }
+  return absl::OkStatus();
+}
+
+absl::Status BadLink(size_t i, const PlanarLink& link, absl::string_view why) {
+  return absl::InvalidArgumentError(
+      absl::StrCat("planar model: link ", i, " (", link.name, ") ", why));
+}
+
+// The root has no hinge: only these checks apply to it.
+absl::Status ValidateLinkBody(const PlanarModel& model, size_t i) {
+  const PlanarLink& link = model.links[i];
+  if (i == 0 ? link.parent != -1
+             : link.parent < 0 || link.parent >= static_cast<int>(i)) {
+    return BadLink(i, link, "needs the root's parent -1, else an earlier link");
+  }
+  if (!(link.mass >= 0.0) || !(link.friction >= 0.0)) {
+    return BadLink(i, link, "needs mass >= 0 and friction >= 0");
+  }
+  if (link.is_box()) {
+    if (!(link.box_depth > 0.0) || !(link.box_height > 0.0)) {
+      return BadLink(i, link, "needs a box depth and height > 0");
+    }
+  } else {
+    if (link.from_x != link.to_x && link.from_z != link.to_z) {
+      return BadLink(i, link, "is not parallel to x or z");
+    }
+    if (!(link.radius > 0.0)) return BadLink(i, link, "needs radius > 0");
+  }
+  return absl::OkStatus();
+}
+
+absl::Status ValidateHinge(const PlanarModel& model, size_t i) {
+  const PlanarLink& link = model.links[i];
+  if (link.axis != 1.0 && link.axis != -1.0) {
+    return BadLink(i, link, "needs axis +-1");
+  }
+  if (!(link.lower < link.upper) || !(link.damping >= 0.0) ||
+      !(link.armature >= 0.0)) {
+    return BadLink(i, link,
+                   "needs lower < upper, damping >= 0 and armature >= 0");
+  }
+  // The damping torque is explicit: it must not overshoot within one
+  // step, i.e. damping * dt well below the link's inertia about its hinge.
+  const LinkInertia body = InertiaOf(link, model.density);
+  const double cx = body.centre.x() - link.joint_x;
+  const double cz = body.centre.z() - link.joint_z;
+  const double about_hinge =
+      body.inertia.y() + link.armature + body.mass * (cx * cx + cz * cz);
+  if (link.damping * model.timestep > 0.5 * about_hinge) {
+    return BadLink(
+        i, link,
+        absl::StrCat("damping ", link.damping,
+                     " is too high for an explicit step of ", model.timestep,
+                     " s (inertia ", about_hinge, ")"));
+  }
+  return absl::OkStatus();
+}
+
+}  // namespace
+
+absl::Status ValidatePlanarModel(const PlanarModel& model) {
+  if (model.links.empty()) {
+    return absl::InvalidArgumentError("planar model: no links");
+  }
+  if (absl::Status status = ValidateWorldSettings(model); !status.ok()) {
+    return status;
+  }
   for (size_t i = 0; i < model.links.size(); ++i) {
-    const PlanarLink& link = model.links[i];
-    const auto bad = [&](absl::string_view why) {
-      return absl::InvalidArgumentError(
-          absl::StrCat("planar model: link ", i, " (", link.name, ") ", why));
-    };
-    if (i == 0 ? link.parent != -1
-               : link.parent < 0 || link.parent >= static_cast<int>(i)) {
-      return bad("needs the root's parent -1, else an earlier link");
-    }
-    if (!(link.mass >= 0.0) || !(link.friction >= 0.0)) {
-      return bad("needs mass >= 0 and friction >= 0");
-    }
-    if (link.is_box()) {
-      if (!(link.box_depth > 0.0) || !(link.box_height > 0.0)) {
-        return bad("needs a box depth and height > 0");
-      }
-    } else {
-      if (link.from_x != link.to_x && link.from_z != link.to_z) {
-        return bad("is not parallel to x or z");
-      }
-      if (!(link.radius > 0.0)) return bad("needs radius > 0");
+    if (absl::Status status = ValidateLinkBody(model, i); !status.ok()) {
+      return status;
     }
     if (i == 0) continue;
-    if (link.axis != 1.0 && link.axis != -1.0) return bad("needs axis +-1");
-    if (!(link.lower < link.upper) || !(link.damping >= 0.0) ||
-        !(link.armature >= 0.0)) {
-      return bad("needs lower < upper, damping >= 0 and armature >= 0");
-    }
-    // The damping torque is explicit: it must not overshoot within one
-    // step, i.e. damping * dt well below the link's inertia about its hinge.
-    const LinkInertia body = InertiaOf(link, model.density);
-    const double cx = body.centre.x() - link.joint_x;
-    const double cz = body.centre.z() - link.joint_z;
-    const double about_hinge =
-        body.inertia.y() + link.armature + body.mass * (cx * cx + cz * cz);
-    if (link.damping * model.timestep > 0.5 * about_hinge) {
-      return bad(absl::StrCat(
-          "damping ", link.damping, " is too high for an explicit step of ",
-          model.timestep, " s (inertia ", about_hinge, ")"));
+    if (absl::Status status = ValidateHinge(model, i); !status.ok()) {
+      return status;
     }
   }
   return absl::OkStatus();
