@@ -344,6 +344,55 @@ class TimeSplitReport {
   PhaseTimes times_;
 };
 
+// The environment's own spec (unwrapped: the learner's run config says
+// how to wrap it), which the registration carries.
+absl::StatusOr<EnvSpec> ProbeEnvSpec(const RemoteActorConfig& config) {
+  EnvOptions own;
+  own.python_kwargs = config.env_kwargs;
+  absl::StatusOr<std::unique_ptr<Environment>> probe =
+      MakeEnvironment(config.env, own);
+  if (!probe.ok()) return probe.status();
+  const EnvSpec spec = (*probe)->spec();
+  probe->reset();
+  return spec;
+}
+
+grpc::ChannelArguments ChannelArgumentsFor(const RemoteActorConfig& config) {
+  grpc::ChannelArguments arguments;
+  arguments.SetMaxReceiveMessageSize(config.max_message_bytes);
+  arguments.SetMaxSendMessageSize(config.max_message_bytes);
+  return arguments;
+}
+
+// Null when the config asks for no metrics.
+absl::StatusOr<std::unique_ptr<ActorMetrics>> StartMetrics(
+    const RemoteActorConfig& config) {
+  if (config.metrics_address.empty()) return nullptr;
+  absl::StatusOr<std::unique_ptr<ActorMetrics>> started =
+      ActorMetrics::Start(config.metrics_address, config.security.auth_token);
+  if (!started.ok()) return started.status();
+  std::unique_ptr<ActorMetrics> metrics = *std::move(started);
+  std::fprintf(stderr, "%s: metrics on port %d\n", config.name.c_str(),
+               metrics->port());
+  if (!config.metrics_port_file.empty()) {
+    if (absl::Status status =
+            WritePortFile(config.metrics_port_file, metrics->port());
+        !status.ok()) {
+      return status;
+    }
+  }
+  return metrics;
+}
+
+// Short naps, so that a stop request ends the wait at once.
+void SleepUnlessStopped(absl::Duration duration,
+                        const std::atomic<bool>& stop) {
+  for (absl::Time until = absl::Now() + duration;
+       !stop && absl::Now() < until;) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+}
+
 }  // namespace
 
 uint64_t ActorEnvSeed(uint64_t run_seed, int64_t actor_id) {
@@ -359,37 +408,15 @@ uint64_t ActorEnvSeed(uint64_t run_seed, int64_t actor_id) {
 
 absl::Status RunRemoteActor(const RemoteActorConfig& config,
                             const std::atomic<bool>& stop) {
-  // The environment's own spec (unwrapped: the learner's run config says
-  // how to wrap it), which the registration carries.
-  EnvOptions own;
-  own.python_kwargs = config.env_kwargs;
-  absl::StatusOr<std::unique_ptr<Environment>> probe =
-      MakeEnvironment(config.env, own);
-  if (!probe.ok()) return probe.status();
-  const EnvSpec spec = (*probe)->spec();
-  probe->reset();
-  grpc::ChannelArguments arguments;
-  arguments.SetMaxReceiveMessageSize(config.max_message_bytes);
-  arguments.SetMaxSendMessageSize(config.max_message_bytes);
+  absl::StatusOr<EnvSpec> spec = ProbeEnvSpec(config);
+  if (!spec.ok()) return spec.status();
+  const grpc::ChannelArguments arguments = ChannelArgumentsFor(config);
   absl::StatusOr<std::shared_ptr<grpc::ChannelCredentials>> credentials =
       MakeChannelCredentials(config.security);
   if (!credentials.ok()) return credentials.status();
-  std::unique_ptr<ActorMetrics> metrics;
-  if (!config.metrics_address.empty()) {
-    absl::StatusOr<std::unique_ptr<ActorMetrics>> started =
-        ActorMetrics::Start(config.metrics_address, config.security.auth_token);
-    if (!started.ok()) return started.status();
-    metrics = *std::move(started);
-    std::fprintf(stderr, "%s: metrics on port %d\n", config.name.c_str(),
-                 metrics->port());
-    if (!config.metrics_port_file.empty()) {
-      if (absl::Status status =
-              WritePortFile(config.metrics_port_file, metrics->port());
-          !status.ok()) {
-        return status;
-      }
-    }
-  }
+  absl::StatusOr<std::unique_ptr<ActorMetrics>> started = StartMetrics(config);
+  if (!started.ok()) return started.status();
+  const std::unique_ptr<ActorMetrics> metrics = *std::move(started);
   TimeSplitReport report(config.name);
   std::unique_ptr<ActorCore> actor;  // kept across reconnects
   int failures = 0;
@@ -399,7 +426,7 @@ absl::Status RunRemoteActor(const RemoteActorConfig& config,
         grpc::CreateCustomChannel(config.learner, *credentials, arguments);
     Session session(config, channel, metrics.get(), report.times());
     bool progressed = false;
-    const absl::Status status = session.Run(spec, actor, stop, progressed);
+    const absl::Status status = session.Run(*spec, actor, stop, progressed);
     if (stop) break;
     if (absl::IsOutOfRange(status)) {
       // The learner completed the run (registration or subscription).
@@ -421,10 +448,7 @@ absl::Status RunRemoteActor(const RemoteActorConfig& config,
     std::fprintf(stderr, "%s: %s; reconnecting in %s\n", config.name.c_str(),
                  std::string(status.message()).c_str(),
                  absl::FormatDuration(backoff).c_str());
-    for (absl::Time until = absl::Now() + backoff;
-         !stop && absl::Now() < until;) {
-      std::this_thread::sleep_for(std::chrono::milliseconds(20));
-    }
+    SleepUnlessStopped(backoff, stop);
     backoff = std::min(backoff * 2, config.max_backoff);
   }
   return absl::OkStatus();
