@@ -23,7 +23,7 @@
 #include "learner/algorithms/ppo/ppo_updater.h"
 #include "learner/exploration/ex2_bonus.h"
 #include "learner/parallel/gloo_replica_group.h"
-#include "learner/update_guard.h"
+#include "learner/update/update_guard.h"
 
 namespace vantage {
 namespace {

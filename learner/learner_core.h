@@ -13,14 +13,15 @@
 #include "common/nn/networks.h"
 #include "common/nn/policy_weights.h"
 #include "common/nn/running_mean_std.h"
-#include "common/rollout/segment.h"
 #include "common/rollout/segment_queue.h"
 #include "learner/algorithms/algorithm.h"
-#include "learner/ingest/reward_scaler.h"
-#include "learner/ingest/rollout_stitcher.h"
+#include "learner/batch/batch_preparer.h"
+#include "learner/batch/reward_scaler.h"
+#include "learner/ingest/segment_intake.h"
 #include "learner/learner_config.h"
 #include "learner/parallel/replica_group.h"
-#include "learner/update_stats.h"
+#include "learner/update/update_stats.h"
+#include "learner/update/update_totals.h"
 
 namespace vantage {
 
@@ -53,18 +54,18 @@ class LearnerCore {
 
   // Frees the stitching state of an actor that is gone (its registration
   // expired); rollouts it already completed still train.
-  void ForgetActor(int64_t actor_id) { stitcher_.ForgetActor(actor_id); }
-  const RolloutStitcher& stitcher() const { return stitcher_; }
+  void ForgetActor(int64_t actor_id) { intake_.ForgetActor(actor_id); }
+  const SegmentIntake& intake() const { return intake_; }
+  const RolloutStitcher& stitcher() const { return intake_.stitcher(); }
   // Steps held for later batches: partial rollouts and complete ones that
   // wait for their batch.
-  int64_t buffered_steps() const {
-    return stitcher_.buffered_steps() +
-           static_cast<int64_t>(pending_.size()) * config_.horizon;
-  }
+  int64_t buffered_steps() const { return intake_.buffered_steps(); }
 
   // Returns of the episodes reported by consumed segments, newest last
   // (at most 100 kept).
-  const std::deque<double>& recent_returns() const { return recent_returns_; }
+  const std::deque<double>& recent_returns() const {
+    return intake_.recent_returns();
+  }
   // Mean of recent_returns(); NaN before the first episode ends.
   double MeanRecentReturn() const;
   // The exploration bonus, or null in a run without one.
@@ -92,32 +93,32 @@ class LearnerCore {
  private:
   LearnerCore(const LearnerConfig& config,
               std::shared_ptr<ReplicaGroup> replicas);
+  // A new learner whose networks are initialised from config.seed.
+  static std::unique_ptr<LearnerCore> Construct(
+      const LearnerConfig& config, std::shared_ptr<ReplicaGroup> replicas);
   // What Load reads into a new learner: the networks, the optimiser,
   // reward scaler, normaliser and exploration states; then the generator,
   // counters and recent returns.
   absl::Status LoadModels(torch::serialize::InputArchive& archive);
   absl::Status LoadCounters(torch::serialize::InputArchive& archive);
-  // Keeps the first refusal's reason of the update being gathered.
-  void NoteRejection(const Segment& segment, const absl::Status& why);
   // Rank 0's networks, normaliser and counters on every replica; an error
   // if this replica's version differs from rank 0's.
   absl::Status SynchroniseReplicas();
   // The update once its batch is complete, under a guard that undoes it on
-  // any error or a rollback: the batch and its advantages (PrepareBatch),
-  // the algorithm's optimisation, the statistics summed over the replicas
-  // (SumOverReplicas), and the new version committed (Commit).
+  // any error or a rollback: the batch and its advantages (the preparer),
+  // the algorithm's optimisation, the statistics summed over the replicas,
+  // and the new version committed (Commit).
   absl::StatusOr<UpdateStats> Update(std::vector<Rollout> rollouts);
-  struct PreparedBatch;
-  struct ReplicaSums;
-  absl::StatusOr<PreparedBatch> PrepareBatch(std::vector<Rollout>& rollouts);
-  // Also turns the algorithm's statistics into means over the replicas.
-  ReplicaSums SumOverReplicas(const PreparedBatch& prepared,
-                              AlgorithmStats& algorithm);
+  absl::StatusOr<UpdateStats> Optimise(std::vector<Rollout>& rollouts,
+                                       UpdateGuard& guard);
   // Keeps the update or, when its statistics are faulty, rolls it back;
   // either way the counters and the version advance.
   absl::Status Commit(const std::vector<Rollout>& rollouts,
-                      const ReplicaSums& sums, UpdateGuard& guard,
+                      const UpdateSums& sums, UpdateGuard& guard,
                       UpdateStats& stats);
+  // Absorbs a kept update's observations into the normaliser.
+  absl::Status UpdateNormaliser(const std::vector<Rollout>& rollouts);
+  void AddTotals(const UpdateSums& sums, UpdateStats& stats);
 
   const LearnerConfig config_;
   std::shared_ptr<ReplicaGroup> replicas_;
@@ -129,8 +130,8 @@ class LearnerCore {
   // Created after the networks, from the same generator, so that a run
   // without it initialises exactly as before it existed.
   std::unique_ptr<Ex2Bonus> exploration_;
-  RolloutStitcher stitcher_;
-  std::vector<Rollout> pending_;
+  SegmentIntake intake_;
+  BatchPreparer preparer_;
   std::mt19937_64 rng_;
   // Totals over the global batch, the same on every replica.
   int64_t version_ = 0;
@@ -140,16 +141,6 @@ class LearnerCore {
   int64_t stale_steps_ = 0;
   int64_t episodes_ = 0;
   int64_t rolled_back_updates_ = 0;
-  // This replica's counts since the last update, added to the totals over
-  // all replicas when the next update sums its statistics.
-  struct LocalCounts {
-    int64_t rejected = 0;
-    int64_t stale_segments = 0;
-    int64_t stale_steps = 0;
-    int64_t episodes = 0;
-  } unreported_;
-  std::string first_rejection_;  // of the update being gathered
-  std::deque<double> recent_returns_;
 };
 
 }  // namespace vantage

@@ -4,8 +4,8 @@
 
 namespace vantage {
 
-SegmentQueue::SegmentQueue(size_t capacity)
-    : capacity_(capacity == 0 ? 1 : capacity) {}
+SegmentQueue::SegmentQueue(size_t capacity, bool checked)
+    : capacity_(capacity == 0 ? 1 : capacity), checked_(checked) {}
 
 absl::Status SegmentQueue::Send(Segment segment) {
   std::unique_lock<std::mutex> lock(mutex_);

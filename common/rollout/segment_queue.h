@@ -27,22 +27,30 @@ class SegmentSource {
   virtual ~SegmentSource() = default;
   // Blocks until a segment arrives; Cancelled once closed and drained.
   virtual absl::StatusOr<Segment> Receive() = 0;
+  // Whether whoever filled it already checked every segment against the
+  // run's spec and limits (the learner's gateway does, to answer its
+  // sender), so that the receiver need not check them again.
+  virtual bool checked() const { return false; }
 };
 
 // A bounded queue that is both: at most `capacity` segments wait, so actors
 // that outpace the learner block instead of growing memory.
 class SegmentQueue : public SegmentSink, public SegmentSource {
  public:
-  explicit SegmentQueue(size_t capacity);
+  // `checked`: what checked() says (segments filled in by a checking
+  // sender only).
+  explicit SegmentQueue(size_t capacity, bool checked = false);
 
   absl::Status Send(Segment segment) override;
   absl::StatusOr<Segment> Receive() override;
   // Wakes every waiter; later Sends fail, Receives drain what is left.
   void Close();
   size_t size() const;
+  bool checked() const override { return checked_; }
 
  private:
   const size_t capacity_;
+  const bool checked_;
   mutable std::mutex mutex_;
   std::condition_variable not_full_;
   std::condition_variable not_empty_;

@@ -8,7 +8,7 @@
 #include "deploy/run/run_config.h"
 #include "deploy/run/run_directory.h"
 #include "learner/algorithms/algorithm_config.h"
-#include "learner/checkpoint_files.h"
+#include "learner/checkpoint/checkpoint_files.h"
 
 namespace vantage {
 namespace {

@@ -11,7 +11,7 @@
 #include "deploy/run/run_directory.h"
 #include "google/protobuf/util/json_util.h"
 #include "google/protobuf/util/message_differencer.h"
-#include "learner/checkpoint_files.h"
+#include "learner/checkpoint/checkpoint_files.h"
 
 namespace vantage {
 namespace {

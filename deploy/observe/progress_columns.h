@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "learner/update_stats.h"
+#include "learner/update/update_stats.h"
 
 namespace vantage {
 

@@ -259,8 +259,10 @@ absl::Status LearnerProcess::Serve() {
   const int64_t batch_segments =
       own_streams_ *
       (config_.learner.horizon / std::max<int64_t>(1, segment_length));
+  // The gateway checks every segment it queues, for its sender to hear why.
   queue_ = std::make_unique<SegmentQueue>(
-      static_cast<size_t>(std::max<int64_t>(8, 2 * batch_segments)));
+      static_cast<size_t>(std::max<int64_t>(8, 2 * batch_segments)),
+      /*checked=*/true);
   GatewayConfig gateway_config;
   gateway_config.run_config = run_config;
   gateway_config.max_segment_steps = segment_length;

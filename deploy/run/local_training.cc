@@ -3,7 +3,7 @@
 #include "absl/strings/str_cat.h"
 #include "actor/actor_core.h"
 #include "deploy/run/training_run.h"
-#include "learner/checkpoint.h"
+#include "learner/checkpoint/checkpoint.h"
 #include "learner/learner_core.h"
 
 namespace vantage {

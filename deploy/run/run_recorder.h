@@ -10,7 +10,7 @@
 #include "absl/status/statusor.h"
 #include "deploy/run/recording_config.h"
 #include "deploy/run/run_directory.h"
-#include "learner/checkpoint.h"
+#include "learner/checkpoint/checkpoint.h"
 #include "learner/learner_core.h"
 
 namespace vantage {

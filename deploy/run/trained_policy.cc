@@ -13,7 +13,7 @@
 #include "common/nn/running_mean_std.h"
 #include "deploy/run/run_config.h"
 #include "deploy/run/run_plan.h"
-#include "learner/checkpoint.h"
+#include "learner/checkpoint/checkpoint.h"
 
 namespace vantage {
 

@@ -17,7 +17,7 @@
 #include "deploy/observe/progress_columns.h"
 #include "deploy/run/recording_config.h"
 #include "deploy/run/run_recorder.h"
-#include "learner/checkpoint.h"
+#include "learner/checkpoint/checkpoint.h"
 #include "learner/learner_core.h"
 
 namespace vantage {

@@ -13,7 +13,7 @@
 #include <utility>
 
 #include "absl/strings/str_cat.h"
-#include "learner/archive_io.h"
+#include "learner/checkpoint/archive_io.h"
 #include "learner/parallel/replica_reductions.h"
 
 namespace vantage {

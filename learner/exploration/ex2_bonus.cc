@@ -14,7 +14,7 @@
 #include "absl/strings/str_cat.h"
 #include "common/nn/networks.h"
 #include "learner/algorithms/gradient_step.h"
-#include "learner/archive_io.h"
+#include "learner/checkpoint/archive_io.h"
 
 namespace vantage {
 namespace {

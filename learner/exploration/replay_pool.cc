@@ -6,7 +6,7 @@
 #include <algorithm>
 
 #include "absl/strings/str_cat.h"
-#include "learner/archive_io.h"
+#include "learner/checkpoint/archive_io.h"
 
 namespace vantage {
 

@@ -58,6 +58,8 @@ absl::Status GatewayLimits::Validate() const {
 
 ActorGateway::ActorGateway(GatewayConfig config, SegmentSink& sink)
     : config_(std::move(config)),
+      check_(config_.spec, config_.max_segment_steps, config_.limits.values,
+             config_.max_policy_lag),
       sink_(sink),
       next_actor_id_(config_.first_actor_id) {}
 
@@ -293,19 +295,15 @@ absl::Status ActorGateway::Admit(int64_t actor_id, const pb::Segment& proto,
     it->second.last_seen = absl::Now();
     newest = weights_ == nullptr ? -1 : weights_->version();
   }
-  if (proto.policy_version() > newest) {
-    return Reject("future_version",
-                  absl::FailedPreconditionError(absl::StrCat(
-                      "segment.policy_version ", proto.policy_version(),
-                      " has not been published (newest: ", newest, ")")));
+  if (absl::Status status =
+          SegmentCheck::CheckPublished(proto.policy_version(), newest);
+      !status.ok()) {
+    return Reject("future_version", status);
   }
   absl::StatusOr<Segment> segment =
       SegmentFromProto(proto, config_.limits.max_tensor_bytes);
   if (!segment.ok()) return Reject("malformed", segment.status());
-  if (absl::Status status =
-          ValidateSegment(*segment, config_.spec, config_.max_segment_steps,
-                          config_.limits.values);
-      !status.ok()) {
+  if (absl::Status status = check_.Validate(*segment); !status.ok()) {
     return Reject("invalid", status);
   }
   auto drop = [&](const std::string& reason, std::string why) {
@@ -313,8 +311,7 @@ absl::Status ActorGateway::Admit(int64_t actor_id, const pb::Segment& proto,
     CountRejected(reason);
     return absl::OkStatus();
   };
-  if (config_.max_policy_lag >= 0 &&
-      segment->policy_version < newest - config_.max_policy_lag) {
+  if (check_.TooStale(segment->policy_version, newest)) {
     return drop("stale",
                 absl::StrCat("segment.policy_version ", segment->policy_version,
                              " is more than ", config_.max_policy_lag,

@@ -21,6 +21,7 @@
 #include "common/nn/policy_weights.h"
 #include "common/rollout/segment.h"
 #include "common/rollout/segment_queue.h"
+#include "learner/ingest/segment_check.h"
 #include "proto/run_config.pb.h"
 #include "proto/vantage.pb.h"
 #include "proto/wire_format.h"
@@ -197,6 +198,7 @@ class ActorGateway {
   void RemoveLocked(std::map<int64_t, Registration>::iterator it);
 
   const GatewayConfig config_;
+  const SegmentCheck check_;
   SegmentSink& sink_;
   mutable std::mutex mutex_;
   std::condition_variable changed_;

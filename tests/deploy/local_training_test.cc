@@ -14,7 +14,7 @@
 #include "deploy/run/run_directory.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
-#include "learner/checkpoint.h"
+#include "learner/checkpoint/checkpoint.h"
 #include "tests/fakes/local_plan.h"
 #include "tests/fakes/run_files.h"
 

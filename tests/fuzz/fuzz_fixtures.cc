@@ -9,7 +9,7 @@
 #include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
 #include "common/rollout/segment_queue.h"
-#include "learner/checkpoint.h"
+#include "learner/checkpoint/checkpoint.h"
 
 namespace vantage {
 

@@ -17,7 +17,7 @@
 #include "absl/strings/str_cat.h"
 #include "common/rollout/segment_queue.h"
 #include "deploy/run/run_config.h"
-#include "learner/checkpoint.h"
+#include "learner/checkpoint/checkpoint.h"
 #include "proto/vantage.pb.h"
 #include "proto/wire_format.h"
 #include "tests/fuzz/fuzz_fixtures.h"

@@ -11,7 +11,7 @@
 
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
-#include "learner/checkpoint.h"
+#include "learner/checkpoint/checkpoint.h"
 #include "learner/exploration/ex2_bonus.h"
 #include "tests/fakes/learner_batches.h"
 

@@ -1,5 +1,5 @@
-#ifndef VANTAGE_LEARNER_UPDATE_STATS_H_
-#define VANTAGE_LEARNER_UPDATE_STATS_H_
+#ifndef VANTAGE_LEARNER_UPDATE_UPDATE_STATS_H_
+#define VANTAGE_LEARNER_UPDATE_UPDATE_STATS_H_
 
 // What one update of the learner reports, without LibTorch: progress.csv,
 // the metrics and the command line read it.
@@ -54,4 +54,4 @@ struct UpdateStats {
 
 }  // namespace vantage
 
-#endif  // VANTAGE_LEARNER_UPDATE_STATS_H_
+#endif  // VANTAGE_LEARNER_UPDATE_UPDATE_STATS_H_

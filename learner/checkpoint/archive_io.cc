@@ -1,4 +1,4 @@
-#include "learner/archive_io.h"
+#include "learner/checkpoint/archive_io.h"
 
 #include <ATen/ATen.h>
 #include <torch/nn/module.h>

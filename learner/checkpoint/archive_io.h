@@ -1,5 +1,5 @@
-#ifndef VANTAGE_LEARNER_ARCHIVE_IO_H_
-#define VANTAGE_LEARNER_ARCHIVE_IO_H_
+#ifndef VANTAGE_LEARNER_CHECKPOINT_ARCHIVE_IO_H_
+#define VANTAGE_LEARNER_CHECKPOINT_ARCHIVE_IO_H_
 
 // Typed reads and writes of LibTorch archives (the checkpoint format) that
 // turn a missing or malformed entry into an error naming it.
@@ -55,4 +55,4 @@ absl::Status CatchTorchErrors(absl::string_view what,
 
 }  // namespace vantage
 
-#endif  // VANTAGE_LEARNER_ARCHIVE_IO_H_
+#endif  // VANTAGE_LEARNER_CHECKPOINT_ARCHIVE_IO_H_

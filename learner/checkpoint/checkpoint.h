@@ -1,5 +1,5 @@
-#ifndef VANTAGE_LEARNER_CHECKPOINT_H_
-#define VANTAGE_LEARNER_CHECKPOINT_H_
+#ifndef VANTAGE_LEARNER_CHECKPOINT_CHECKPOINT_H_
+#define VANTAGE_LEARNER_CHECKPOINT_CHECKPOINT_H_
 
 // Checkpoint files: the learner's whole state plus named byte strings the
 // caller adds (the run's resolved config, the local actor's state, ...).
@@ -12,7 +12,7 @@
 
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
-#include "learner/checkpoint_files.h"
+#include "learner/checkpoint/checkpoint_files.h"
 #include "learner/learner_core.h"
 
 namespace vantage {
@@ -29,4 +29,4 @@ absl::StatusOr<std::unique_ptr<LearnerCore>> ReadCheckpoint(
 
 }  // namespace vantage
 
-#endif  // VANTAGE_LEARNER_CHECKPOINT_H_
+#endif  // VANTAGE_LEARNER_CHECKPOINT_CHECKPOINT_H_

@@ -1,5 +1,5 @@
-#ifndef VANTAGE_LEARNER_UPDATE_GUARD_H_
-#define VANTAGE_LEARNER_UPDATE_GUARD_H_
+#ifndef VANTAGE_LEARNER_UPDATE_UPDATE_GUARD_H_
+#define VANTAGE_LEARNER_UPDATE_UPDATE_GUARD_H_
 
 // Defence in depth around one update: whatever passed validation, an update
 // that produces non-finite numbers (or an exploding gradient) is undone, so
@@ -54,4 +54,4 @@ class UpdateGuard {
 
 }  // namespace vantage
 
-#endif  // VANTAGE_LEARNER_UPDATE_GUARD_H_
+#endif  // VANTAGE_LEARNER_UPDATE_UPDATE_GUARD_H_

@@ -1,4 +1,4 @@
-#include "learner/checkpoint.h"
+#include "learner/checkpoint/checkpoint.h"
 
 #include <fcntl.h>
 #include <torch/serialize/archive.h>
@@ -15,8 +15,8 @@
 #include "absl/strings/str_format.h"
 #include "absl/strings/str_join.h"
 #include "absl/strings/str_split.h"
-#include "learner/archive_integrity.h"
-#include "learner/archive_io.h"
+#include "learner/checkpoint/archive_integrity.h"
+#include "learner/checkpoint/archive_io.h"
 
 namespace vantage {
 namespace {

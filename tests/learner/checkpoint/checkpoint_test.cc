@@ -1,4 +1,4 @@
-#include "learner/checkpoint.h"
+#include "learner/checkpoint/checkpoint.h"
 
 #include <ATen/ATen.h>
 #include <torch/serialize/archive.h>

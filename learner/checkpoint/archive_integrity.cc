@@ -1,4 +1,4 @@
-#include "learner/archive_integrity.h"
+#include "learner/checkpoint/archive_integrity.h"
 
 #include <minizip/unzip.h>
 

@@ -1,11 +1,11 @@
-#include "learner/ingest/reward_scaler.h"
+#include "learner/batch/reward_scaler.h"
 
 #include <ATen/ATen.h>
 #include <torch/serialize/archive.h>
 
 #include <cmath>
 
-#include "learner/archive_io.h"
+#include "learner/checkpoint/archive_io.h"
 #include "learner/parallel/replica_reductions.h"
 
 namespace vantage {

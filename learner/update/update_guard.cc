@@ -1,4 +1,4 @@
-#include "learner/update_guard.h"
+#include "learner/update/update_guard.h"
 
 #include <ATen/ATen.h>
 #include <ATen/core/grad_mode.h>
@@ -9,8 +9,8 @@
 
 #include "absl/strings/str_cat.h"
 #include "common/nn/networks.h"
+#include "learner/batch/reward_scaler.h"
 #include "learner/exploration/ex2_bonus.h"
-#include "learner/ingest/reward_scaler.h"
 
 namespace vantage {
 namespace {

@@ -1,4 +1,4 @@
-#include "learner/ingest/training_batch.h"
+#include "learner/batch/training_batch.h"
 
 #include <ATen/ATen.h>
 

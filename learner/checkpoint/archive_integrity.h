@@ -1,5 +1,5 @@
-#ifndef VANTAGE_LEARNER_ARCHIVE_INTEGRITY_H_
-#define VANTAGE_LEARNER_ARCHIVE_INTEGRITY_H_
+#ifndef VANTAGE_LEARNER_CHECKPOINT_ARCHIVE_INTEGRITY_H_
+#define VANTAGE_LEARNER_CHECKPOINT_ARCHIVE_INTEGRITY_H_
 
 // Checkpoints are zip archives (LibTorch's format). LibTorch's reader checks
 // none of an archive's CRC-32s, and what it then parses from corrupt bytes
@@ -22,4 +22,4 @@ absl::Status VerifyArchiveIntegrity(const std::string& path);
 
 }  // namespace vantage
 
-#endif  // VANTAGE_LEARNER_ARCHIVE_INTEGRITY_H_
+#endif  // VANTAGE_LEARNER_CHECKPOINT_ARCHIVE_INTEGRITY_H_

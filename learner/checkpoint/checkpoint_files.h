@@ -1,8 +1,8 @@
-#ifndef VANTAGE_LEARNER_CHECKPOINT_FILES_H_
-#define VANTAGE_LEARNER_CHECKPOINT_FILES_H_
+#ifndef VANTAGE_LEARNER_CHECKPOINT_CHECKPOINT_FILES_H_
+#define VANTAGE_LEARNER_CHECKPOINT_CHECKPOINT_FILES_H_
 
 // A run's checkpoint files by name, and their extras, without the learner
-// (learner/checkpoint.h writes and reads the learner's state).
+// (learner/checkpoint/checkpoint.h writes and reads the learner's state).
 
 #include <cstdint>
 #include <map>
@@ -32,4 +32,4 @@ absl::Status PruneCheckpoints(const std::string& directory, int keep);
 
 }  // namespace vantage
 
-#endif  // VANTAGE_LEARNER_CHECKPOINT_FILES_H_
+#endif  // VANTAGE_LEARNER_CHECKPOINT_CHECKPOINT_FILES_H_

@@ -1,0 +1,34 @@
+#include "learner/ingest/segment_check.h"
+
+#include <limits>
+#include <utility>
+
+#include "absl/strings/str_cat.h"
+
+namespace vantage {
+
+SegmentCheck::SegmentCheck(EnvSpec spec, int64_t max_segment_steps,
+                           ValueLimits value_limits, int64_t max_policy_lag)
+    : spec_(std::move(spec)),
+      max_segment_steps_(max_segment_steps),
+      value_limits_(value_limits),
+      max_policy_lag_(max_policy_lag) {}
+
+absl::Status SegmentCheck::Validate(const Segment& segment) const {
+  return ValidateSegment(segment, spec_, max_segment_steps_, value_limits_);
+}
+
+absl::Status SegmentCheck::CheckPublished(int64_t policy_version,
+                                          int64_t newest) {
+  if (policy_version <= newest) return absl::OkStatus();
+  return absl::FailedPreconditionError(
+      absl::StrCat("segment.policy_version ", policy_version,
+                   " has not been published (newest: ", newest, ")"));
+}
+
+int64_t SegmentCheck::OldestTrainable(int64_t newest) const {
+  return max_policy_lag_ < 0 ? std::numeric_limits<int64_t>::min()
+                             : newest - max_policy_lag_;
+}
+
+}  // namespace vantage
