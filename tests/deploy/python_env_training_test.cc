@@ -6,6 +6,8 @@
 
 #include <ATen/Parallel.h>
 
+#include <algorithm>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -52,23 +54,40 @@ double BestMeanReturn(const std::string& run_dir) {
 // configs/python_cartpole_ppo.json: RL Zoo's PPO settings for CartPole
 // (8 envs x 32 steps, 20 epochs of one minibatch, lr 1e-3, gamma 0.98,
 // lambda 0.8, no entropy bonus) with plain GAE, 100k steps. A uniformly
-// random policy's mean return is about 22; seed 1 reaches the 500 cap.
-constexpr char kCartPole[] =
-    "--config=configs/python_cartpole_ppo.json --seed=1";
+// random policy's mean return is about 22; the cap is 500.
+constexpr char kCartPole[] = "--config=configs/python_cartpole_ppo.json";
 
+// A local run repeats bit for bit only where OpenBLAS runs the same
+// kernels, and one seed's curve moves with them: measured 2026-12-06 on an
+// AVX-512 EPYC, seed 1 reached 500 with the Haswell and Zen kernels but
+// 430 with SkylakeX's, seed 4 missed 450 with all three (329, 188, 329),
+// seeds 0, 2, 3 and 5 reached 497-500 with each. So the bar is the median
+// of seeds 0-2 (500 under every kernel set measured), which one unlucky
+// curve cannot sink and no run without learning reaches.
 TEST(PythonEnvTrainingTest, PpoLearnsCartPoleLocally) {
-  const std::string run = FreshDirectory("python_cartpole_local");
-  const Outcome outcome = RunVantage(
-      absl::StrCat("train --mode=local ", kCartPole, " --run_dir=", run));
-  ASSERT_EQ(outcome.exit_code, 0) << outcome.err;
-  EXPECT_THAT(outcome.out, HasSubstr("env=python:cartpole:make"));
-  EXPECT_GE(BestMeanReturn(run), 450.0);
+  std::vector<double> best;
+  for (int seed : {0, 1, 2}) {
+    const std::string run =
+        FreshDirectory(absl::StrCat("python_cartpole_local_", seed));
+    const Outcome outcome =
+        RunVantage(absl::StrCat("train --mode=local ", kCartPole,
+                                " --seed=", seed, " --run_dir=", run));
+    ASSERT_EQ(outcome.exit_code, 0) << outcome.err;
+    EXPECT_THAT(outcome.out, HasSubstr("env=python:cartpole:make"));
+    best.push_back(BestMeanReturn(run));
+    std::printf("cartpole seed %d: best mean return %.1f\n", seed, best.back());
+  }
+  std::sort(best.begin(), best.end());
+  EXPECT_GE(best[1], 450.0);
 }
 
+// Distributed runs reached 500 with seeds 0-2 under the Haswell and
+// SkylakeX kernels alike (2026-12-06).
 TEST(PythonEnvTrainingTest, PpoLearnsCartPoleDistributed) {
   const std::string run = FreshDirectory("python_cartpole_distributed");
-  const Outcome outcome = RunVantage(absl::StrCat(
-      "train ", kCartPole, " --actors=2 --envs_per_actor=4 --run_dir=", run));
+  const Outcome outcome = RunVantage(
+      absl::StrCat("train ", kCartPole,
+                   " --seed=1 --actors=2 --envs_per_actor=4 --run_dir=", run));
   ASSERT_EQ(outcome.exit_code, 0) << outcome.err;
   EXPECT_GE(BestMeanReturn(run), 450.0);
 }
