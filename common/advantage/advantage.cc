@@ -287,6 +287,10 @@ absl::StatusOr<Advantages> ComputeAdvantages(const AdvantageInputs& inputs,
   out.gae = computed.gae;
   out.biased = unbiased ? computed.gae : computed.biased;
   out.mask = DrawBiasMask(out.gae.sizes(), config.rho, rng);
+  // With no bias no sample takes the biased estimate, whatever rho says;
+  // the mask is still drawn, so that the generator (and with it every
+  // later minibatch) is where it was in runs made before this held.
+  if (unbiased) out.mask.zero_();
   // A select, not m*A + (1-m)*Â, so that unmasked samples are GAE bit for bit.
   out.mixed = at::where(out.mask, out.biased, out.gae);
   out.returns = inputs.values.to(out.gae.scalar_type()) + out.gae;

@@ -32,7 +32,7 @@ struct Advantages {
   at::Tensor gae;      // the normal estimate
   at::Tensor biased;   // the statistic over the path ensemble
   at::Tensor mixed;    // mask ? biased : gae, what the policy loss uses
-  at::Tensor mask;     // bool, Bernoulli(rho) per sample
+  at::Tensor mask;     // bool, Bernoulli(rho) per sample; none with gae
   at::Tensor returns;  // values + gae, what the critic regresses on
 };
 

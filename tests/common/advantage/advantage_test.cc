@@ -370,6 +370,23 @@ TEST_F(AdvantagePropertyTest, CriticTargetsAreAlwaysValuePlusGae) {
   }
 }
 
+// With the gae statistic no sample is biased (progress.csv's
+// biased_fraction says 0), and the generator moves exactly as with a
+// statistic, so that later draws (minibatches) are those of older runs.
+TEST_F(AdvantagePropertyTest, GaeBiasesNoSampleButDrawsItsMask) {
+  AdvantageConfig config;
+  config.statistic = *ParseStatistic("gae");
+  config.rho = 0.4;
+  std::mt19937_64 rng(11);
+  const Advantages out = *ComputeAdvantages(inputs_, config, rng);
+  EXPECT_FALSE(out.mask.any().item<bool>());
+  EXPECT_TRUE(at::equal(out.mixed, out.gae));
+  config.statistic = *ParseStatistic("maxabs");
+  std::mt19937_64 biased_rng(11);
+  ASSERT_TRUE(ComputeAdvantages(inputs_, config, biased_rng).ok());
+  EXPECT_EQ(rng(), biased_rng());
+}
+
 TEST_F(AdvantagePropertyTest, MixedPicksPerSampleByTheMask) {
   AdvantageConfig config;
   config.statistic = *ParseStatistic("maxabs");
