@@ -21,7 +21,7 @@ FlatAdam::FlatAdam(std::vector<at::Tensor> parameters,
       exp_avg_(size, 0.0f),
       exp_avg_sq_(size, 0.0f) {}
 
-void FlatAdam::Step(const torch::optim::Adam& adam, float* parameters,
+void FlatAdam::Step(const torch::optim::Optimizer& adam, float* parameters,
                     const float* gradients) {
   const auto& options = static_cast<const torch::optim::AdamOptions&>(
       adam.param_groups().front().options());
@@ -51,7 +51,7 @@ void FlatAdam::Step(const torch::optim::Adam& adam, float* parameters,
   }
 }
 
-void FlatAdam::StoreInto(torch::optim::Adam& adam) const {
+void FlatAdam::StoreInto(torch::optim::Optimizer& adam) const {
   auto& state = adam.state();
   for (size_t i = 0; i < parameters_.size(); ++i) {
     const std::string key = OptimizerStateKey(parameters_[i]);
@@ -69,7 +69,7 @@ void FlatAdam::StoreInto(torch::optim::Adam& adam) const {
   }
 }
 
-absl::Status FlatAdam::LoadFrom(const torch::optim::Adam& adam) {
+absl::Status FlatAdam::LoadFrom(const torch::optim::Optimizer& adam) {
   const auto& state = adam.state();
   int64_t step = -1;
   std::vector<float> exp_avg(exp_avg_.size(), 0.0f);

@@ -14,30 +14,27 @@
 #include <vector>
 
 #include "absl/status/status.h"
-
-namespace torch::optim {
-class Adam;
-}  // namespace torch::optim
+#include "learner/algorithms/flat_optimizer.h"
 
 namespace vantage {
 
-class FlatAdam {
+class FlatAdam : public FlatOptimizer {
  public:
   // For the parameter tensors `parameters` laid out one after another from
   // `offsets` in a flat array of `size` floats.
   FlatAdam(std::vector<at::Tensor> parameters, std::vector<int64_t> offsets,
            int64_t size);
 
-  // One step of `adam`'s settings (its first group's learning rate, betas
-  // and eps) on `parameters` with `gradients`.
-  void Step(const torch::optim::Adam& adam, float* parameters,
-            const float* gradients);
+  // With a torch::optim::Adam: one step of `adam`'s settings (its first group's
+  // learning rate, betas and eps) on `parameters` with `gradients`.
+  void Step(const torch::optim::Optimizer& adam, float* parameters,
+            const float* gradients) override;
 
   // The state into `adam`'s per-parameter state (for its save()), and back
   // (after its load()): InvalidArgument when the loaded state's steps
   // differ between parameters or its moments do not fit.
-  void StoreInto(torch::optim::Adam& adam) const;
-  absl::Status LoadFrom(const torch::optim::Adam& adam);
+  void StoreInto(torch::optim::Optimizer& adam) const override;
+  absl::Status LoadFrom(const torch::optim::Optimizer& adam) override;
 
  private:
   std::vector<at::Tensor> parameters_;

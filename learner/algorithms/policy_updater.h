@@ -3,14 +3,20 @@
 
 // What every learning algorithm (PPO, A2C, TRPO) does with a batch: the
 // learner core hands over the estimates, the algorithm changes the networks.
+// PPO and A2C share more (first_order_updater.h).
 
 #include <ATen/core/Tensor.h>
 
 #include <cstdint>
+#include <memory>
 #include <random>
+#include <utility>
 
 #include "absl/status/status.h"
+#include "common/nn/networks.h"
 #include "learner/algorithms/algorithm_stats.h"
+#include "learner/algorithms/update_batch.h"
+#include "learner/parallel/replica_group.h"
 
 namespace torch::serialize {
 class InputArchive;
@@ -19,20 +25,8 @@ class OutputArchive;
 
 namespace vantage {
 
-// N env streams x T steps flattened time-major: row t * N + n.
-struct UpdateBatch {
-  int64_t horizon = 0;             // T
-  int64_t streams = 0;             // N
-  at::Tensor observations;         // [T*N, obs], normalised
-  at::Tensor actions;              // [T*N, act]
-  at::Tensor behaviour_log_probs;  // [T*N] of the policy that acted
-  at::Tensor advantages;           // [T*N] rho-mixed: the policy's
-  at::Tensor returns;              // [T*N] V + GAE: the critic's
-  // Some steps were acted by an older version than the one updating (an
-  // asynchronous run's lag).
-  bool lagged = false;
-};
-
+// The state every algorithm works on: the two networks it changes and the
+// data-parallel replicas it averages over.
 class PolicyUpdater {
  public:
   virtual ~PolicyUpdater() = default;
@@ -45,6 +39,17 @@ class PolicyUpdater {
   // The optimisers' state, for checkpoints.
   virtual void Save(torch::serialize::OutputArchive& archive) const = 0;
   virtual absl::Status Load(torch::serialize::InputArchive& archive) = 0;
+
+ protected:
+  PolicyUpdater(PolicyNetwork policy, ValueNetwork value,
+                std::shared_ptr<ReplicaGroup> replicas)
+      : policy_(std::move(policy)),
+        value_(std::move(value)),
+        replicas_(std::move(replicas)) {}
+
+  PolicyNetwork policy_;
+  ValueNetwork value_;
+  std::shared_ptr<ReplicaGroup> replicas_;
 };
 
 }  // namespace vantage

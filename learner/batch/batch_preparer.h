@@ -13,7 +13,7 @@
 
 #include "absl/status/statusor.h"
 #include "common/advantage/advantage.h"
-#include "learner/algorithms/policy_updater.h"
+#include "learner/algorithms/update_batch.h"
 #include "learner/batch/training_batch.h"
 #include "learner/exploration/exploration_stats.h"
 #include "learner/ingest/rollout_stitcher.h"

@@ -8,7 +8,7 @@
 #include "absl/functional/function_ref.h"
 #include "absl/status/statusor.h"
 #include "common/advantage/advantage.h"
-#include "learner/algorithms/policy_updater.h"
+#include "learner/algorithms/update_batch.h"
 #include "learner/ingest/rollout_stitcher.h"
 
 namespace vantage {

@@ -14,16 +14,13 @@
 #include <vector>
 
 #include "absl/status/status.h"
-
-namespace torch::optim {
-class Optimizer;
-}  // namespace torch::optim
+#include "learner/algorithms/flat_optimizer.h"
 
 namespace vantage {
 
 enum class RmspropArithmetic { kPytorch, kTensorflow };
 
-class FlatRmsprop {
+class FlatRmsprop : public FlatOptimizer {
  public:
   // For the parameter tensors `parameters` laid out one after another from
   // `offsets` in a flat array of `size` floats.
@@ -33,13 +30,13 @@ class FlatRmsprop {
   // One step with the learning rate, alpha and eps of `rmsprop`'s first
   // group (a torch::optim::RMSprop or a TensorflowRmsprop).
   void Step(const torch::optim::Optimizer& rmsprop, float* parameters,
-            const float* gradients);
+            const float* gradients) override;
 
   // The state into `rmsprop`'s per-parameter state (for its save()), and
   // back (after its load()): InvalidArgument when the loaded state's steps
   // differ between parameters or its mean squares do not fit.
-  void StoreInto(torch::optim::Optimizer& rmsprop) const;
-  absl::Status LoadFrom(const torch::optim::Optimizer& rmsprop);
+  void StoreInto(torch::optim::Optimizer& rmsprop) const override;
+  absl::Status LoadFrom(const torch::optim::Optimizer& rmsprop) override;
 
  private:
   // The mean square a parameter starts from: 0 or 1 by the arithmetic.

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "common/util/scratch_buffer.h"
+#include "learner/algorithms/flat_adam.h"
 #include "learner/algorithms/gradient_step.h"
 #include "learner/algorithms/ppo/ppo_objective.h"
 #include "learner/parallel/replica_reductions.h"
@@ -52,31 +53,22 @@ PpoUpdater::PpoUpdater(PolicyNetwork policy, ValueNetwork value,
                        const PpoConfig& config,
                        std::shared_ptr<ReplicaGroup> replicas,
                        bool autograd_only)
-    : policy_(std::move(policy)),
-      value_(std::move(value)),
-      config_(config),
-      replicas_(std::move(replicas)),
-      parameters_(NetworkParameters(*policy_, *value_)),
-      optimizer_(std::make_unique<torch::optim::Adam>(
-          parameters_,
-          torch::optim::AdamOptions(config.learning_rate).eps(1e-5))),
-      flat_(MakeFlatActorCritic(*policy_, *value_, parameters_, "PPO",
-                                autograd_only)) {
-  if (flat_.has_value()) {
-    flat_adam_.emplace(parameters_, flat_->offsets(), flat_->size());
-  }
+    : FirstOrderUpdater(
+          std::move(policy), std::move(value), std::move(replicas),
+          GradientSettings{config.learning_rate, config.value_coef,
+                           config.entropy_coef, config.max_grad_norm},
+          "PPO", "adam", autograd_only),
+      config_(config) {
+  UseOptimizers(std::make_unique<torch::optim::Adam>(
+                    parameters(),
+                    torch::optim::AdamOptions(config.learning_rate).eps(1e-5)),
+                flat() ? std::make_unique<FlatAdam>(parameters(),
+                                                    flat_networks().offsets(),
+                                                    flat_networks().size())
+                       : nullptr);
 }
 
 PpoUpdater::~PpoUpdater() = default;
-
-AlgorithmStats PpoUpdater::Update(const UpdateBatch& batch, double progress,
-                                  std::mt19937_64& rng) {
-  SetLearningRate(*optimizer_,
-                  config_.learning_rate * std::max(0.0, 1.0 - progress));
-  const Decoupled decoupled = Decouple(batch);
-  return flat_.has_value() ? FlatUpdate(decoupled, rng)
-                           : AutogradUpdate(decoupled, rng);
-}
 
 PpoUpdater::Decoupled PpoUpdater::Decouple(const UpdateBatch& batch) {
   Decoupled out{batch, at::Tensor()};
@@ -90,31 +82,16 @@ PpoUpdater::Decoupled PpoUpdater::Decouple(const UpdateBatch& batch) {
   return out;
 }
 
-AlgorithmStats PpoUpdater::FlatUpdate(const Decoupled& decoupled,
+AlgorithmStats PpoUpdater::FlatUpdate(const UpdateBatch& lagged,
                                       std::mt19937_64& rng) {
+  const Decoupled decoupled = Decouple(lagged);
   const UpdateBatch& batch = decoupled.batch;
-  FlatActorCritic& net = *flat_;
-  // The modules may have been rolled back or loaded since the last update.
-  net.Pull();
+  const FlatRows rows = StartFlatUpdate(batch);
   const int64_t size = batch.observations.size(0);
   const int64_t minibatch = std::max<int64_t>(1, size / config_.minibatches);
-  const at::Tensor inputs = net.Inputs(batch.observations);
-  const at::Tensor actions = FloatRows(batch.actions, size);
-  const at::Tensor behaviour = FloatRows(batch.behaviour_log_probs, size);
-  const at::Tensor advantages = FloatRows(batch.advantages, size);
-  const at::Tensor returns = FloatRows(batch.returns, size);
   const at::Tensor weights = decoupled.weights.defined()
                                  ? FloatRows(decoupled.weights, size)
                                  : at::Tensor();
-  const int64_t observation_size = inputs.size(1);
-  const int64_t action_width = actions.size(1);
-  d_log_probs_.resize(minibatch);
-  d_values_.resize(minibatch);
-  // The clipping bounds and tests in float, as the autograd path has them.
-  const float low = static_cast<float>(1.0 - config_.clip);
-  const float high = static_cast<float>(1.0 + config_.clip);
-  const float clip = static_cast<float>(config_.clip);
-  const double rows = static_cast<double>(minibatch);
   std::vector<int64_t> order(size);
   MeanStats stats;
   for (int epoch = 0; epoch < config_.epochs; ++epoch) {
@@ -129,66 +106,71 @@ AlgorithmStats PpoUpdater::FlatUpdate(const Decoupled& decoupled,
     size_t part = 0;
     for (int64_t begin = 0; begin + minibatch <= size;
          begin += minibatch, ++part) {
-      const int64_t* index = order.data() + begin;
-      GatherRows(inputs.data_ptr<float>(), observation_size, index, minibatch,
-                 inputs_);
-      GatherRows(actions.data_ptr<float>(), action_width, index, minibatch,
-                 actions_);
-      GatherRows(behaviour.data_ptr<float>(), 1, index, minibatch, behaviour_);
-      GatherRows(advantages.data_ptr<float>(), 1, index, minibatch,
-                 advantages_);
-      GatherRows(returns.data_ptr<float>(), 1, index, minibatch, returns_);
-      if (normalizer.has_value()) {
-        normalizer->NormalizeInPlace(part, advantages_.data(), minibatch);
-      }
-      if (weights.defined()) {
-        GatherRows(weights.data_ptr<float>(), 1, index, minibatch, weights_);
-        for (int64_t i = 0; i < minibatch; ++i) advantages_[i] *= weights_[i];
-      }
-      net.Forward(inputs_.data(), actions_.data(), minibatch);
-      const float* log_probs = net.log_probs();
-      const float* values = net.values();
-      double policy_loss = 0.0, value_loss = 0.0, approx_kl = 0.0;
-      int64_t clipped = 0;
-      for (int64_t i = 0; i < minibatch; ++i) {
-        const float log_ratio = log_probs[i] - behaviour_[i];
-        const float ratio = std::exp(log_ratio);
-        const float advantage = advantages_[i];
-        const float unclipped = ratio * advantage;
-        const float bounded = std::min(std::max(ratio, low), high) * advantage;
-        // The surrogate's gradient flows through the unclipped term when
-        // it is the smaller (or both are equal: the ratio is in bounds);
-        // the clipped one is flat in the ratio.
-        policy_loss -= std::min(unclipped, bounded);
-        d_log_probs_[i] = unclipped <= bounded
-                              ? static_cast<float>(-advantage * ratio / rows)
-                              : 0.0f;
-        const float error = values[i] - returns_[i];
-        value_loss += 0.5 * error * error;
-        d_values_[i] = static_cast<float>(config_.value_coef * error / rows);
-        approx_kl += (ratio - 1.0f) - log_ratio;
-        if (std::abs(ratio - 1.0f) > clip) ++clipped;
-      }
-      net.Backward(d_log_probs_.data(), -config_.entropy_coef,
-                   d_values_.data());
-      AlgorithmStats step;
-      step.max_gradient_norm = AverageAndClipFlatGradient(
-          net.gradients(), net.size(), config_.max_grad_norm, *replicas_);
-      flat_adam_->Step(*optimizer_, net.parameters(), net.gradients());
-      step.policy_loss = policy_loss / rows;
-      step.value_loss = value_loss / rows;
-      step.entropy = net.mean_entropy();
-      step.approx_kl = approx_kl / rows;
-      step.clip_fraction = static_cast<double>(clipped) / rows;
-      stats.Add(step);
+      stats.Add(FlatMinibatch(rows, weights, order.data() + begin, minibatch,
+                              normalizer.has_value() ? &*normalizer : nullptr,
+                              part));
     }
   }
-  net.Push();
+  flat_networks().Push();
   return stats.Mean();
 }
 
-AlgorithmStats PpoUpdater::AutogradUpdate(const Decoupled& decoupled,
+AlgorithmStats PpoUpdater::FlatMinibatch(
+    const FlatRows& rows, const at::Tensor& weights, const int64_t* index,
+    int64_t minibatch, PartsNormalizer* normalizer, size_t part) {
+  GatherRows(rows.inputs.data_ptr<float>(), rows.inputs.size(1), index,
+             minibatch, inputs_);
+  GatherRows(rows.actions.data_ptr<float>(), rows.actions.size(1), index,
+             minibatch, actions_);
+  GatherRows(rows.behaviour.data_ptr<float>(), 1, index, minibatch, behaviour_);
+  GatherRows(rows.advantages.data_ptr<float>(), 1, index, minibatch,
+             advantages_);
+  GatherRows(rows.returns.data_ptr<float>(), 1, index, minibatch, returns_);
+  if (normalizer != nullptr) {
+    normalizer->NormalizeInPlace(part, advantages_.data(), minibatch);
+  }
+  if (weights.defined()) {
+    GatherRows(weights.data_ptr<float>(), 1, index, minibatch, weights_);
+    for (int64_t i = 0; i < minibatch; ++i) advantages_[i] *= weights_[i];
+  }
+  FlatActorCritic& net = flat_networks();
+  net.Forward(inputs_.data(), actions_.data(), minibatch);
+  const float* log_probs = net.log_probs();
+  const float* values = net.values();
+  float* d_log_prob = d_log_probs(minibatch);
+  float* d_value = d_values(minibatch);
+  // The clipping bounds and tests in float, as the autograd path has them.
+  const float low = static_cast<float>(1.0 - config_.clip);
+  const float high = static_cast<float>(1.0 + config_.clip);
+  const float clip = static_cast<float>(config_.clip);
+  const double count = static_cast<double>(minibatch);
+  LossSums sums;
+  int64_t clipped = 0;
+  for (int64_t i = 0; i < minibatch; ++i) {
+    const float log_ratio = log_probs[i] - behaviour_[i];
+    const float ratio = std::exp(log_ratio);
+    const float advantage = advantages_[i];
+    const float unclipped = ratio * advantage;
+    const float bounded = std::min(std::max(ratio, low), high) * advantage;
+    // The surrogate's gradient flows through the unclipped term when it is
+    // the smaller (or both are equal: the ratio is in bounds); the clipped
+    // one is flat in the ratio.
+    sums.policy_loss -= std::min(unclipped, bounded);
+    d_log_prob[i] = unclipped <= bounded
+                        ? static_cast<float>(-advantage * ratio / count)
+                        : 0.0f;
+    const float error = values[i] - returns_[i];
+    sums.value_loss += 0.5 * error * error;
+    d_value[i] = ValueGradient(error, count);
+    sums.approx_kl += (ratio - 1.0f) - log_ratio;
+    if (std::abs(ratio - 1.0f) > clip) ++clipped;
+  }
+  return FlatStep(minibatch, sums, static_cast<double>(clipped) / count);
+}
+
+AlgorithmStats PpoUpdater::AutogradUpdate(const UpdateBatch& lagged,
                                           std::mt19937_64& rng) {
+  const Decoupled decoupled = Decouple(lagged);
   const UpdateBatch& batch = decoupled.batch;
   const int64_t size = batch.observations.size(0);
   const int64_t minibatch = std::max<int64_t>(1, size / config_.minibatches);
@@ -217,38 +199,16 @@ AlgorithmStats PpoUpdater::AutogradUpdate(const Decoupled& decoupled,
       const PpoPolicyLoss policy_loss = PpoClippedPolicyLoss(
           log_prob, batch.behaviour_log_probs.index_select(0, index), adv,
           config_.clip);
-      const at::Tensor entropy = policy_->Entropy(output).mean();
-      const at::Tensor value_loss =
-          ValueLoss(*value_, obs, batch.returns.index_select(0, index));
-      const double gradient_norm =
-          GradientStep(*optimizer_, parameters_,
-                       policy_loss.loss + config_.value_coef * value_loss -
-                           config_.entropy_coef * entropy,
-                       config_.max_grad_norm, *replicas_);
-      AlgorithmStats step;
-      step.max_gradient_norm = gradient_norm;
-      step.policy_loss = policy_loss.loss.item<double>();
-      step.value_loss = value_loss.item<double>();
-      step.entropy = entropy.item<double>();
+      AlgorithmStats step = AutogradStep(
+          policy_loss.loss,
+          ValueLoss(*value_, obs, batch.returns.index_select(0, index)),
+          policy_->Entropy(output).mean());
       step.approx_kl = policy_loss.approx_kl.item<double>();
       step.clip_fraction = policy_loss.clip_fraction.item<double>();
       stats.Add(step);
     }
   }
   return stats.Mean();
-}
-
-void PpoUpdater::Save(torch::serialize::OutputArchive& archive) const {
-  if (flat_adam_.has_value()) flat_adam_->StoreInto(*optimizer_);
-  SaveOptimizer(*optimizer_, "adam", archive);
-}
-
-absl::Status PpoUpdater::Load(torch::serialize::InputArchive& archive) {
-  if (absl::Status status = LoadOptimizer(*optimizer_, "adam", archive);
-      !status.ok() || !flat_adam_.has_value()) {
-    return status;
-  }
-  return flat_adam_->LoadFrom(*optimizer_);
 }
 
 }  // namespace vantage

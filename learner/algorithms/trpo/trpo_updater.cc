@@ -52,10 +52,8 @@ void AssignParameters(const at::Tensor& flat,
 TrpoUpdater::TrpoUpdater(PolicyNetwork policy, ValueNetwork value,
                          const TrpoConfig& config,
                          std::shared_ptr<ReplicaGroup> replicas)
-    : policy_(std::move(policy)),
-      value_(std::move(value)),
+    : PolicyUpdater(std::move(policy), std::move(value), std::move(replicas)),
       config_(config),
-      replicas_(std::move(replicas)),
       policy_parameters_(policy_->parameters()),
       value_parameters_(value_->parameters()),
       value_optimizer_(std::make_unique<torch::optim::Adam>(

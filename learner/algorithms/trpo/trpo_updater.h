@@ -42,10 +42,7 @@ class TrpoUpdater : public PolicyUpdater {
                     double& surrogate_after);
   double FitValue(const UpdateBatch& batch, std::mt19937_64& rng);
 
-  PolicyNetwork policy_;
-  ValueNetwork value_;
   TrpoConfig config_;
-  std::shared_ptr<ReplicaGroup> replicas_;
   std::vector<at::Tensor> policy_parameters_;
   std::vector<at::Tensor> value_parameters_;
   std::unique_ptr<torch::optim::Adam> value_optimizer_;

@@ -1,0 +1,109 @@
+#include "learner/algorithms/first_order_updater.h"
+
+#include <ATen/ATen.h>
+#include <torch/optim/optimizer.h>
+
+#include <algorithm>
+#include <utility>
+
+#include "learner/algorithms/gradient_step.h"
+
+namespace vantage {
+
+FirstOrderUpdater::FirstOrderUpdater(PolicyNetwork policy, ValueNetwork value,
+                                     std::shared_ptr<ReplicaGroup> replicas,
+                                     const GradientSettings& settings,
+                                     const char* algorithm,
+                                     std::string checkpoint_key,
+                                     bool autograd_only)
+    : PolicyUpdater(std::move(policy), std::move(value), std::move(replicas)),
+      settings_(settings),
+      checkpoint_key_(std::move(checkpoint_key)),
+      parameters_(NetworkParameters(*policy_, *value_)),
+      flat_(MakeFlatActorCritic(*policy_, *value_, parameters_, algorithm,
+                                autograd_only)) {}
+
+FirstOrderUpdater::~FirstOrderUpdater() = default;
+
+void FirstOrderUpdater::UseOptimizers(
+    std::unique_ptr<torch::optim::Optimizer> optimizer,
+    std::unique_ptr<FlatOptimizer> flat_optimizer) {
+  optimizer_ = std::move(optimizer);
+  flat_optimizer_ = std::move(flat_optimizer);
+}
+
+AlgorithmStats FirstOrderUpdater::Update(const UpdateBatch& batch,
+                                         double progress,
+                                         std::mt19937_64& rng) {
+  SetLearningRate(*optimizer_,
+                  settings_.learning_rate * std::max(0.0, 1.0 - progress));
+  return flat() ? FlatUpdate(batch, rng) : AutogradUpdate(batch, rng);
+}
+
+FirstOrderUpdater::FlatRows FirstOrderUpdater::StartFlatUpdate(
+    const UpdateBatch& batch) {
+  flat_->Pull();
+  const int64_t size = batch.observations.size(0);
+  return FlatRows{
+      flat_->Inputs(batch.observations), FloatRows(batch.actions, size),
+      FloatRows(batch.behaviour_log_probs, size),
+      FloatRows(batch.advantages, size), FloatRows(batch.returns, size)};
+}
+
+float* FirstOrderUpdater::d_log_probs(int64_t rows) {
+  d_log_probs_.resize(rows);
+  return d_log_probs_.data();
+}
+
+float* FirstOrderUpdater::d_values(int64_t rows) {
+  d_values_.resize(rows);
+  return d_values_.data();
+}
+
+AlgorithmStats FirstOrderUpdater::FlatStep(int64_t rows, const LossSums& sums,
+                                           double clip_fraction) {
+  FlatActorCritic& net = *flat_;
+  net.Backward(d_log_probs_.data(), -settings_.entropy_coef, d_values_.data());
+  AlgorithmStats step;
+  step.max_gradient_norm = AverageAndClipFlatGradient(
+      net.gradients(), net.size(), settings_.max_grad_norm, *replicas_);
+  flat_optimizer_->Step(*optimizer_, net.parameters(), net.gradients());
+  const double count = static_cast<double>(rows);
+  step.policy_loss = sums.policy_loss / count;
+  step.value_loss = sums.value_loss / count;
+  step.entropy = net.mean_entropy();
+  step.approx_kl = sums.approx_kl / count;
+  step.clip_fraction = clip_fraction;
+  return step;
+}
+
+AlgorithmStats FirstOrderUpdater::AutogradStep(const at::Tensor& policy_loss,
+                                               const at::Tensor& value_loss,
+                                               const at::Tensor& entropy) {
+  AlgorithmStats step;
+  step.max_gradient_norm =
+      GradientStep(*optimizer_, parameters_,
+                   policy_loss + settings_.value_coef * value_loss -
+                       settings_.entropy_coef * entropy,
+                   settings_.max_grad_norm, *replicas_);
+  step.policy_loss = policy_loss.item<double>();
+  step.value_loss = value_loss.item<double>();
+  step.entropy = entropy.item<double>();
+  return step;
+}
+
+void FirstOrderUpdater::Save(torch::serialize::OutputArchive& archive) const {
+  if (flat_optimizer_ != nullptr) flat_optimizer_->StoreInto(*optimizer_);
+  SaveOptimizer(*optimizer_, checkpoint_key_, archive);
+}
+
+absl::Status FirstOrderUpdater::Load(torch::serialize::InputArchive& archive) {
+  if (absl::Status status =
+          LoadOptimizer(*optimizer_, checkpoint_key_, archive);
+      !status.ok() || flat_optimizer_ == nullptr) {
+    return status;
+  }
+  return flat_optimizer_->LoadFrom(*optimizer_);
+}
+
+}  // namespace vantage

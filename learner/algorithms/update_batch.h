@@ -1,0 +1,29 @@
+#ifndef VANTAGE_LEARNER_ALGORITHMS_UPDATE_BATCH_H_
+#define VANTAGE_LEARNER_ALGORITHMS_UPDATE_BATCH_H_
+
+// What every learning algorithm trains on: the batch as the learner's batch
+// stage hands it over.
+
+#include <ATen/core/Tensor.h>
+
+#include <cstdint>
+
+namespace vantage {
+
+// N env streams x T steps flattened time-major: row t * N + n.
+struct UpdateBatch {
+  int64_t horizon = 0;             // T
+  int64_t streams = 0;             // N
+  at::Tensor observations;         // [T*N, obs], normalised
+  at::Tensor actions;              // [T*N, act]
+  at::Tensor behaviour_log_probs;  // [T*N] of the policy that acted
+  at::Tensor advantages;           // [T*N] rho-mixed: the policy's
+  at::Tensor returns;              // [T*N] V + GAE: the critic's
+  // Some steps were acted by an older version than the one updating (an
+  // asynchronous run's lag).
+  bool lagged = false;
+};
+
+}  // namespace vantage
+
+#endif  // VANTAGE_LEARNER_ALGORITHMS_UPDATE_BATCH_H_
