@@ -88,51 +88,15 @@ class Expander {
           "not ",
           options_.budget));
     }
-    std::vector<uint64_t> seeds = options_.seeds;
-    std::string seeds_origin = "--seeds";
-    if (seeds.empty()) {
-      seeds.assign(experiment_.seeds().begin(), experiment_.seeds().end());
-      seeds_origin = "seeds";
-    }
-    if (seeds.empty()) {
-      return Invalid(options_.file, "seeds", "list at least one seed");
-    }
-    if (std::set<uint64_t>(seeds.begin(), seeds.end()).size() != seeds.size()) {
-      return Invalid(options_.file, seeds_origin, "a seed is listed twice");
-    }
-    absl::StatusOr<std::vector<Point>> common =
-        AxesProduct(experiment_.axes(), "axes", {Point()});
-    if (!common.ok()) return common.status();
-    std::vector<Point> points;
-    if (experiment_.variants().empty()) {
-      points = *common;
-    }
-    for (int v = 0; v < experiment_.variants_size(); ++v) {
-      const pb::Variant& variant = experiment_.variants(v);
-      const std::string field = absl::StrCat("variants[", v, "]");
-      Point fixed;
-      // A map's order is unspecified; sorted names keep cells stable.
-      std::map<std::string, std::string> set(variant.set().begin(),
-                                             variant.set().end());
-      for (const auto& [flag, value] : set) {
-        const std::string origin = absl::StrCat(field, ".set.", flag);
-        if (absl::Status status = CheckFlag(flag, origin); !status.ok()) {
-          return status;
-        }
-        fixed.push_back({flag, value, origin});
-      }
-      std::vector<Point> starts;
-      for (const Point& point : *common) starts.push_back(Join(point, fixed));
-      absl::StatusOr<std::vector<Point>> product =
-          AxesProduct(variant.axes(), absl::StrCat(field, ".axes"), starts);
-      if (!product.ok()) return product.status();
-      points.insert(points.end(), product->begin(), product->end());
-    }
+    absl::StatusOr<Seeds> seeds = ChooseSeeds();
+    if (!seeds.ok()) return seeds.status();
+    absl::StatusOr<std::vector<Point>> points = AllPoints();
+    if (!points.ok()) return points.status();
     if (absl::Status status = CheckReport(); !status.ok()) return status;
-    if (points.size() * seeds.size() > kMaxCells) {
-      return absl::InvalidArgumentError(
-          absl::StrCat(options_.file, ": ", points.size() * seeds.size(),
-                       " cells, more than ", kMaxCells));
+    if (points->size() * seeds->values.size() > kMaxCells) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          options_.file, ": ", points->size() * seeds->values.size(),
+          " cells, more than ", kMaxCells));
     }
 
     pb::ExpandedExperiment expanded;
@@ -144,15 +108,86 @@ class Expander {
     if (expanded.report().baseline().empty()) {
       expanded.mutable_report()->set_baseline("gae");
     }
+    if (absl::Status status = AddCells(*points, *seeds, expanded);
+        !status.ok()) {
+      return status;
+    }
+    if (absl::Status status = CheckThresholdEnvs(expanded); !status.ok()) {
+      return status;
+    }
+    return expanded;
+  }
+
+ private:
+  struct Seeds {
+    std::vector<uint64_t> values;
+    std::string origin;  // --seeds or the file's seeds
+  };
+
+  absl::StatusOr<Seeds> ChooseSeeds() const {
+    Seeds seeds{options_.seeds, "--seeds"};
+    if (seeds.values.empty()) {
+      seeds.values.assign(experiment_.seeds().begin(),
+                          experiment_.seeds().end());
+      seeds.origin = "seeds";
+    }
+    if (seeds.values.empty()) {
+      return Invalid(options_.file, "seeds", "list at least one seed");
+    }
+    if (std::set<uint64_t>(seeds.values.begin(), seeds.values.end()).size() !=
+        seeds.values.size()) {
+      return Invalid(options_.file, seeds.origin, "a seed is listed twice");
+    }
+    return seeds;
+  }
+
+  // The axes' product, or each variant's on top of it.
+  absl::StatusOr<std::vector<Point>> AllPoints() {
+    absl::StatusOr<std::vector<Point>> common =
+        AxesProduct(experiment_.axes(), "axes", {Point()});
+    if (!common.ok()) return common.status();
+    if (experiment_.variants().empty()) return common;
+    std::vector<Point> points;
+    for (int v = 0; v < experiment_.variants_size(); ++v) {
+      absl::StatusOr<std::vector<Point>> product = VariantPoints(v, *common);
+      if (!product.ok()) return product.status();
+      points.insert(points.end(), product->begin(), product->end());
+    }
+    return points;
+  }
+
+  absl::StatusOr<std::vector<Point>> VariantPoints(
+      int v, const std::vector<Point>& common) {
+    const pb::Variant& variant = experiment_.variants(v);
+    const std::string field = absl::StrCat("variants[", v, "]");
+    Point fixed;
+    // A map's order is unspecified; sorted names keep cells stable.
+    std::map<std::string, std::string> set(variant.set().begin(),
+                                           variant.set().end());
+    for (const auto& [flag, value] : set) {
+      const std::string origin = absl::StrCat(field, ".set.", flag);
+      if (absl::Status status = CheckFlag(flag, origin); !status.ok()) {
+        return status;
+      }
+      fixed.push_back({flag, value, origin});
+    }
+    std::vector<Point> starts;
+    for (const Point& point : common) starts.push_back(Join(point, fixed));
+    return AxesProduct(variant.axes(), absl::StrCat(field, ".axes"), starts);
+  }
+
+  // Each point once per seed, in that order; no two cells may share a run
+  // directory.
+  absl::Status AddCells(const std::vector<Point>& points, const Seeds& seeds,
+                        pb::ExpandedExperiment& expanded) {
     std::map<std::string, std::string> origin_of_dir;
-    std::set<std::string> envs;
     for (const Point& point : points) {
       if (absl::Status status = CheckRepeats(point); !status.ok()) {
         return status;
       }
-      for (uint64_t seed : seeds) {
+      for (uint64_t seed : seeds.values) {
         absl::StatusOr<pb::ExperimentCell> cell =
-            MakeCell(point, seed, seeds_origin);
+            MakeCell(point, seed, seeds.origin);
         if (!cell.ok()) return cell.status();
         const std::string origins = OriginsText(point);
         auto [it, inserted] = origin_of_dir.emplace(cell->dir(), origins);
@@ -166,9 +201,16 @@ class Expander {
                   : "; settings set together with the env in one point do "
                     "not name groups"));
         }
-        envs.insert(cell->env());
         *expanded.add_cells() = *std::move(cell);
       }
+    }
+    return absl::OkStatus();
+  }
+
+  absl::Status CheckThresholdEnvs(const pb::ExpandedExperiment& expanded) {
+    std::set<std::string> envs;
+    for (const pb::ExperimentCell& cell : expanded.cells()) {
+      envs.insert(cell.env());
     }
     for (const auto& [env, threshold] : experiment_.report().thresholds()) {
       if (envs.count(env) == 0) {
@@ -178,10 +220,9 @@ class Expander {
                          " (its envs: ", absl::StrJoin(envs, ", "), ")"));
       }
     }
-    return expanded;
+    return absl::OkStatus();
   }
 
- private:
   static Point Join(const Point& a, const Point& b) {
     Point joined = a;
     joined.insert(joined.end(), b.begin(), b.end());
