@@ -54,88 +54,21 @@ class LocalBackend : public ExperimentBackend {
     // Children are reaped here: an ignored SIGCHLD inherited from the
     // parent would make the kernel reap them and waitpid fail.
     std::signal(SIGCHLD, SIG_DFL);
-    std::vector<CellOutcome> outcomes(tasks.size());
-    for (CellOutcome& outcome : outcomes) {
-      outcome.kind = CellOutcome::Kind::kStopped;
-      outcome.message = "not started";
-    }
-    std::map<pid_t, size_t> running;
-    size_t next = 0;
-    Progress progress{totals, Clock::now()};
-    // Steps each task made in this invocation, within its run's steps.
-    std::vector<int64_t> start_steps;
-    std::vector<int64_t> gained(tasks.size(), 0);
-    for (const CellTask& task : tasks) {
-      start_steps.push_back(LastProgressSteps(task.run_dir));
-    }
-    auto count_steps = [&](size_t i) {
-      const int64_t now = LastProgressSteps(tasks[i].run_dir);
-      gained[i] = std::clamp<int64_t>(
-          now - start_steps[i], 0,
-          std::max<int64_t>(0, tasks[i].steps - start_steps[i]));
-    };
-    Clock::time_point last_count;
+    Grid grid(tasks, totals);
     while (true) {
       if (stop) {
-        StopAll(running, tasks, outcomes);
+        StopAll(grid.running, tasks, grid.outcomes);
         break;
       }
-      while (!stop && static_cast<int>(running.size()) < jobs_ &&
-             next < tasks.size()) {
-        const CellTask& task = tasks[next];
-        absl::StatusOr<pid_t> pid =
-            SpawnSelf(task.train_args, task.log_path, /*append=*/true);
-        if (pid.ok()) {
-          running[*pid] = next;
-        } else {
-          outcomes[next] = {CellOutcome::Kind::kFailed,
-                            std::string(pid.status().message())};
-          ++progress.failed;
-          Report(progress, "failed", task.name, outcomes[next].message);
-        }
-        ++next;
-      }
-      if (running.empty() && next >= tasks.size()) break;
-      for (auto it = running.begin(); it != running.end();) {
-        int status = 0;
-        const pid_t ended = waitpid(it->first, &status, WNOHANG);
-        if (ended == 0 || (ended < 0 && errno == EINTR)) {
-          ++it;
-          continue;
-        }
-        // ended < 0 otherwise: the child is gone without a status to read;
-        // its progress.csv still says how far it got.
-        const size_t index = it->second;
-        const CellTask& task = tasks[index];
-        CellOutcome& outcome = outcomes[index];
-        outcome = Classify(task, ended > 0 ? status : -1, stop);
-        count_steps(index);
-        it = running.erase(it);
-        progress.running = static_cast<int>(running.size());
-        if (outcome.kind == CellOutcome::Kind::kFinished) {
-          ++progress.finished;
-          Report(progress, "finished", task.name, "");
-        } else if (outcome.kind == CellOutcome::Kind::kFailed) {
-          ++progress.failed;
-          Report(progress, "failed", task.name, outcome.message);
-        }
-      }
-      progress.running = static_cast<int>(running.size());
-      progress.waiting = static_cast<int>(tasks.size() - next);
-      // Reading the running cells' progress files once a second is enough
-      // for a progress line.
-      if (Clock::now() - last_count >= std::chrono::seconds(1)) {
-        for (const auto& [pid, index] : running) count_steps(index);
-        last_count = Clock::now();
-      }
-      progress.steps = totals.steps_before;
-      for (int64_t steps : gained) progress.steps += steps;
-      PrintProgress(progress);
+      StartCells(grid, stop);
+      if (grid.running.empty() && grid.next >= tasks.size()) break;
+      ReapEndedCells(grid, stop);
+      ShowProgress(grid);
       std::this_thread::sleep_for(std::chrono::milliseconds(200));
     }
     if (terminal_) std::printf("\n");
     std::fflush(stdout);
-    return outcomes;
+    return grid.outcomes;
   }
 
  private:
@@ -148,6 +81,103 @@ class LocalBackend : public ExperimentBackend {
     int waiting = 0;
     int64_t steps = 0;
   };
+
+  // One Run's cells: those running, the next to start, how each ended.
+  struct Grid {
+    Grid(const std::vector<CellTask>& tasks, const GridTotals& totals)
+        : tasks(tasks),
+          outcomes(tasks.size()),
+          progress{totals, Clock::now()},
+          gained(tasks.size(), 0) {
+      for (CellOutcome& outcome : outcomes) {
+        outcome.kind = CellOutcome::Kind::kStopped;
+        outcome.message = "not started";
+      }
+      for (const CellTask& task : tasks) {
+        start_steps.push_back(LastProgressSteps(task.run_dir));
+      }
+    }
+
+    const std::vector<CellTask>& tasks;
+    std::vector<CellOutcome> outcomes;
+    std::map<pid_t, size_t> running;
+    size_t next = 0;
+    Progress progress;
+    // Steps each task made in this invocation, within its run's steps.
+    std::vector<int64_t> start_steps;
+    std::vector<int64_t> gained;
+    Clock::time_point last_count;
+  };
+
+  static void CountSteps(Grid& grid, size_t i) {
+    const CellTask& task = grid.tasks[i];
+    const int64_t now = LastProgressSteps(task.run_dir);
+    grid.gained[i] = std::clamp<int64_t>(
+        now - grid.start_steps[i], 0,
+        std::max<int64_t>(0, task.steps - grid.start_steps[i]));
+  }
+
+  // Up to `jobs_` at a time; a cell that cannot start has failed.
+  void StartCells(Grid& grid, const std::atomic<bool>& stop) {
+    while (!stop && static_cast<int>(grid.running.size()) < jobs_ &&
+           grid.next < grid.tasks.size()) {
+      const CellTask& task = grid.tasks[grid.next];
+      absl::StatusOr<pid_t> pid =
+          SpawnSelf(task.train_args, task.log_path, /*append=*/true);
+      if (pid.ok()) {
+        grid.running[*pid] = grid.next;
+      } else {
+        grid.outcomes[grid.next] = {CellOutcome::Kind::kFailed,
+                                    std::string(pid.status().message())};
+        ++grid.progress.failed;
+        Report(grid.progress, "failed", task.name,
+               grid.outcomes[grid.next].message);
+      }
+      ++grid.next;
+    }
+  }
+
+  void ReapEndedCells(Grid& grid, const std::atomic<bool>& stop) {
+    for (auto it = grid.running.begin(); it != grid.running.end();) {
+      int status = 0;
+      const pid_t ended = waitpid(it->first, &status, WNOHANG);
+      if (ended == 0 || (ended < 0 && errno == EINTR)) {
+        ++it;
+        continue;
+      }
+      // ended < 0 otherwise: the child is gone without a status to read;
+      // its progress.csv still says how far it got.
+      const size_t index = it->second;
+      const CellTask& task = grid.tasks[index];
+      CellOutcome& outcome = grid.outcomes[index];
+      outcome = Classify(task, ended > 0 ? status : -1, stop);
+      CountSteps(grid, index);
+      it = grid.running.erase(it);
+      grid.progress.running = static_cast<int>(grid.running.size());
+      if (outcome.kind == CellOutcome::Kind::kFinished) {
+        ++grid.progress.finished;
+        Report(grid.progress, "finished", task.name, "");
+      } else if (outcome.kind == CellOutcome::Kind::kFailed) {
+        ++grid.progress.failed;
+        Report(grid.progress, "failed", task.name, outcome.message);
+      }
+    }
+  }
+
+  void ShowProgress(Grid& grid) {
+    Progress& progress = grid.progress;
+    progress.running = static_cast<int>(grid.running.size());
+    progress.waiting = static_cast<int>(grid.tasks.size() - grid.next);
+    // Reading the running cells' progress files once a second is enough
+    // for a progress line.
+    if (Clock::now() - grid.last_count >= std::chrono::seconds(1)) {
+      for (const auto& [pid, index] : grid.running) CountSteps(grid, index);
+      grid.last_count = Clock::now();
+    }
+    progress.steps = progress.totals.steps_before;
+    for (int64_t steps : grid.gained) progress.steps += steps;
+    PrintProgress(progress);
+  }
 
   // How a cell's command ended: its progress.csv says whether the run is
   // complete; `stopped` tells an interruption from a failure.
