@@ -113,53 +113,19 @@ class SlurmBackend : public ExperimentBackend {
         "with a checkpoint\n",
         array->c_str(), tasks.size(), array->c_str());
     std::fflush(stdout);
-    int64_t last_steps = -1;
-    while (true) {
-      absl::StatusOr<int> queued = QueuedTasks(*array);
-      int64_t steps = totals.steps_before;
-      int finished = 0;
-      for (const CellTask& task : tasks) {
-        const int64_t done = LastProgressSteps(task.run_dir);
-        steps += done;
-        finished += done >= task.steps ? 1 : 0;
+    if (!WaitWhileQueued(*array, tasks, totals, stop)) {
+      // The array belongs to the cluster now: it goes on without us.
+      for (size_t i = 0; i < tasks.size(); ++i) {
+        outcomes[i] = {CellOutcome::Kind::kStopped,
+                       absl::StrCat("still in job array ", *array)};
       }
-      if (steps != last_steps) {
-        std::printf(
-            "experiment: %d of %zu cells finished, %s queued, %ld of "
-            "%ld steps\n",
-            finished, tasks.size(),
-            queued.ok() ? absl::StrCat(*queued).c_str() : "?",
-            static_cast<long>(steps), static_cast<long>(totals.steps));
-        std::fflush(stdout);
-        last_steps = steps;
-      }
-      if (queued.ok() && *queued == 0) break;
-      if (stop) {
-        // The array belongs to the cluster now: it goes on without us.
-        for (size_t i = 0; i < tasks.size(); ++i) {
-          outcomes[i] = {CellOutcome::Kind::kStopped,
-                         absl::StrCat("still in job array ", *array)};
-        }
-        std::printf(
-            "experiment: job array %s keeps running; run the same command "
-            "again once it has left the queue (squeue)\n",
-            array->c_str());
-        return outcomes;
-      }
-      std::this_thread::sleep_for(std::chrono::seconds(2));
+      std::printf(
+          "experiment: job array %s keeps running; run the same command "
+          "again once it has left the queue (squeue)\n",
+          array->c_str());
+      return outcomes;
     }
-    for (size_t i = 0; i < tasks.size(); ++i) {
-      const int64_t steps = LastProgressSteps(tasks[i].run_dir);
-      if (steps >= tasks[i].steps) {
-        outcomes[i] = {CellOutcome::Kind::kFinished, ""};
-      } else {
-        outcomes[i] = {
-            CellOutcome::Kind::kFailed,
-            absl::StrCat("task ended at ", steps, " of ", tasks[i].steps,
-                         " steps; ", tasks[i].log_path, ": ",
-                         LastLogLine(tasks[i].log_path))};
-      }
-    }
+    outcomes = EndedOutcomes(tasks);
     std::remove(ArrayIdPath().c_str());
     return outcomes;
   }
@@ -183,34 +149,71 @@ class SlurmBackend : public ExperimentBackend {
  private:
   std::string ArrayIdPath() const { return options_.work_dir + "/array_id"; }
 
-  absl::StatusOr<std::string> Submit(const std::vector<CellTask>& tasks) const {
-    const std::string task_dir = options_.work_dir + "/tasks";
-    std::error_code error;
-    std::filesystem::remove_all(task_dir, error);
-    std::filesystem::create_directories(task_dir, error);
-    if (error) {
-      return absl::FailedPreconditionError(
-          absl::StrCat("cannot create ", task_dir, ": ", error.message()));
+  std::string TaskDir() const { return options_.work_dir + "/tasks"; }
+  std::string ScriptPath() const { return options_.work_dir + "/array.sbatch"; }
+
+  // Polls the queue until the cluster holds none of the array's tasks
+  // (true) or `stop` is set (false), with a line whenever the steps grew.
+  static bool WaitWhileQueued(const std::string& array,
+                              const std::vector<CellTask>& tasks,
+                              const GridTotals& totals,
+                              const std::atomic<bool>& stop) {
+    int64_t last_steps = -1;
+    while (true) {
+      absl::StatusOr<int> queued = QueuedTasks(array);
+      int64_t steps = totals.steps_before;
+      int finished = 0;
+      for (const CellTask& task : tasks) {
+        const int64_t done = LastProgressSteps(task.run_dir);
+        steps += done;
+        finished += done >= task.steps ? 1 : 0;
+      }
+      if (steps != last_steps) {
+        std::printf(
+            "experiment: %d of %zu cells finished, %s queued, %ld of "
+            "%ld steps\n",
+            finished, tasks.size(),
+            queued.ok() ? absl::StrCat(*queued).c_str() : "?",
+            static_cast<long>(steps), static_cast<long>(totals.steps));
+        std::fflush(stdout);
+        last_steps = steps;
+      }
+      if (queued.ok() && *queued == 0) return true;
+      if (stop) return false;
+      std::this_thread::sleep_for(std::chrono::seconds(2));
     }
-    int cores = 1;
+  }
+
+  // Once the array has left the queue: each cell's progress.csv says
+  // whether its task completed the run.
+  static std::vector<CellOutcome> EndedOutcomes(
+      const std::vector<CellTask>& tasks) {
+    std::vector<CellOutcome> outcomes(tasks.size());
     for (size_t i = 0; i < tasks.size(); ++i) {
-      std::string lines = absl::StrCat(tasks[i].log_path, "\n");
-      for (const std::string& arg : tasks[i].repeatable_args) {
-        absl::StrAppend(&lines, arg, "\n");
+      const int64_t steps = LastProgressSteps(tasks[i].run_dir);
+      if (steps >= tasks[i].steps) {
+        outcomes[i] = {CellOutcome::Kind::kFinished, ""};
+      } else {
+        outcomes[i] = {
+            CellOutcome::Kind::kFailed,
+            absl::StrCat("task ended at ", steps, " of ", tasks[i].steps,
+                         " steps; ", tasks[i].log_path, ": ",
+                         LastLogLine(tasks[i].log_path))};
       }
-      if (absl::Status status =
-              WriteFileAtomically(absl::StrCat(task_dir, "/", i), lines);
-          !status.ok()) {
-        return status;
-      }
-      cores = std::max(cores, tasks[i].cores);
     }
-    const std::string script = options_.work_dir + "/array.sbatch";
-    if (absl::Status status = WriteFileAtomically(script, kArrayScript);
+    return outcomes;
+  }
+
+  absl::StatusOr<std::string> Submit(const std::vector<CellTask>& tasks) const {
+    if (absl::Status status = WriteTaskFiles(tasks); !status.ok()) {
+      return status;
+    }
+    if (absl::Status status = WriteFileAtomically(ScriptPath(), kArrayScript);
         !status.ok()) {
       return status;
     }
     const std::string self = SelfPath();
+    const std::string task_dir = TaskDir();
     if (absl::StrContains(self, ",") || absl::StrContains(task_dir, ",")) {
       // sbatch --export separates its variables with commas.
       return absl::InvalidArgumentError(absl::StrCat(
@@ -218,24 +221,8 @@ class SlurmBackend : public ExperimentBackend {
           "--export: ",
           self, " or ", task_dir));
     }
-    std::vector<std::string> args = {
-        "sbatch",
-        "--parsable",
-        absl::StrCat("--array=0-", tasks.size() - 1, "%",
-                     std::max(1, options_.jobs)),
-        "--job-name=vantage-experiment",
-        absl::StrCat("--output=", options_.work_dir, "/array-%A_%a.out"),
-        "--open-mode=append",
-        "--requeue",
-        "--signal=B:TERM@120",
-        "--ntasks=1",
-        absl::StrCat("--cpus-per-task=", cores),
-        absl::StrCat("--export=ALL,VANTAGE_BIN=", self,
-                     ",VANTAGE_TASK_DIR=", task_dir)};
-    args.insert(args.end(), options_.scheduler_args.begin(),
-                options_.scheduler_args.end());
-    args.push_back(script);
-    absl::StatusOr<CommandResult> submitted = RunProgram(args);
+    absl::StatusOr<CommandResult> submitted =
+        RunProgram(SbatchArgs(tasks, self));
     if (!submitted.ok()) return submitted.status();
     const std::string output(absl::StripAsciiWhitespace(submitted->output));
     if (submitted->exit_code != 0) {
@@ -250,6 +237,55 @@ class SlurmBackend : public ExperimentBackend {
       return status;
     }
     return id;
+  }
+
+  // Task i's file: its log's path, then its command's arguments, a line
+  // each (the array script reads them by the task's id).
+  absl::Status WriteTaskFiles(const std::vector<CellTask>& tasks) const {
+    const std::string task_dir = TaskDir();
+    std::error_code error;
+    std::filesystem::remove_all(task_dir, error);
+    std::filesystem::create_directories(task_dir, error);
+    if (error) {
+      return absl::FailedPreconditionError(
+          absl::StrCat("cannot create ", task_dir, ": ", error.message()));
+    }
+    for (size_t i = 0; i < tasks.size(); ++i) {
+      std::string lines = absl::StrCat(tasks[i].log_path, "\n");
+      for (const std::string& arg : tasks[i].repeatable_args) {
+        absl::StrAppend(&lines, arg, "\n");
+      }
+      if (absl::Status status =
+              WriteFileAtomically(absl::StrCat(task_dir, "/", i), lines);
+          !status.ok()) {
+        return status;
+      }
+    }
+    return absl::OkStatus();
+  }
+
+  std::vector<std::string> SbatchArgs(const std::vector<CellTask>& tasks,
+                                      const std::string& self) const {
+    int cores = 1;
+    for (const CellTask& task : tasks) cores = std::max(cores, task.cores);
+    std::vector<std::string> args = {
+        "sbatch",
+        "--parsable",
+        absl::StrCat("--array=0-", tasks.size() - 1, "%",
+                     std::max(1, options_.jobs)),
+        "--job-name=vantage-experiment",
+        absl::StrCat("--output=", options_.work_dir, "/array-%A_%a.out"),
+        "--open-mode=append",
+        "--requeue",
+        "--signal=B:TERM@120",
+        "--ntasks=1",
+        absl::StrCat("--cpus-per-task=", cores),
+        absl::StrCat("--export=ALL,VANTAGE_BIN=", self,
+                     ",VANTAGE_TASK_DIR=", TaskDir())};
+    args.insert(args.end(), options_.scheduler_args.begin(),
+                options_.scheduler_args.end());
+    args.push_back(ScriptPath());
+    return args;
   }
 
   // The array's tasks the cluster still holds (pending, running, requeued).
