@@ -55,76 +55,113 @@ int Usage(const char* message) {
   return kUsageError;
 }
 
+// The bench's env and steps unless given; only the distributed main job.
+// An error's message is a usage line.
+absl::Status ApplyTrainBenchDefaults(RunRequest& request) {
+  if (!request.resume.empty() || !request.run_dir.empty()) {
+    return absl::InvalidArgumentError(
+        "train: --run_dir and --resume are not for a benchmark");
+  }
+  pb::TrainingSettings& training = *request.flags.mutable_training();
+  if (!training.has_env()) training.set_env(kTrainBenchEnv);
+  if (!training.has_steps()) training.set_steps(kTrainBenchSteps);
+  if (request.flags.has_mode() && request.flags.mode() != "distributed") {
+    return absl::InvalidArgumentError(
+        "train: times the distributed main job (no --mode=local)");
+  }
+  request.flags.set_mode("distributed");
+  return absl::OkStatus();
+}
+
+// Both ways the main job can act unless told one: synchronous, and
+// asynchronous with a policy lag of one version.
+std::vector<RunRequest> TrainBenchModes(const RunRequest& request) {
+  const pb::DistributedSettings& given = request.flags.distributed();
+  if (given.has_sync() || given.has_max_policy_lag()) return {request};
+  std::vector<RunRequest> modes;
+  for (const auto& [sync, lag] :
+       std::vector<std::pair<bool, int64_t>>{{true, 0}, {false, 1}}) {
+    RunRequest& mode = modes.emplace_back(request);
+    pb::DistributedSettings& d = *mode.flags.mutable_distributed();
+    d.set_sync(sync);
+    d.set_max_policy_lag(lag);
+  }
+  return modes;
+}
+
+// The shapes and sizes the machine's limit is computed for (every mode's
+// run is the same but for sync and the policy lag).
+void DescribeTrainBench(const ResolvedRun& run, const EnvSpec& spec,
+                        TrainBenchConfig& bench) {
+  const pb::RunConfig& config = run.config;
+  const pb::DistributedSettings& resolved = config.distributed();
+  bench.env = config.training().env();
+  bench.learners = resolved.learners();
+  bench.actors = resolved.actors();
+  bench.envs_per_actor = resolved.envs_per_actor();
+  bench.batch = config.training().horizon() * config.training().envs();
+  bench.shape.observations = spec.observation_size;
+  bench.shape.actions = spec.action_size;
+  bench.shape.hidden.assign(config.training().hidden().begin(),
+                            config.training().hidden().end());
+  bench.shape.epochs = config.ppo().epochs();
+  bench.shape.minibatches = config.ppo().minibatches();
+  bench.a2c = AlgorithmNameOf(config) == "a2c";
+  bench.spec = spec;
+  bench.network = run.plan.learner.network;
+  bench.a2c_config = run.plan.learner.algorithm.a2c;
+  bench.streams = config.training().envs();
+}
+
+// Resolves one mode's run and writes its config for the timed `vantage
+// train`. An error's message is a usage line.
+absl::Status AddTrainBenchRun(const RunRequest& mode_request,
+                              TrainBenchConfig& bench) {
+  absl::StatusOr<ResolvedRun> run = ResolveRunRequest(mode_request);
+  if (!run.ok()) return run.status();
+  const pb::RunConfig& config = run->config;
+  const std::string algorithm = AlgorithmNameOf(config);
+  if (algorithm != "ppo" && algorithm != "a2c") {
+    return absl::InvalidArgumentError(
+        "train: the limit counts PPO's epochs or A2C's update; use "
+        "--algo=ppo or --algo=a2c");
+  }
+  absl::StatusOr<std::unique_ptr<Environment>> env =
+      MakeEnvironment(config.training().env(), EnvOptionsOf(config));
+  if (!env.ok()) return env.status();
+  TrainBenchRun timed;
+  timed.config_path = absl::StrCat(
+      std::filesystem::temp_directory_path().string(), "/vantage-bench-train-",
+      ::getpid(), "-", bench.runs.size(), ".json");
+  timed.sync = config.distributed().sync();
+  timed.max_policy_lag = config.distributed().max_policy_lag();
+  {
+    std::ofstream file(timed.config_path, std::ios::trunc);
+    file << RunConfigToJson(config);
+    if (!file.flush()) {
+      return absl::InvalidArgumentError("train: cannot write its run config");
+    }
+  }
+  bench.runs.push_back(timed);
+  DescribeTrainBench(*run, (*env)->spec(), bench);
+  return absl::OkStatus();
+}
+
 // The run `vantage train` would make of the run flags given (with the
 // bench's env and steps unless given), timed against the machine's limit.
 int RunTrainBench() {
   absl::StatusOr<RunRequest> request = RunRequestFromFlags();
   if (!request.ok())
     return Usage(std::string(request.status().message()).c_str());
-  if (!request->resume.empty() || !request->run_dir.empty()) {
-    return Usage("train: --run_dir and --resume are not for a benchmark");
+  if (absl::Status status = ApplyTrainBenchDefaults(*request); !status.ok()) {
+    return Usage(std::string(status.message()).c_str());
   }
-  pb::TrainingSettings& training = *request->flags.mutable_training();
-  if (!training.has_env()) training.set_env(kTrainBenchEnv);
-  if (!training.has_steps()) training.set_steps(kTrainBenchSteps);
-  if (request->flags.has_mode() && request->flags.mode() != "distributed") {
-    return Usage("train: times the distributed main job (no --mode=local)");
-  }
-  request->flags.set_mode("distributed");
-  // Both ways the main job can act unless told one: synchronous, and
-  // asynchronous with a policy lag of one version.
-  std::vector<std::pair<bool, int64_t>> modes = {{true, 0}, {false, 1}};
-  const pb::DistributedSettings& given = request->flags.distributed();
-  if (given.has_sync() || given.has_max_policy_lag()) modes.resize(1);
   TrainBenchConfig bench;
-  for (const auto& [sync, lag] : modes) {
-    RunRequest mode_request = *request;
-    pb::DistributedSettings& d = *mode_request.flags.mutable_distributed();
-    if (!given.has_sync() && !given.has_max_policy_lag()) {
-      d.set_sync(sync);
-      d.set_max_policy_lag(lag);
+  for (const RunRequest& mode_request : TrainBenchModes(*request)) {
+    if (absl::Status status = AddTrainBenchRun(mode_request, bench);
+        !status.ok()) {
+      return Usage(std::string(status.message()).c_str());
     }
-    absl::StatusOr<ResolvedRun> run = ResolveRunRequest(mode_request);
-    if (!run.ok()) return Usage(std::string(run.status().message()).c_str());
-    const pb::RunConfig& config = run->config;
-    const std::string algorithm = AlgorithmNameOf(config);
-    if (algorithm != "ppo" && algorithm != "a2c") {
-      return Usage(
-          "train: the limit counts PPO's epochs or A2C's update; use "
-          "--algo=ppo or --algo=a2c");
-    }
-    absl::StatusOr<std::unique_ptr<Environment>> env =
-        MakeEnvironment(config.training().env(), EnvOptionsOf(config));
-    if (!env.ok()) return Usage(std::string(env.status().message()).c_str());
-    TrainBenchRun timed;
-    timed.config_path = absl::StrCat(
-        std::filesystem::temp_directory_path().string(),
-        "/vantage-bench-train-", ::getpid(), "-", bench.runs.size(), ".json");
-    timed.sync = config.distributed().sync();
-    timed.max_policy_lag = config.distributed().max_policy_lag();
-    {
-      std::ofstream file(timed.config_path, std::ios::trunc);
-      file << RunConfigToJson(config);
-      if (!file.flush()) return Usage("train: cannot write its run config");
-    }
-    bench.runs.push_back(timed);
-    const pb::DistributedSettings& resolved = config.distributed();
-    bench.env = config.training().env();
-    bench.learners = resolved.learners();
-    bench.actors = resolved.actors();
-    bench.envs_per_actor = resolved.envs_per_actor();
-    bench.batch = config.training().horizon() * config.training().envs();
-    bench.shape.observations = (*env)->spec().observation_size;
-    bench.shape.actions = (*env)->spec().action_size;
-    bench.shape.hidden.assign(config.training().hidden().begin(),
-                              config.training().hidden().end());
-    bench.shape.epochs = config.ppo().epochs();
-    bench.shape.minibatches = config.ppo().minibatches();
-    bench.a2c = algorithm == "a2c";
-    bench.spec = (*env)->spec();
-    bench.network = run->plan.learner.network;
-    bench.a2c_config = run->plan.learner.algorithm.a2c;
-    bench.streams = config.training().envs();
   }
   const int code = RunTrainBenchmark(bench);
   std::error_code error;
@@ -134,65 +171,69 @@ int RunTrainBench() {
   return code;
 }
 
+int RunAdvantagesBench() {
+  const int64_t steps = absl::GetFlag(FLAGS_bench_steps);
+  const int64_t streams = absl::GetFlag(FLAGS_bench_streams);
+  if (steps < 1 || streams < 1) {
+    return Usage("advantages: --bench_steps and --bench_streams must be >= 1");
+  }
+  return RunAdvantageBenchmark(steps, streams);
+}
+
+int RunActorBench() {
+  const std::string env =
+      FlagGiven("env") ? absl::GetFlag(FLAGS_env) : kActorBenchEnv;
+  const int envs =
+      FlagGiven("envs") ? absl::GetFlag(FLAGS_envs) : kActorBenchEnvs;
+  const double seconds = absl::GetFlag(FLAGS_bench_seconds);
+  if (envs < 1 || !(seconds > 0)) {
+    return Usage("actor: --envs must be >= 1 and --bench_seconds > 0");
+  }
+  return RunActorBenchmark(env, envs, seconds);
+}
+
+int RunEnvBench() {
+  return RunEnvBenchmark(absl::GetFlag(FLAGS_env),
+                         absl::GetFlag(FLAGS_env_kwargs));
+}
+
+int RunIngestBench() {
+  const int clients = absl::GetFlag(FLAGS_bench_clients);
+  const double seconds = absl::GetFlag(FLAGS_bench_seconds);
+  if (clients < 1 || !(seconds > 0)) {
+    return Usage(
+        "ingest: --bench_clients must be >= 1 and --bench_seconds > 0");
+  }
+  return RunIngestBenchmark(clients, seconds);
+}
+
+int RunConnectionsBench() {
+  const int actors = FlagGiven("bench_clients")
+                         ? absl::GetFlag(FLAGS_bench_clients)
+                         : kConnectionsBenchActors;
+  if (actors < 4 || actors > 1000) {
+    return Usage("connections: --bench_clients must be in [4, 1000]");
+  }
+  return RunConnectionsBenchmark(actors);
+}
+
+int RunLearnerBench() {
+  const std::string replica_of = absl::GetFlag(FLAGS_bench_replica_of);
+  return replica_of.empty() ? RunLearnerBenchmark()
+                            : RunLearnerBenchmarkReplica(replica_of);
+}
+
 const std::map<std::string, std::function<int()>>& Benchmarks() {
-  static const auto* benchmarks = new std::map<std::string,
-                                               std::function<int()>>{
-      {"advantages",
-       [] {
-         const int64_t steps = absl::GetFlag(FLAGS_bench_steps);
-         const int64_t streams = absl::GetFlag(FLAGS_bench_streams);
-         if (steps < 1 || streams < 1) {
-           return Usage(
-               "advantages: --bench_steps and --bench_streams must be >= 1");
-         }
-         return RunAdvantageBenchmark(steps, streams);
-       }},
-      {"actor",
-       [] {
-         const std::string env =
-             FlagGiven("env") ? absl::GetFlag(FLAGS_env) : kActorBenchEnv;
-         const int envs =
-             FlagGiven("envs") ? absl::GetFlag(FLAGS_envs) : kActorBenchEnvs;
-         const double seconds = absl::GetFlag(FLAGS_bench_seconds);
-         if (envs < 1 || !(seconds > 0)) {
-           return Usage("actor: --envs must be >= 1 and --bench_seconds > 0");
-         }
-         return RunActorBenchmark(env, envs, seconds);
-       }},
-      {"env",
-       [] {
-         return RunEnvBenchmark(absl::GetFlag(FLAGS_env),
-                                absl::GetFlag(FLAGS_env_kwargs));
-       }},
-      {"ingest",
-       [] {
-         const int clients = absl::GetFlag(FLAGS_bench_clients);
-         const double seconds = absl::GetFlag(FLAGS_bench_seconds);
-         if (clients < 1 || !(seconds > 0)) {
-           return Usage(
-               "ingest: --bench_clients must be >= 1 and --bench_seconds > "
-               "0");
-         }
-         return RunIngestBenchmark(clients, seconds);
-       }},
-      {"train", RunTrainBench},
-      {"connections",
-       [] {
-         const int actors = FlagGiven("bench_clients")
-                                ? absl::GetFlag(FLAGS_bench_clients)
-                                : kConnectionsBenchActors;
-         if (actors < 4 || actors > 1000) {
-           return Usage("connections: --bench_clients must be in [4, 1000]");
-         }
-         return RunConnectionsBenchmark(actors);
-       }},
-      {"learner",
-       [] {
-         const std::string replica_of = absl::GetFlag(FLAGS_bench_replica_of);
-         return replica_of.empty() ? RunLearnerBenchmark()
-                                   : RunLearnerBenchmarkReplica(replica_of);
-       }},
-  };
+  static const auto* benchmarks =
+      new std::map<std::string, std::function<int()>>{
+          {"advantages", RunAdvantagesBench},
+          {"actor", RunActorBench},
+          {"env", RunEnvBench},
+          {"ingest", RunIngestBench},
+          {"train", RunTrainBench},
+          {"connections", RunConnectionsBench},
+          {"learner", RunLearnerBench},
+      };
   return *benchmarks;
 }
 
