@@ -62,19 +62,7 @@ void AppendColumn(const at::Tensor& tensor, Field* field) {
   field->Add(data, data + flat.numel());
 }
 
-}  // namespace
-
-absl::StatusOr<AdvantageRequest> ParseAdvantageRequest(
-    const std::string& json) {
-  pb::AdvantageRequest message;
-  google::protobuf::util::JsonParseOptions options;
-  options.ignore_unknown_fields = false;
-  const auto parsed =
-      google::protobuf::util::JsonStringToMessage(json, &message, options);
-  if (!parsed.ok()) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("invalid JSON input: ", parsed.message().as_string()));
-  }
+absl::Status CheckPresent(const pb::AdvantageRequest& message) {
   if (!message.has_gamma()) return Missing("gamma");
   if (!message.has_lambda()) return Missing("lambda");
   if (message.ensemble().empty()) return Missing("ensemble");
@@ -87,7 +75,10 @@ absl::StatusOr<AdvantageRequest> ParseAdvantageRequest(
   if (message.truncated().empty()) return Missing("truncated");
   if (message.truncation_values().empty()) return Missing("truncation_values");
   if (!message.has_last_value()) return Missing("last_value");
+  return absl::OkStatus();
+}
 
+absl::Status CheckLengthsAndNumbers(const pb::AdvantageRequest& message) {
   const int steps = message.rewards_size();
   for (absl::Status status :
        {CheckLength(message.values(), "values", steps),
@@ -103,22 +94,24 @@ absl::StatusOr<AdvantageRequest> ParseAdvantageRequest(
         CheckFiniteList(message.truncation_values(), "truncation_values")}) {
     if (!status.ok()) return status;
   }
+  return absl::OkStatus();
+}
 
-  AdvantageRequest request;
-  request.config.gamma = message.gamma();
-  request.config.lambda = message.lambda();
-  request.config.rho = message.rho();
-  request.config.ensemble.assign(message.ensemble().begin(),
-                                 message.ensemble().end());
+absl::StatusOr<AdvantageConfig> ConfigOf(const pb::AdvantageRequest& message) {
+  AdvantageConfig config;
+  config.gamma = message.gamma();
+  config.lambda = message.lambda();
+  config.rho = message.rho();
+  config.ensemble.assign(message.ensemble().begin(), message.ensemble().end());
   absl::StatusOr<Statistic> statistic = ParseStatistic(message.statistic());
   if (!statistic.ok()) return statistic.status();
-  request.config.statistic = *statistic;
-  if (absl::Status status = request.config.Validate(); !status.ok()) {
-    return status;
-  }
-  request.seed = message.seed();
+  config.statistic = *statistic;
+  if (absl::Status status = config.Validate(); !status.ok()) return status;
+  return config;
+}
 
-  AdvantageInputs& in = request.inputs;
+absl::StatusOr<AdvantageInputs> InputsOf(const pb::AdvantageRequest& message) {
+  AdvantageInputs in;
   in.rewards = ColumnTensor(message.rewards(), at::kDouble);
   in.values = ColumnTensor(message.values(), at::kDouble);
   in.terminated = ColumnTensor(message.terminated(), at::kBool);
@@ -128,6 +121,34 @@ absl::StatusOr<AdvantageRequest> ParseAdvantageRequest(
   if (absl::Status status = ValidateAdvantageInputs(in); !status.ok()) {
     return status;
   }
+  return in;
+}
+
+}  // namespace
+
+absl::StatusOr<AdvantageRequest> ParseAdvantageRequest(
+    const std::string& json) {
+  pb::AdvantageRequest message;
+  google::protobuf::util::JsonParseOptions options;
+  options.ignore_unknown_fields = false;
+  const auto parsed =
+      google::protobuf::util::JsonStringToMessage(json, &message, options);
+  if (!parsed.ok()) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("invalid JSON input: ", parsed.message().as_string()));
+  }
+  if (absl::Status status = CheckPresent(message); !status.ok()) return status;
+  if (absl::Status status = CheckLengthsAndNumbers(message); !status.ok()) {
+    return status;
+  }
+  AdvantageRequest request;
+  absl::StatusOr<AdvantageConfig> config = ConfigOf(message);
+  if (!config.ok()) return config.status();
+  request.config = *std::move(config);
+  request.seed = message.seed();
+  absl::StatusOr<AdvantageInputs> inputs = InputsOf(message);
+  if (!inputs.ok()) return inputs.status();
+  request.inputs = *std::move(inputs);
   return request;
 }
 
