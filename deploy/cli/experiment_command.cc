@@ -148,67 +148,106 @@ void PrintDryRun(const pb::ExpandedExperiment& experiment,
               experiment.cells_size(), DefaultJobs(experiment));
 }
 
-int RunGrid(const std::vector<std::string>& args) {
-  if (args.size() != 2) {
-    return Fail(kUsageError,
-                "usage: vantage experiment run FILE --out=EXP_DIR [flags]");
-  }
-  const std::string out = absl::GetFlag(FLAGS_out);
-  const bool dry_run = absl::GetFlag(FLAGS_dry_run);
-  if (out.empty() && !dry_run) {
-    return Fail(kUsageError, "run needs --out=EXP_DIR");
+struct GridFlags {
+  std::string out;
+  bool dry_run = false;
+  std::string backend;
+  std::vector<uint64_t> seeds;
+};
+
+// An error's message is the usage error to print.
+absl::StatusOr<GridFlags> ReadGridFlags() {
+  GridFlags flags;
+  flags.out = absl::GetFlag(FLAGS_out);
+  flags.dry_run = absl::GetFlag(FLAGS_dry_run);
+  if (flags.out.empty() && !flags.dry_run) {
+    return absl::InvalidArgumentError("run needs --out=EXP_DIR");
   }
   if (absl::GetFlag(FLAGS_jobs) < 0) {
-    return Fail(kUsageError, "--jobs must be >= 0 (0: as the cores allow)");
+    return absl::InvalidArgumentError(
+        "--jobs must be >= 0 (0: as the cores allow)");
   }
   absl::StatusOr<std::vector<uint64_t>> seeds = SeedsFlag();
-  if (!seeds.ok()) return Fail(kUsageError, seeds.status().message());
-  const std::string backend = absl::GetFlag(FLAGS_backend);
+  if (!seeds.ok()) return seeds.status();
+  flags.seeds = *std::move(seeds);
+  flags.backend = absl::GetFlag(FLAGS_backend);
   if (absl::StatusOr<std::unique_ptr<ExperimentBackend>> made =
-          MakeExperimentBackend(backend, BackendOptions());
+          MakeExperimentBackend(flags.backend, BackendOptions());
       !made.ok()) {
-    return Fail(kUsageError,
-                absl::StrCat("--backend: ", made.status().message()));
+    return absl::InvalidArgumentError(
+        absl::StrCat("--backend: ", made.status().message()));
   }
-  if (!absl::GetFlag(FLAGS_sbatch_args).empty() && backend != "slurm") {
-    return Fail(kUsageError, "--sbatch_args goes with --backend=slurm");
+  if (!absl::GetFlag(FLAGS_sbatch_args).empty() && flags.backend != "slurm") {
+    return absl::InvalidArgumentError(
+        "--sbatch_args goes with --backend=slurm");
   }
-  absl::StatusOr<pb::Experiment> experiment = ReadExperimentFile(args[1]);
-  if (!experiment.ok()) {
-    return Fail(kUsageError, experiment.status().message());
-  }
+  return flags;
+}
+
+// The experiment file and the cells of it that --only selects.
+struct GridPlan {
+  pb::Experiment experiment;
+  pb::ExpandedExperiment expanded;
+};
+
+// An error's message is the usage error to print.
+absl::StatusOr<GridPlan> PlanGrid(const std::string& file,
+                                  const GridFlags& flags) {
+  GridPlan plan;
+  absl::StatusOr<pb::Experiment> experiment = ReadExperimentFile(file);
+  if (!experiment.ok()) return experiment.status();
+  plan.experiment = *std::move(experiment);
   ExpandOptions options;
-  options.file = args[1];
+  options.file = file;
   options.budget = absl::GetFlag(FLAGS_budget);
-  options.seeds = *seeds;
+  options.seeds = flags.seeds;
   absl::StatusOr<pb::ExpandedExperiment> expanded =
-      ExpandExperiment(*experiment, options, ExperimentRunSchema());
-  if (!expanded.ok()) return Fail(kUsageError, expanded.status().message());
-  if (absl::Status status = SelectCells(*expanded); !status.ok()) {
-    return Fail(kUsageError, status.message());
+      ExpandExperiment(plan.experiment, options, ExperimentRunSchema());
+  if (!expanded.ok()) return expanded.status();
+  plan.expanded = *std::move(expanded);
+  if (absl::Status status = SelectCells(plan.expanded); !status.ok()) {
+    return status;
   }
-  const ExperimentDirectory directory(out.empty() ? "EXP_DIR" : out);
-  if (dry_run) {
-    if (!out.empty()) {
-      if (absl::Status status = directory.CheckRuns(*expanded); !status.ok()) {
-        return Fail(kUsageError, status.message());
-      }
-    }
-    PrintDryRun(*expanded, directory);
-    return 0;
-  }
+  return plan;
+}
+
+int RunCells(const GridPlan& plan, const GridFlags& flags) {
   ExperimentRunOptions run_options;
-  run_options.exp_dir = out;
-  run_options.backend = backend;
+  run_options.exp_dir = flags.out;
+  run_options.backend = flags.backend;
   run_options.jobs = absl::GetFlag(FLAGS_jobs);
   run_options.scheduler_args = absl::GetFlag(FLAGS_sbatch_args);
-  const absl::Status status = RunExperiment(*expanded, experiment->base(),
-                                            run_options, StopRequested());
+  const absl::Status status = RunExperiment(
+      plan.expanded, plan.experiment.base(), run_options, StopRequested());
   if (absl::IsFailedPrecondition(status)) {
     return Fail(kUsageError, status.message());
   }
   if (!status.ok()) return Fail(kRuntimeError, status.message());
   return 0;
+}
+
+int RunGrid(const std::vector<std::string>& args) {
+  if (args.size() != 2) {
+    return Fail(kUsageError,
+                "usage: vantage experiment run FILE --out=EXP_DIR [flags]");
+  }
+  absl::StatusOr<GridFlags> flags = ReadGridFlags();
+  if (!flags.ok()) return Fail(kUsageError, flags.status().message());
+  absl::StatusOr<GridPlan> plan = PlanGrid(args[1], *flags);
+  if (!plan.ok()) return Fail(kUsageError, plan.status().message());
+  const ExperimentDirectory directory(flags->out.empty() ? "EXP_DIR"
+                                                         : flags->out);
+  if (flags->dry_run) {
+    if (!flags->out.empty()) {
+      if (absl::Status status = directory.CheckRuns(plan->expanded);
+          !status.ok()) {
+        return Fail(kUsageError, status.message());
+      }
+    }
+    PrintDryRun(plan->expanded, directory);
+    return 0;
+  }
+  return RunCells(*plan, *flags);
 }
 
 int RunExperimentCommand(const std::vector<std::string>& args) {
