@@ -80,10 +80,9 @@ int RunDistributed(const ResolvedRun& run) {
   return 0;
 }
 
-int RunLocal(const ResolvedRun& run) {
+void PrintLocalStart(const ResolvedRun& run) {
   const pb::RunConfig& config = run.config;
   const RecordingConfig& recording = run.plan.recording;
-  SetComputeThreads(1);
   std::printf(
       "%s %s with %s, estimator %s (rho %g, ensemble %s), %ld steps, seed "
       "%lu%s%s\n",
@@ -96,50 +95,73 @@ int RunLocal(const ResolvedRun& run) {
       recording.run_dir.empty() ? "" : ", run directory ",
       recording.run_dir.c_str());
   std::fflush(stdout);
-  const bool terminal = ::isatty(STDOUT_FILENO) == 1;
+}
+
+// Rewrites the terminal's last line.
+void PrintProgressLine(const ProgressRow& progress, int64_t steps) {
+  const double remaining =
+      (steps - progress.stats.env_steps) / progress.steps_per_second;
+  std::printf(
+      "\r\033[Kupdate %ld  steps %ld/%ld  %.0f steps/s  "
+      "return(last100) %.1f  ETA %s",
+      static_cast<long>(progress.stats.policy_version),
+      static_cast<long>(progress.stats.env_steps), static_cast<long>(steps),
+      progress.steps_per_second, progress.mean_return,
+      Duration(remaining).c_str());
+  std::fflush(stdout);
+}
+
+// The last progress row a local run reported, if any.
+struct LocalProgress {
   ProgressRow last;
-  last.mean_return = std::nan("");
   bool updated = false;
-  const std::atomic<bool>& stop = StopRequested();
-  const absl::Status status = RunLocalTraining(
-      run.plan,
-      [&](const ProgressRow& progress) {
-        last = progress;
-        updated = true;
-        if (!terminal) return true;
-        const double remaining =
-            (config.training().steps() - progress.stats.env_steps) /
-            progress.steps_per_second;
-        std::printf(
-            "\r\033[Kupdate %ld  steps %ld/%ld  %.0f steps/s  "
-            "return(last100) %.1f  ETA %s",
-            static_cast<long>(progress.stats.policy_version),
-            static_cast<long>(progress.stats.env_steps),
-            static_cast<long>(config.training().steps()),
-            progress.steps_per_second, progress.mean_return,
-            Duration(remaining).c_str());
-        std::fflush(stdout);
-        return true;
-      },
-      &stop);
-  if (terminal) std::printf("\n");
-  if (!status.ok()) return Fail(kRuntimeError, status.message());
-  if (stop && (!updated || last.stats.env_steps < config.training().steps())) {
+};
+
+// How a local run that returned without an error ended: stopped, with
+// nothing left to do, or with its result.
+int FinishLocal(const ResolvedRun& run, const LocalProgress& seen,
+                bool stopped) {
+  const pb::RunConfig& config = run.config;
+  const RecordingConfig& recording = run.plan.recording;
+  if (stopped && (!seen.updated ||
+                  seen.last.stats.env_steps < config.training().steps())) {
     const std::string where =
-        updated ? absl::StrCat("at ", last.stats.env_steps, " of ",
-                               config.training().steps(), " steps")
-                : "before its first update in this process";
+        seen.updated ? absl::StrCat("at ", seen.last.stats.env_steps, " of ",
+                                    config.training().steps(), " steps")
+                     : "before its first update in this process";
     std::printf("stopped %s%s%s\n", where.c_str(),
                 recording.run_dir.empty() ? "" : "; continue with --resume=",
                 recording.run_dir.c_str());
     return 0;
   }
-  if (!updated && recording.resume) {
+  if (!seen.updated && recording.resume) {
     PrintFinishedAlready(run);
     return 0;
   }
-  PrintTrainResult(config, last);
+  PrintTrainResult(config, seen.last);
   return 0;
+}
+
+int RunLocal(const ResolvedRun& run) {
+  SetComputeThreads(1);
+  PrintLocalStart(run);
+  const int64_t steps = run.config.training().steps();
+  const bool terminal = ::isatty(STDOUT_FILENO) == 1;
+  LocalProgress seen;
+  seen.last.mean_return = std::nan("");
+  const std::atomic<bool>& stop = StopRequested();
+  const absl::Status status = RunLocalTraining(
+      run.plan,
+      [&](const ProgressRow& progress) {
+        seen.last = progress;
+        seen.updated = true;
+        if (terminal) PrintProgressLine(progress, steps);
+        return true;
+      },
+      &stop);
+  if (terminal) std::printf("\n");
+  if (!status.ok()) return Fail(kRuntimeError, status.message());
+  return FinishLocal(run, seen, stop);
 }
 
 int RunTrain(const std::vector<std::string>&) {
