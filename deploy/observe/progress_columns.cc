@@ -27,10 +27,8 @@ std::string FormatValue(Format format, double value) {
   return "";
 }
 
-}  // namespace
-
-const std::vector<ProgressColumn>& ProgressColumns() {
-  static const std::vector<ProgressColumn> columns = {
+std::vector<ProgressColumn> RunProgressColumns() {
+  return {
       {"env_steps", "env_steps_total", Metric::kCounter, Format::kInteger,
        "Environment steps consumed by updates.",
        [](const ProgressRow& r) { return double(r.stats.env_steps); }},
@@ -46,6 +44,11 @@ const std::vector<ProgressColumn>& ProgressColumns() {
       {"mean_return", "mean_return", Metric::kGauge, Format::kNumber,
        "Mean return of the last 100 finished episodes.",
        [](const ProgressRow& r) { return r.mean_return; }},
+  };
+}
+
+std::vector<ProgressColumn> UpdateColumns() {
+  return {
       {"policy_loss", "policy_loss", Metric::kGauge, Format::kNumber,
        "Policy (surrogate) loss of the last update.",
        [](const ProgressRow& r) { return r.stats.algorithm.policy_loss; }},
@@ -71,6 +74,11 @@ const std::vector<ProgressColumn>& ProgressColumns() {
       {"mean_abs_bias", "mean_abs_bias", Metric::kGauge, Format::kNumber,
        "Mean |biased - GAE| advantage over the last batch.",
        [](const ProgressRow& r) { return r.stats.mean_abs_bias; }},
+  };
+}
+
+std::vector<ProgressColumn> DiscardedWorkColumns() {
+  return {
       {"rejected_segments", "batch_rejected_segments_total", Metric::kCounter,
        Format::kInteger,
        "Segments the learner's stitcher refused or dropped as stale.",
@@ -81,6 +89,11 @@ const std::vector<ProgressColumn>& ProgressColumns() {
        [](const ProgressRow& r) {
          return double(r.stats.rolled_back_updates);
        }},
+  };
+}
+
+std::vector<ProgressColumn> ExplorationColumns() {
+  return {
       {"exploration_loss", "exploration_model_loss", Metric::kGauge,
        Format::kNumber,
        "Mean loss of the exploration model's fit in the last update (EX2).",
@@ -95,6 +108,13 @@ const std::vector<ProgressColumn>& ProgressColumns() {
        "Mean exploration bonus of the last batch before centring and "
        "weighting (EX2: -log p(s)).",
        [](const ProgressRow& r) { return r.stats.exploration.mean_bonus; }},
+  };
+}
+
+// Last in the file: the only columns a rerun with the same seed and flags
+// does not repeat.
+std::vector<ProgressColumn> TimeColumns() {
+  return {
       {"elapsed_s", "run_elapsed_seconds", Metric::kGauge,
        Format::kMilliseconds, "Wall time of the whole run, across resumes.",
        [](const ProgressRow& r) { return r.elapsed_seconds; }},
@@ -102,6 +122,20 @@ const std::vector<ProgressColumn>& ProgressColumns() {
        "Environment steps consumed per second since the process started.",
        [](const ProgressRow& r) { return r.steps_per_second; }},
   };
+}
+
+}  // namespace
+
+const std::vector<ProgressColumn>& ProgressColumns() {
+  static const std::vector<ProgressColumn> columns = [] {
+    std::vector<ProgressColumn> all;
+    for (const std::vector<ProgressColumn>& group :
+         {RunProgressColumns(), UpdateColumns(), DiscardedWorkColumns(),
+          ExplorationColumns(), TimeColumns()}) {
+      all.insert(all.end(), group.begin(), group.end());
+    }
+    return all;
+  }();
   return columns;
 }
 
