@@ -9,7 +9,7 @@
 #include <utility>
 
 #include "absl/strings/str_cat.h"
-#include "actor/render/mujoco_renderer.h"
+#include "actor/envs/mujoco/mujoco_renderer.h"
 #include "common/util/state_bytes.h"
 
 namespace vantage {

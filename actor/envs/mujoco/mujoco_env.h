@@ -37,7 +37,7 @@ class MujocoEnv : public Environment {
   absl::StatusOr<std::string> SaveState() const override;
   absl::Status RestoreState(absl::string_view state) override;
   // MuJoCo's own renderer on an offscreen OSMesa context
-  // (actor/render/mujoco_renderer.h), made at the first call and again
+  // (actor/envs/mujoco/mujoco_renderer.h), made at the first call and again
   // when the size changes. Needs a running episode.
   absl::StatusOr<Frame> Render(int width, int height) override;
 

@@ -1,4 +1,4 @@
-#include "actor/render/mujoco_renderer.h"
+#include "actor/envs/mujoco/mujoco_renderer.h"
 
 #include <GL/osmesa.h>
 #include <dlfcn.h>

@@ -1,5 +1,5 @@
-#ifndef VANTAGE_ACTOR_RENDER_MUJOCO_RENDERER_H_
-#define VANTAGE_ACTOR_RENDER_MUJOCO_RENDERER_H_
+#ifndef VANTAGE_ACTOR_ENVS_MUJOCO_MUJOCO_RENDERER_H_
+#define VANTAGE_ACTOR_ENVS_MUJOCO_MUJOCO_RENDERER_H_
 
 // Offscreen pictures of a MuJoCo simulation with MuJoCo's own renderer, on
 // a software OpenGL context (OSMesa), so no display or GPU is needed. The
@@ -50,4 +50,4 @@ class MujocoRenderer {
 
 }  // namespace vantage
 
-#endif  // VANTAGE_ACTOR_RENDER_MUJOCO_RENDERER_H_
+#endif  // VANTAGE_ACTOR_ENVS_MUJOCO_MUJOCO_RENDERER_H_
