@@ -29,6 +29,7 @@
 #include "common/nn/networks.h"
 #include "common/util/self_process.h"
 #include "learner/algorithms/a2c/a2c_updater.h"
+#include "learner/algorithms/ppo/ppo_updater.h"
 
 namespace vantage {
 namespace {
@@ -81,15 +82,13 @@ double BareSamplesPerSecond(const BarePpoShape& shape, int64_t batch_size) {
   return static_cast<double>(batch_size) * shape.epochs / fastest;
 }
 
-// Sample passes per second of vantage's A2C update of `config` on the
-// run's networks, the fastest of three updates (after a warm-up) of a
-// synthetic batch of `streams` envs x its horizon.
-double A2cSamplesPerSecond(const TrainBenchConfig& config) {
-  at::manual_seed(0);
-  const A2cConfig& a2c = config.a2c_config;
-  const int64_t rows = a2c.horizon() * config.streams;
+// A synthetic batch of `streams` envs x `horizon` steps of the run's env,
+// its actions drawn by `policy`.
+UpdateBatch RunBatch(const TrainBenchConfig& config, int64_t horizon,
+                     PolicyNetworkImpl& policy) {
+  const int64_t rows = horizon * config.streams;
   UpdateBatch batch;
-  batch.horizon = a2c.horizon();
+  batch.horizon = horizon;
   batch.streams = config.streams;
   const EnvSpec& spec = config.spec;
   // Observations as batches hold them: bytes for image tasks.
@@ -98,26 +97,49 @@ double A2cSamplesPerSecond(const TrainBenchConfig& config) {
           ? at::randint(0, spec.observation_high + 1,
                         {rows, spec.observation_size}, at::kByte)
           : at::randn({rows, spec.observation_size});
-  PolicyNetwork policy(spec, config.network);
-  ValueNetwork value = MakeValueNetwork(spec, config.network, *policy);
   {
     at::NoGradGuard no_grad;
-    batch.actions = policy->Act(policy->forward(batch.observations),
-                                /*deterministic=*/false, at::Generator());
+    batch.actions = policy.Act(policy.forward(batch.observations),
+                               /*deterministic=*/false, at::Generator());
   }
   batch.behaviour_log_probs = at::randn({rows}) - 2;
   batch.advantages = at::randn({rows});
   batch.returns = at::randn({rows});
-  A2cUpdater updater(policy, value, a2c);
+  return batch;
+}
+
+// Sample passes per second of vantage's own update of the run (PPO's
+// `epochs` passes or A2C's one) on the run's networks, the fastest of
+// three updates (after a warm-up) of a synthetic batch of the run's envs x
+// its horizon: what each env step costs the learner the run uses.
+double UpdateSamplesPerSecond(const TrainBenchConfig& config) {
+  at::manual_seed(0);
+  PolicyNetwork policy(config.spec, config.network);
+  ValueNetwork value = MakeValueNetwork(config.spec, config.network, *policy);
+  std::unique_ptr<PolicyUpdater> updater;
+  int64_t horizon = 0;
+  int passes = 1;
+  if (config.a2c) {
+    horizon = config.a2c_config.horizon();
+    updater = std::make_unique<A2cUpdater>(policy, value, config.a2c_config);
+  } else {
+    PpoConfig ppo;
+    ppo.epochs = config.shape.epochs;
+    ppo.minibatches = config.shape.minibatches;
+    passes = ppo.epochs;
+    horizon = std::max<int64_t>(1, config.batch / config.streams);
+    updater = std::make_unique<PpoUpdater>(policy, value, ppo);
+  }
+  const UpdateBatch batch = RunBatch(config, horizon, *policy);
   std::mt19937_64 rng(0);
-  updater.Update(batch, 0.999, rng);  // warm-up
+  updater->Update(batch, 0.999, rng);  // warm-up
   double fastest = std::numeric_limits<double>::infinity();
   for (int i = 0; i < 3; ++i) {
     const auto start = std::chrono::steady_clock::now();
-    updater.Update(batch, 0.999, rng);
+    updater->Update(batch, 0.999, rng);
     fastest = std::min(fastest, SecondsSince(start));
   }
-  return static_cast<double>(rows) / fastest;
+  return static_cast<double>(batch.observations.size(0)) * passes / fastest;
 }
 
 struct ProgressPoint {
@@ -256,19 +278,30 @@ int RunTrainBenchmark(const TrainBenchConfig& config) {
                  std::string(raw.status().message()).c_str());
     return 2;
   }
-  // The update's samples/s and the passes each env step costs of it.
-  const double update = config.a2c
-                            ? A2cSamplesPerSecond(config)
-                            : BareSamplesPerSecond(config.shape, config.batch);
+  // The update's samples/s and the passes each env step costs of it:
+  // vantage's own update, the one the run uses; for PPO the bare LibTorch
+  // loop's limit too, for comparison.
+  const double update = UpdateSamplesPerSecond(config);
   const int passes = config.a2c ? 1 : config.shape.epochs;
-  const double limit =
-      cores / (1.0 / *raw + static_cast<double>(passes) / update);
+  const auto limit_of = [&](double samples_per_s) {
+    return cores / (1.0 / *raw + static_cast<double>(passes) / samples_per_s);
+  };
+  const double limit = limit_of(update);
   std::printf(
-      "train: %s raw physics %.0f steps/s, %s %.0f samples/s "
-      "(%d passes), %d cores: limit %.0f env steps/s\n",
-      config.env.c_str(), *raw,
-      config.a2c ? "vantage's A2C update" : "bare PPO update", update, passes,
+      "train: %s raw physics %.0f steps/s, vantage's %s update %.0f "
+      "samples/s (%d passes), %d cores: limit %.0f env steps/s\n",
+      config.env.c_str(), *raw, config.a2c ? "A2C" : "PPO", update, passes,
       cores, limit);
+  std::string bare_fields;
+  if (!config.a2c) {
+    const double bare = BareSamplesPerSecond(config.shape, config.batch);
+    std::printf(
+        "train: with the bare LibTorch PPO loop's %.0f samples/s instead: "
+        "limit %.0f env steps/s\n",
+        bare, limit_of(bare));
+    bare_fields = absl::StrFormat(" bare_samples_per_s=%.0f bare_limit_sps=%.0f",
+                                  bare, limit_of(bare));
+  }
   std::fflush(stdout);
 
   for (const TrainBenchRun& run : config.runs) {
@@ -293,13 +326,14 @@ int RunTrainBenchmark(const TrainBenchConfig& config) {
     std::printf(
         "RESULT train env=%s algo=%s learners=%d actors=%d envs_per_actor=%d "
         "sync=%d max_policy_lag=%ld sps=%.0f limit_sps=%.0f ratio=%.3f "
-        "raw_steps_per_s=%.0f %s=%.0f cores=%d%s%s\n",
+        "raw_steps_per_s=%.0f %s=%.0f%s cores=%d%s%s\n",
         config.env.c_str(), config.a2c ? "a2c" : "ppo", config.learners,
         config.actors, config.envs_per_actor, run.sync ? 1 : 0,
         static_cast<long>(run.max_policy_lag), measured->sps, limit,
         measured->sps / limit, *raw,
-        config.a2c ? "a2c_update_samples_per_s" : "bare_samples_per_s", update,
-        cores, SplitFields(measured->learner, "learner").c_str(),
+        config.a2c ? "a2c_update_samples_per_s" : "ppo_update_samples_per_s",
+        update, bare_fields.c_str(), cores,
+        SplitFields(measured->learner, "learner").c_str(),
         SplitFields(measured->actors, "actor").c_str());
     std::fflush(stdout);
   }

@@ -30,10 +30,7 @@ struct TrainBenchConfig {
   int envs_per_actor = 1;
   int64_t batch = 0;   // env steps per update, all learners together
   BarePpoShape shape;  // PPO: the run's network and epochs/minibatches
-  // A2C, which has no bare loop here: the update each env step costs is
-  // vantage's own A2cUpdater on the run's networks (a convolutional torso
-  // too) over a synthetic batch of the run's envs.
-  bool a2c = false;
+  bool a2c = false;    // else PPO
   EnvSpec spec;
   NetworkConfig network;
   A2cConfig a2c_config;
@@ -41,18 +38,20 @@ struct TrainBenchConfig {
 };
 
 // `vantage bench train`: in one run, measures this machine's raw physics
-// steps/s of the env (one core; a MinAtar game's bare rules) and the bare
-// LibTorch PPO update's samples/s (one core, the run's shapes), then runs
+// steps/s of the env (one core; a MinAtar game's bare rules) and the
+// samples/s of vantage's own update of the run (PpoUpdater or A2cUpdater,
+// one core, the run's networks and shapes, a synthetic batch), then runs
 // the distributed main job (`vantage train`, a child process) in each
 // configuration and compares its steady-state env steps/s (the first two
 // updates, start-up, excluded) with the machine's limit
-// cores / (1/raw + epochs/bare): every env step costs its physics and
-// `epochs` sample passes of the update, and nothing else is free. For A2C
-// the update term is 1/a2c, a2c the samples/s of vantage's own A2C update
-// (one pass per sample). Each configuration ends with `RESULT train env=..
-// sync=.. max_policy_lag=.. sps=.. limit_sps=.. ratio=..` and the time
-// splits the run's learners and actors printed when they stopped (mean
-// shares in percent: learner_advantages=.., actor_physics=.., ...).
+// cores / (1/raw + passes/update): every env step costs its physics and
+// `passes` sample passes of the update (PPO's epochs, A2C's one), and
+// nothing else is free. For PPO the limit with the bare LibTorch loop's
+// samples/s (bare_ppo.h) in place of vantage's is printed beside it. Each
+// configuration ends with `RESULT train env=.. sync=.. max_policy_lag=..
+// sps=.. limit_sps=.. ratio=..` and the time splits the run's learners
+// and actors printed when they stopped (mean shares in percent:
+// learner_advantages=.., actor_physics=.., ...).
 int RunTrainBenchmark(const TrainBenchConfig& config);
 
 }  // namespace vantage

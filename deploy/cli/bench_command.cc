@@ -284,7 +284,8 @@ Command BenchCommand() {
       "learner's memory and threads per connected actor against its idle\n"
       "footprint; train: the distributed main job (`vantage train` with the\n"
       "run flags given) against the\n"
-      "machine's limit from raw physics and a bare update. Each ends with a\n"
+      "machine's limit from raw physics and vantage's own update (the bare\n"
+      "loop's limit beside it). Each ends with a\n"
       "line `RESULT <name> ... ratio=...` measured in the same run. Google\n"
       "Benchmark's --benchmark_* flags apply.";
   command.flags = {"bench_steps",   "bench_streams",    "bench_clients",

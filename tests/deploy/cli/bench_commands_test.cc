@@ -102,7 +102,7 @@ TEST(BenchCommandsTest, ResultLinesCarryNoColourCodes) {
 }
 
 // limit_sps as documented: cores / (1 / raw + passes / update), with the
-// update's samples/s in the field `update_field`.
+// samples/s of vantage's own update in the field `update_field`.
 void ExpectTheLimitOf(const std::map<std::string, std::string>& fields,
                       const std::string& update_field, int passes) {
   const double raw = Number(fields, "raw_steps_per_s");
@@ -139,7 +139,15 @@ TEST(BenchCommandsTest, TrainTimesTheMainJobAgainstTheMachinesLimit) {
     EXPECT_EQ(fields.at("algo"), "ppo");
     EXPECT_EQ(fields.at("learners"), "2");
     EXPECT_EQ(fields.at("actors"), "2");
-    ExpectTheLimitOf(fields, "bare_samples_per_s", 10);
+    ExpectTheLimitOf(fields, "ppo_update_samples_per_s", 10);
+    // The bare LibTorch loop's limit beside it, for comparison.
+    const double bare = Number(fields, "bare_samples_per_s");
+    ASSERT_GT(bare, 0);
+    const double bare_limit = Number(fields, "bare_limit_sps");
+    EXPECT_NEAR(bare_limit,
+                Number(fields, "cores") /
+                    (1 / Number(fields, "raw_steps_per_s") + 10 / bare),
+                0.01 * bare_limit + 1);
     const double limit = Number(fields, "limit_sps");
     EXPECT_GT(Number(fields, "sps"), 0);
     EXPECT_NEAR(Number(fields, "ratio"), Number(fields, "sps") / limit, 0.002);
