@@ -27,67 +27,47 @@ absl::StatusOr<FlatActorCritic> FlatActorCritic::Create(
   FlatActorCritic flat;
   flat.spec_ = policy.spec();
   flat.discrete_ = policy.discrete();
+  absl::StatusOr<int64_t> size = flat.TakeParameters(std::move(parameters));
+  if (!size.ok()) return size.status();
+  if (absl::Status status = flat.LayOutNetworks(policy, value); !status.ok()) {
+    return status;
+  }
+  flat.parameters_.resize(*size);
+  flat.gradients_.assign(*size, 0.0f);
+  flat.Pull();
+  return flat;
+}
+
+absl::StatusOr<int64_t> FlatActorCritic::TakeParameters(
+    std::vector<at::Tensor> parameters) {
   int64_t size = 0;
   for (const at::Tensor& p : parameters) {
     if (p.scalar_type() != at::kFloat || !p.is_contiguous() || !p.is_cpu()) {
       return absl::UnimplementedError(
           "a parameter is not a contiguous float tensor on the CPU");
     }
-    flat.offsets_.push_back(size);
+    offsets_.push_back(size);
     size += p.numel();
   }
-  flat.tensors_ = std::move(parameters);
-  std::vector<bool> claimed(flat.tensors_.size(), false);
-  // The offset of the parameter that is `tensor`, claimed once.
-  auto offset_of = [&](const at::Tensor& tensor) -> int64_t {
-    for (size_t i = 0; i < flat.tensors_.size(); ++i) {
-      if (flat.tensors_[i].unsafeGetTensorImpl() ==
-              tensor.unsafeGetTensorImpl() &&
-          !claimed[i]) {
-        claimed[i] = true;
-        return flat.offsets_[i];
-      }
-    }
-    return -1;
-  };
-  auto layout = [&](const TanhMlp& body, int64_t outputs,
-                    Mlp& mlp) -> absl::Status {
-    const torch::nn::ModuleList& layers = body->layers();
-    int64_t width = flat.spec_.observation_size;
-    for (size_t i = 0; i < layers->size(); ++i) {
-      const auto& linear = layers->at<torch::nn::LinearImpl>(i);
-      Layer layer;
-      layer.outputs = linear.weight.size(0);
-      layer.inputs = linear.weight.size(1);
-      layer.weight = offset_of(linear.weight);
-      layer.bias = linear.bias.defined() ? offset_of(linear.bias) : -1;
-      if (layer.inputs != width || layer.weight < 0 || layer.bias < 0) {
-        return absl::UnimplementedError(
-            absl::StrCat("layer ", i, " is not a biased Linear layer on ",
-                         width, " inputs whose parameters are the given ones"));
-      }
-      width = layer.outputs;
-      mlp.layers.push_back(layer);
-    }
-    if (mlp.layers.empty() || width != outputs) {
-      return absl::UnimplementedError(
-          absl::StrCat("an MLP ends in ", width, " outputs, not ", outputs));
-    }
-    mlp.outputs.resize(mlp.layers.size());
-    return absl::OkStatus();
-  };
+  tensors_ = std::move(parameters);
+  return size;
+}
+
+absl::Status FlatActorCritic::LayOutNetworks(PolicyNetworkImpl& policy,
+                                             ValueNetworkImpl& value) {
+  std::vector<bool> claimed(tensors_.size(), false);
   if (absl::Status status =
-          layout(policy.body(), flat.spec_.action_size, flat.policy_);
+          LayOutMlp(policy.body(), spec_.action_size, claimed, policy_);
       !status.ok()) {
     return status;
   }
-  if (absl::Status status = layout(value.body(), 1, flat.value_);
+  if (absl::Status status = LayOutMlp(value.body(), 1, claimed, value_);
       !status.ok()) {
     return status;
   }
-  if (!flat.discrete_) {
-    flat.log_std_ = offset_of(policy.log_std());
-    if (flat.log_std_ < 0) {
+  if (!discrete_) {
+    log_std_ = ClaimOffset(policy.log_std(), claimed);
+    if (log_std_ < 0) {
       return absl::UnimplementedError("the log-std is not a given parameter");
     }
   }
@@ -95,10 +75,46 @@ absl::StatusOr<FlatActorCritic> FlatActorCritic::Create(
     return absl::UnimplementedError(
         "a parameter belongs to neither network's layers nor the log-std");
   }
-  flat.parameters_.resize(size);
-  flat.gradients_.assign(size, 0.0f);
-  flat.Pull();
-  return flat;
+  return absl::OkStatus();
+}
+
+absl::Status FlatActorCritic::LayOutMlp(const TanhMlp& body, int64_t outputs,
+                                        std::vector<bool>& claimed, Mlp& mlp) {
+  const torch::nn::ModuleList& layers = body->layers();
+  int64_t width = spec_.observation_size;
+  for (size_t i = 0; i < layers->size(); ++i) {
+    const auto& linear = layers->at<torch::nn::LinearImpl>(i);
+    Layer layer;
+    layer.outputs = linear.weight.size(0);
+    layer.inputs = linear.weight.size(1);
+    layer.weight = ClaimOffset(linear.weight, claimed);
+    layer.bias = linear.bias.defined() ? ClaimOffset(linear.bias, claimed) : -1;
+    if (layer.inputs != width || layer.weight < 0 || layer.bias < 0) {
+      return absl::UnimplementedError(
+          absl::StrCat("layer ", i, " is not a biased Linear layer on ", width,
+                       " inputs whose parameters are the given ones"));
+    }
+    width = layer.outputs;
+    mlp.layers.push_back(layer);
+  }
+  if (mlp.layers.empty() || width != outputs) {
+    return absl::UnimplementedError(
+        absl::StrCat("an MLP ends in ", width, " outputs, not ", outputs));
+  }
+  mlp.outputs.resize(mlp.layers.size());
+  return absl::OkStatus();
+}
+
+int64_t FlatActorCritic::ClaimOffset(const at::Tensor& tensor,
+                                     std::vector<bool>& claimed) const {
+  for (size_t i = 0; i < tensors_.size(); ++i) {
+    if (tensors_[i].unsafeGetTensorImpl() == tensor.unsafeGetTensorImpl() &&
+        !claimed[i]) {
+      claimed[i] = true;
+      return offsets_[i];
+    }
+  }
+  return -1;
 }
 
 void FlatActorCritic::Pull() {

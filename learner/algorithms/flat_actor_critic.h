@@ -22,6 +22,7 @@
 namespace vantage {
 
 class PolicyNetworkImpl;
+class TanhMlp;
 class ValueNetworkImpl;
 
 class FlatActorCritic {
@@ -81,6 +82,18 @@ class FlatActorCritic {
   };
 
   FlatActorCritic() = default;
+  // Create's steps. TakeParameters returns the flat size. LayOutNetworks
+  // fails unless every parameter is claimed exactly once, by a layer or the
+  // log-std: the flat arrays must cover the networks and nothing else.
+  absl::StatusOr<int64_t> TakeParameters(std::vector<at::Tensor> parameters);
+  absl::Status LayOutNetworks(PolicyNetworkImpl& policy,
+                              ValueNetworkImpl& value);
+  absl::Status LayOutMlp(const TanhMlp& body, int64_t outputs,
+                         std::vector<bool>& claimed, Mlp& mlp);
+  // -1 for a tensor that is not a given parameter or whose parameter is
+  // already claimed (shared by two layers).
+  int64_t ClaimOffset(const at::Tensor& tensor,
+                      std::vector<bool>& claimed) const;
   void MlpForward(Mlp& mlp, const float* inputs, int64_t rows);
   // From d loss / d (the last layer's output) in `gradient` [rows, last
   // outputs] (used as scratch).
