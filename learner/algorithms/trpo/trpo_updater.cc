@@ -47,6 +47,15 @@ void AssignParameters(const at::Tensor& flat,
   }
 }
 
+// Every replica's batch is the same size, so means over the global batch
+// are means of the replicas' means.
+std::vector<double> MeansAcrossReplicas(ReplicaGroup& replicas,
+                                        std::vector<double> local) {
+  std::vector<double> sums = SumAcrossReplicas(replicas, std::move(local));
+  for (double& sum : sums) sum /= replicas.world_size();
+  return sums;
+}
+
 }  // namespace
 
 TrpoUpdater::TrpoUpdater(PolicyNetwork policy, ValueNetwork value,
@@ -87,61 +96,70 @@ AlgorithmStats TrpoUpdater::Update(const UpdateBatch& batch,
 double TrpoUpdater::PolicyStep(const UpdateBatch& batch,
                                const at::Tensor& advantages,
                                double& surrogate_after) {
-  PolicyNetworkImpl& policy = *policy_;
-  at::Tensor old_output;
-  at::Tensor old_log_std;
+  PolicyStepInputs step{batch, advantages, at::Tensor(), at::Tensor()};
   {
     at::NoGradGuard no_grad;
-    old_output = policy.forward(batch.observations);
-    if (!policy.discrete()) old_log_std = policy.log_std().clone();
+    step.old_output = policy_->forward(batch.observations);
+    if (!policy_->discrete()) step.old_log_std = policy_->log_std().clone();
   }
-  // Importance-weighted against the policy that acted (the actors' version
-  // may lag the learner's).
-  auto surrogate = [&]() {
-    const at::Tensor output = policy.forward(batch.observations);
-    const at::Tensor ratio = at::exp(policy.LogProb(output, batch.actions) -
-                                     batch.behaviour_log_probs);
-    return (ratio * advantages).mean() +
-           config_.entropy_coef * policy.Entropy(output).mean();
-  };
-  auto mean_kl = [&]() {
-    return policy
-        .Kl(old_output, old_log_std, policy.forward(batch.observations))
-        .mean();
-  };
-
-  // Every replica's batch is the same size, so means over the global batch
-  // are means of the replicas' means.
-  ReplicaGroup& replicas = *replicas_;
-  auto global_means = [&](std::vector<double> local) {
-    std::vector<double> sums = SumAcrossReplicas(replicas, std::move(local));
-    for (double& sum : sums) sum /= replicas.world_size();
-    return sums;
-  };
-  const at::Tensor objective = surrogate();
-  const double objective_before = global_means({objective.item<double>()})[0];
+  const at::Tensor objective = Surrogate(step);
+  const double objective_before =
+      MeansAcrossReplicas(*replicas_, {objective.item<double>()})[0];
   surrogate_after = objective_before;
+  const at::Tensor full_step = NaturalGradientStep(step, objective);
+  if (!full_step.defined()) return 0.0;
+  return LineSearch(step, full_step, objective_before, surrogate_after);
+}
+
+at::Tensor TrpoUpdater::Surrogate(const PolicyStepInputs& step) {
+  PolicyNetworkImpl& policy = *policy_;
+  const at::Tensor output = policy.forward(step.batch.observations);
+  const at::Tensor ratio = at::exp(policy.LogProb(output, step.batch.actions) -
+                                   step.batch.behaviour_log_probs);
+  return (ratio * step.advantages).mean() +
+         config_.entropy_coef * policy.Entropy(output).mean();
+}
+
+at::Tensor TrpoUpdater::MeanKl(const PolicyStepInputs& step) {
+  PolicyNetworkImpl& policy = *policy_;
+  return policy
+      .Kl(step.old_output, step.old_log_std,
+          policy.forward(step.batch.observations))
+      .mean();
+}
+
+at::Tensor TrpoUpdater::FisherProduct(const PolicyStepInputs& step,
+                                      const at::Tensor& v) {
+  const at::Tensor kl = MeanKl(step);
+  const at::Tensor kl_gradient =
+      FlatGradient(kl, policy_parameters_, /*create_graph=*/true);
+  const at::Tensor product =
+      FlatGradient((kl_gradient * v.detach()).sum(), policy_parameters_,
+                   /*create_graph=*/false);
+  return AverageAcrossReplicas(*replicas_, product.detach()) +
+         config_.cg_damping * v;
+}
+
+at::Tensor TrpoUpdater::NaturalGradientStep(const PolicyStepInputs& step,
+                                            const at::Tensor& objective) {
   const at::Tensor gradient = AverageAcrossReplicas(
-      replicas,
+      *replicas_,
       FlatGradient(objective, policy_parameters_, /*create_graph=*/false));
   auto fisher_product = [&](const at::Tensor& v) {
-    const at::Tensor kl = mean_kl();
-    const at::Tensor kl_gradient =
-        FlatGradient(kl, policy_parameters_, /*create_graph=*/true);
-    const at::Tensor product =
-        FlatGradient((kl_gradient * v.detach()).sum(), policy_parameters_,
-                     /*create_graph=*/false);
-    return AverageAcrossReplicas(replicas, product.detach()) +
-           config_.cg_damping * v;
+    return FisherProduct(step, v);
   };
   const at::Tensor direction = ConjugateGradient(
       fisher_product, gradient.detach(), config_.cg_iterations);
   const double curvature =
       0.5 * (direction * fisher_product(direction)).sum().item<double>();
-  if (!(curvature > 0) || !std::isfinite(curvature)) return 0.0;
-  const at::Tensor full_step =
-      direction * std::sqrt(config_.max_kl / curvature);
+  if (!(curvature > 0) || !std::isfinite(curvature)) return at::Tensor();
+  return direction * std::sqrt(config_.max_kl / curvature);
+}
 
+double TrpoUpdater::LineSearch(const PolicyStepInputs& step,
+                               const at::Tensor& full_step,
+                               double objective_before,
+                               double& surrogate_after) {
   const at::Tensor start =
       torch::nn::utils::parameters_to_vector(policy_parameters_)
           .detach()
@@ -150,8 +168,9 @@ double TrpoUpdater::PolicyStep(const UpdateBatch& batch,
   double fraction = 1.0;
   for (int i = 0; i < config_.line_search_steps; ++i, fraction *= 0.5) {
     AssignParameters(start + fraction * full_step, policy_parameters_);
-    const std::vector<double> means =
-        global_means({surrogate().item<double>(), mean_kl().item<double>()});
+    const std::vector<double> means = MeansAcrossReplicas(
+        *replicas_,
+        {Surrogate(step).item<double>(), MeanKl(step).item<double>()});
     const double value = means[0];
     const double kl = means[1];
     if (std::isfinite(value) && std::isfinite(kl) && kl <= config_.max_kl &&

@@ -37,9 +37,30 @@ class TrpoUpdater : public PolicyUpdater {
   absl::Status Load(torch::serialize::InputArchive& archive) override;
 
  private:
+  // What a policy step compares the moved policy against.
+  struct PolicyStepInputs {
+    const UpdateBatch& batch;
+    const at::Tensor& advantages;
+    at::Tensor old_output;
+    at::Tensor old_log_std;  // undefined for a discrete policy
+  };
+
   // Returns the accepted step's mean KL (0 if the policy did not move).
   double PolicyStep(const UpdateBatch& batch, const at::Tensor& advantages,
                     double& surrogate_after);
+  // Importance-weighted against the policy that acted (the actors' version
+  // may lag the learner's).
+  at::Tensor Surrogate(const PolicyStepInputs& step);
+  at::Tensor MeanKl(const PolicyStepInputs& step);
+  at::Tensor FisherProduct(const PolicyStepInputs& step, const at::Tensor& v);
+  // To the trust region's edge; undefined when the curvature along the
+  // direction is not positive and finite.
+  at::Tensor NaturalGradientStep(const PolicyStepInputs& step,
+                                 const at::Tensor& objective);
+  // Tries ever halved fractions of `full_step`; returns the accepted one's
+  // mean KL, or restores the parameters and returns 0.
+  double LineSearch(const PolicyStepInputs& step, const at::Tensor& full_step,
+                    double objective_before, double& surrogate_after);
   double FitValue(const UpdateBatch& batch, std::mt19937_64& rng);
 
   TrpoConfig config_;
