@@ -66,62 +66,15 @@ ActorGateway::ActorGateway(GatewayConfig config, SegmentSink& sink)
 absl::StatusOr<pb::RegisterResponse> ActorGateway::Register(
     const pb::RegisterRequest& request, absl::string_view peer,
     absl::Duration timeout) {
-  auto refuse = [&](absl::Status status) {
+  if (absl::Status status = CheckRegisterRequest(request); !status.ok()) {
     std::lock_guard<std::mutex> lock(mutex_);
     ++counters_.refused_registrations;
     return status;
-  };
-  absl::StatusOr<EnvSpec> spec =
-      EnvSpecFromProto(request.spec(), config_.limits.spec);
-  if (!spec.ok()) return refuse(spec.status());
-  if (spec->name != config_.spec.name) {
-    return refuse(absl::InvalidArgumentError(absl::StrCat(
-        "this learner trains ", config_.spec.name, ", not ", spec->name)));
   }
-  // Actors register their environment's own spec and wrap it as the run
-  // config they receive says.
-  const int64_t frames = config_.run_config.training().frame_stack();
-  if (absl::Status status =
-          CheckSameSpec(config_.spec, StackedSpec(*spec, frames));
-      !status.ok()) {
-    return refuse(status);
-  }
-  const int64_t num_envs = request.num_envs();
-  if (num_envs < 1 || num_envs > config_.limits.max_envs_per_actor) {
-    return refuse(absl::InvalidArgumentError(
-        absl::StrCat("num_envs is ", num_envs, ", expected 1..",
-                     config_.limits.max_envs_per_actor)));
-  }
-  int64_t actor_id = 0;
   std::string secret = NewSecret();
-  {
-    std::unique_lock<std::mutex> lock(mutex_);
-    if (run_over_) return absl::OutOfRangeError(kRunOver);
-    if (closed_) return absl::UnavailableError("the learner is shutting down");
-    const absl::Time now = absl::Now();
-    if (absl::Status quota = CheckUnclaimedQuota(peer, now); !quota.ok()) {
-      ++counters_.refused_registrations;
-      return quota;
-    }
-    if (!MakeRoom(num_envs)) {
-      ++counters_.refused_registrations;
-      return absl::ResourceExhaustedError(absl::StrCat(
-          "the learner serves at most ", config_.limits.max_live_actors,
-          " actors and ", config_.limits.max_live_env_slots,
-          " env slots at once (now ", actors_.size(), " and ",
-          counters_.live_env_slots,
-          "), and every registration has a call open"));
-    }
-    actor_id = next_actor_id_++;
-    Registration& registration = actors_[actor_id];
-    registration.secret = secret;
-    registration.peer = std::string(peer);
-    registration.num_envs = num_envs;
-    registration.next_sequence.assign(num_envs, 0);
-    registration.last_seen = now;
-    ++counters_.registrations;
-    counters_.live_env_slots += num_envs;
-  }
+  absl::StatusOr<int64_t> actor_id =
+      AddRegistration(peer, request.num_envs(), secret);
+  if (!actor_id.ok()) return actor_id.status();
   std::shared_ptr<const pb::Weights> weights =
       WaitForWeightsNewerThan(-1, timeout);
   if (weights == nullptr) {
@@ -129,11 +82,67 @@ absl::StatusOr<pb::RegisterResponse> ActorGateway::Register(
         "the learner has published no weights yet; retry");
   }
   pb::RegisterResponse response;
-  response.set_actor_id(actor_id);
-  response.set_session(absl::StrCat(actor_id, ":", secret));
+  response.set_actor_id(*actor_id);
+  response.set_session(absl::StrCat(*actor_id, ":", secret));
   *response.mutable_run_config() = config_.run_config;
   *response.mutable_weights() = *weights;
   return response;
+}
+
+absl::Status ActorGateway::CheckRegisterRequest(
+    const pb::RegisterRequest& request) const {
+  absl::StatusOr<EnvSpec> spec =
+      EnvSpecFromProto(request.spec(), config_.limits.spec);
+  if (!spec.ok()) return spec.status();
+  if (spec->name != config_.spec.name) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "this learner trains ", config_.spec.name, ", not ", spec->name));
+  }
+  // Actors register their environment's own spec and wrap it as the run
+  // config they receive says.
+  const int64_t frames = config_.run_config.training().frame_stack();
+  if (absl::Status status =
+          CheckSameSpec(config_.spec, StackedSpec(*spec, frames));
+      !status.ok()) {
+    return status;
+  }
+  const int64_t num_envs = request.num_envs();
+  if (num_envs < 1 || num_envs > config_.limits.max_envs_per_actor) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("num_envs is ", num_envs, ", expected 1..",
+                     config_.limits.max_envs_per_actor));
+  }
+  return absl::OkStatus();
+}
+
+absl::StatusOr<int64_t> ActorGateway::AddRegistration(
+    absl::string_view peer, int64_t num_envs, const std::string& secret) {
+  std::unique_lock<std::mutex> lock(mutex_);
+  if (run_over_) return absl::OutOfRangeError(kRunOver);
+  if (closed_) return absl::UnavailableError("the learner is shutting down");
+  const absl::Time now = absl::Now();
+  if (absl::Status quota = CheckUnclaimedQuota(peer, now); !quota.ok()) {
+    ++counters_.refused_registrations;
+    return quota;
+  }
+  if (!MakeRoom(num_envs)) {
+    ++counters_.refused_registrations;
+    return absl::ResourceExhaustedError(absl::StrCat(
+        "the learner serves at most ", config_.limits.max_live_actors,
+        " actors and ", config_.limits.max_live_env_slots,
+        " env slots at once (now ", actors_.size(), " and ",
+        counters_.live_env_slots, "), and every registration has a call open"));
+  }
+  const int64_t actor_id = next_actor_id_++;
+  Registration& registration = actors_[actor_id];
+  registration.secret = secret;
+  registration.peer = std::string(peer);
+  registration.num_envs = num_envs;
+  registration.next_sequence.assign(num_envs, 0);
+  registration.last_seen = now;
+  ++counters_.registrations;
+  counters_.live_env_slots += num_envs;
+  return actor_id;
 }
 
 absl::StatusOr<int64_t> ActorGateway::Attach(absl::string_view session) {
@@ -271,30 +280,49 @@ void ActorGateway::CountRejected(const std::string& reason) {
 absl::Status ActorGateway::Admit(int64_t actor_id, const pb::Segment& proto,
                                  std::string* dropped) {
   if (dropped != nullptr) dropped->clear();
-  int64_t newest = -1;
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    auto it = actors_.find(actor_id);
-    if (it == actors_.end()) {
-      ++counters_.rejected["unknown_session"];
-      return absl::NotFoundError(absl::StrCat(
-          "actor ", actor_id, "'s registration expired; register again"));
-    }
-    if (proto.actor_id() != actor_id) {
-      ++counters_.rejected["foreign_actor"];
-      return absl::PermissionDeniedError(absl::StrCat(
-          "segment.actor_id ", proto.actor_id(),
-          " does not belong to this stream, which is actor ", actor_id, "'s"));
-    }
-    if (proto.env_slot() < 0 || proto.env_slot() >= it->second.num_envs) {
-      ++counters_.rejected["foreign_slot"];
-      return absl::PermissionDeniedError(absl::StrCat(
-          "segment.env_slot ", proto.env_slot(), " is not one of actor ",
-          actor_id, "'s ", it->second.num_envs, " env slots"));
-    }
-    it->second.last_seen = absl::Now();
-    newest = weights_ == nullptr ? -1 : weights_->version();
+  absl::StatusOr<int64_t> newest = CheckSender(actor_id, proto);
+  if (!newest.ok()) return newest.status();
+  absl::StatusOr<Segment> segment = DecodeSegment(proto, *newest);
+  if (!segment.ok()) return segment.status();
+  if (check_.TooStale(segment->policy_version, *newest)) {
+    std::string why = absl::StrCat(
+        "segment.policy_version ", segment->policy_version, " is more than ",
+        config_.max_policy_lag, " versions behind the newest (", *newest, ")");
+    if (dropped != nullptr) *dropped = std::move(why);
+    CountRejected("stale");
+    return absl::OkStatus();
   }
+  if (!AdvanceSequence(actor_id, *segment, dropped)) return absl::OkStatus();
+  return Deliver(actor_id, *std::move(segment));
+}
+
+absl::StatusOr<int64_t> ActorGateway::CheckSender(int64_t actor_id,
+                                                  const pb::Segment& proto) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  auto it = actors_.find(actor_id);
+  if (it == actors_.end()) {
+    ++counters_.rejected["unknown_session"];
+    return absl::NotFoundError(absl::StrCat(
+        "actor ", actor_id, "'s registration expired; register again"));
+  }
+  if (proto.actor_id() != actor_id) {
+    ++counters_.rejected["foreign_actor"];
+    return absl::PermissionDeniedError(absl::StrCat(
+        "segment.actor_id ", proto.actor_id(),
+        " does not belong to this stream, which is actor ", actor_id, "'s"));
+  }
+  if (proto.env_slot() < 0 || proto.env_slot() >= it->second.num_envs) {
+    ++counters_.rejected["foreign_slot"];
+    return absl::PermissionDeniedError(absl::StrCat(
+        "segment.env_slot ", proto.env_slot(), " is not one of actor ",
+        actor_id, "'s ", it->second.num_envs, " env slots"));
+  }
+  it->second.last_seen = absl::Now();
+  return weights_ == nullptr ? -1 : weights_->version();
+}
+
+absl::StatusOr<Segment> ActorGateway::DecodeSegment(const pb::Segment& proto,
+                                                    int64_t newest) {
   if (absl::Status status =
           SegmentCheck::CheckPublished(proto.policy_version(), newest);
       !status.ok()) {
@@ -306,38 +334,33 @@ absl::Status ActorGateway::Admit(int64_t actor_id, const pb::Segment& proto,
   if (absl::Status status = check_.Validate(*segment); !status.ok()) {
     return Reject("invalid", status);
   }
-  auto drop = [&](const std::string& reason, std::string why) {
-    if (dropped != nullptr) *dropped = std::move(why);
-    CountRejected(reason);
-    return absl::OkStatus();
-  };
-  if (check_.TooStale(segment->policy_version, newest)) {
-    return drop("stale",
-                absl::StrCat("segment.policy_version ", segment->policy_version,
-                             " is more than ", config_.max_policy_lag,
-                             " versions behind the newest (", newest, ")"));
-  }
-  {
-    // Sequence numbers only grow along a slot's stream (a jump starts a
-    // new stream); one already admitted would be stitched twice.
-    std::lock_guard<std::mutex> lock(mutex_);
-    auto it = actors_.find(actor_id);
-    if (it != actors_.end()) {
-      int64_t& next = it->second.next_sequence[segment->env_slot];
-      if (segment->sequence < next) {
-        ++counters_.rejected["duplicate"];
-        if (dropped != nullptr) {
-          *dropped = absl::StrCat("segment.sequence ", segment->sequence,
-                                  " of slot ", segment->env_slot,
-                                  " was already admitted (next: ", next, ")");
-        }
-        return absl::OkStatus();
-      }
-      next = segment->sequence + 1;
+  return segment;
+}
+
+bool ActorGateway::AdvanceSequence(int64_t actor_id, const Segment& segment,
+                                   std::string* dropped) {
+  // Sequence numbers only grow along a slot's stream (a jump starts a new
+  // stream); one already admitted would be stitched twice.
+  std::lock_guard<std::mutex> lock(mutex_);
+  auto it = actors_.find(actor_id);
+  if (it == actors_.end()) return true;
+  int64_t& next = it->second.next_sequence[segment.env_slot];
+  if (segment.sequence < next) {
+    ++counters_.rejected["duplicate"];
+    if (dropped != nullptr) {
+      *dropped = absl::StrCat("segment.sequence ", segment.sequence,
+                              " of slot ", segment.env_slot,
+                              " was already admitted (next: ", next, ")");
     }
+    return false;
   }
-  const int64_t steps = segment->steps();
-  if (absl::Status status = sink_.Send(*std::move(segment)); !status.ok()) {
+  next = segment.sequence + 1;
+  return true;
+}
+
+absl::Status ActorGateway::Deliver(int64_t actor_id, Segment segment) {
+  const int64_t steps = segment.steps();
+  if (absl::Status status = sink_.Send(std::move(segment)); !status.ok()) {
     return absl::UnavailableError("the learner is shutting down");
   }
   std::lock_guard<std::mutex> lock(mutex_);

@@ -189,6 +189,28 @@ class ActorGateway {
   };
 
   absl::Status Reject(const std::string& reason, absl::Status status);
+
+  // Register's steps: the request against the run's spec and the limits,
+  // then (taking mutex_) the new registration's id, or why there is no room.
+  absl::Status CheckRegisterRequest(const pb::RegisterRequest& request) const;
+  absl::StatusOr<int64_t> AddRegistration(absl::string_view peer,
+                                          int64_t num_envs,
+                                          const std::string& secret);
+
+  // Admit's steps. Each takes mutex_ only around what it reads or writes of
+  // the gateway's state, so that the lock is never held while a segment is
+  // decoded or while sink_ blocks. CheckSender refuses a segment of another
+  // actor or slot and returns the newest published version as of the same
+  // lock. AdvanceSequence is false for a sequence number already admitted
+  // (the segment is then dropped, counted, and *dropped says why).
+  absl::StatusOr<int64_t> CheckSender(int64_t actor_id,
+                                      const pb::Segment& proto);
+  absl::StatusOr<Segment> DecodeSegment(const pb::Segment& proto,
+                                        int64_t newest);
+  bool AdvanceSequence(int64_t actor_id, const Segment& segment,
+                       std::string* dropped);
+  absl::Status Deliver(int64_t actor_id, Segment segment);
+
   // With mutex_ held: whether `peer` may hold one more unclaimed
   // registration, and room for `num_envs` more env slots made by evicting
   // idle registrations (false if there is not enough to evict).
