@@ -299,8 +299,8 @@ int RunTrainBenchmark(const TrainBenchConfig& config) {
         "train: with the bare LibTorch PPO loop's %.0f samples/s instead: "
         "limit %.0f env steps/s\n",
         bare, limit_of(bare));
-    bare_fields = absl::StrFormat(" bare_samples_per_s=%.0f bare_limit_sps=%.0f",
-                                  bare, limit_of(bare));
+    bare_fields = absl::StrFormat(
+        " bare_samples_per_s=%.0f bare_limit_sps=%.0f", bare, limit_of(bare));
   }
   std::fflush(stdout);
 

@@ -15,8 +15,8 @@
 #include "deploy/cli/shared_flags.h"
 #include "deploy/cli/stop_signal.h"
 #include "deploy/cli/train_command.h"
-#include "deploy/run/learner_server.h"
 #include "deploy/run/run_config.h"
+#include "learner/server/learner_server.h"
 #include "learner/service/actor_gateway.h"
 
 ABSL_FLAG(std::string, listen, "127.0.0.1:0",
@@ -50,51 +50,53 @@ int LearnerThreads(const pb::DistributedSettings& distributed) {
   return std::max(1, cores / std::max(1, distributed.learners()));
 }
 
-int RunLearner(const std::vector<std::string>&) {
+// The run a learner serves, from its flags: always a distributed one, with
+// --world_size standing for --learners. An error is a usage line.
+absl::StatusOr<ResolvedRun> ResolveLearnerRun() {
   absl::StatusOr<RunRequest> request = RunRequestFromFlags();
-  if (!request.ok()) return Fail(kUsageError, request.status().message());
+  if (!request.ok()) return request.status();
   // A learner is the distributed run's, whatever a config file says.
   if (request->resume.empty()) request->flags.set_mode("distributed");
   if (const int world_size = absl::GetFlag(FLAGS_world_size); world_size != 0) {
     pb::DistributedSettings& d = *request->flags.mutable_distributed();
     if (d.has_learners() && d.learners() != world_size) {
-      return Fail(kUsageError,
-                  absl::StrCat("--world_size=", world_size,
-                               " contradicts --learners=", d.learners()));
+      return absl::InvalidArgumentError(
+          absl::StrCat("--world_size=", world_size,
+                       " contradicts --learners=", d.learners()));
     }
     if (request->resume.empty()) d.set_learners(world_size);
   }
   absl::StatusOr<ResolvedRun> resolved = ResolveRunRequest(*request);
-  if (!resolved.ok()) return Fail(kUsageError, resolved.status().message());
+  if (!resolved.ok()) return resolved.status();
   if (resolved->config.mode() != "distributed") {
-    return Fail(kUsageError,
-                absl::StrCat(request->resume,
-                             " holds a local run; continue it with `vantage "
-                             "train --resume=",
-                             request->resume, "`"));
+    return absl::InvalidArgumentError(absl::StrCat(
+        request->resume,
+        " holds a local run; continue it with `vantage train --resume=",
+        request->resume, "`"));
   }
   if (absl::Status status = CheckRunCanStart(*resolved); !status.ok()) {
-    return Fail(kUsageError, status.message());
+    return status;
   }
-  if (absl::Status status = PrepareRunDirectory(*resolved); !status.ok()) {
-    return Fail(kRuntimeError, status.message());
-  }
-  LearnerServerConfig server;
+  return resolved;
+}
+
+// The server's settings from the resolved run and the learner's own flags
+// (limits, security, ports, replicas). An error is a usage line.
+absl::Status DescribeServer(const ResolvedRun& resolved,
+                            LearnerServerConfig& server) {
   if (absl::Status status = ReadLearnerLimits(server); !status.ok()) {
-    return Fail(kUsageError, status.message());
+    return status;
   }
   absl::StatusOr<SecurityOptions> security = SecurityFromFlags(/*server=*/true);
-  if (!security.ok()) return Fail(kUsageError, security.status().message());
-  const int learner_threads = LearnerThreads(resolved->config.distributed());
-  SetComputeThreads(learner_threads);
+  if (!security.ok()) return security.status();
   // The learner's own configuration pins the environment; no actor's
   // registration decides it.
   absl::StatusOr<std::unique_ptr<Environment>> env = MakeEnvironment(
-      resolved->config.training().env(), EnvOptionsOf(resolved->config));
-  if (!env.ok()) return Fail(kUsageError, env.status().message());
-  server.learner = resolved->plan.learner;
-  server.recording = resolved->plan.recording;
-  server.run_config = resolved->config;
+      resolved.config.training().env(), EnvOptionsOf(resolved.config));
+  if (!env.ok()) return env.status();
+  server.learner = resolved.plan.learner;
+  server.recording = resolved.plan.recording;
+  server.run_config = resolved.config;
   server.spec = (*env)->spec();
   // Only its spec is needed: a Python env is closed again here.
   env->reset();
@@ -104,16 +106,22 @@ int RunLearner(const std::vector<std::string>&) {
   server.metrics_address = absl::GetFlag(FLAGS_metrics);
   server.metrics_port_file = absl::GetFlag(FLAGS_metrics_port_file);
   server.replicas.rank = absl::GetFlag(FLAGS_rank);
-  server.replicas.world_size = resolved->config.distributed().learners();
+  server.replicas.world_size = resolved.config.distributed().learners();
   server.replicas.rendezvous = absl::GetFlag(FLAGS_rendezvous);
   server.replicas.timeout =
       absl::Seconds(absl::GetFlag(FLAGS_replica_timeout_s));
   if (absl::Status status = server.replicas.Validate(); !status.ok()) {
-    return Fail(kUsageError, absl::StrCat(status.message(),
-                                          " (--rank, --learners, --rendezvous, "
-                                          "--replica_timeout_s)"));
+    return absl::InvalidArgumentError(
+        absl::StrCat(status.message(),
+                     " (--rank, --learners, --rendezvous, "
+                     "--replica_timeout_s)"));
   }
-  // The other replicas train silently: rank 0 speaks for the run.
+  return absl::OkStatus();
+}
+
+// Serves until the run is done or stopped; rank 0 reports each update and
+// the result, the other replicas train silently.
+int Serve(const ResolvedRun& resolved, const LearnerServerConfig& server) {
   const bool primary = server.replicas.rank == 0;
   ProgressRow last;
   last.mean_return = std::nan("");
@@ -132,12 +140,27 @@ int RunLearner(const std::vector<std::string>&) {
       });
   if (!status.ok()) return Fail(kRuntimeError, status.message());
   if (!primary) return 0;
-  if (!updated && resolved->plan.recording.resume && !StopRequested()) {
-    PrintFinishedAlready(*resolved);
+  if (!updated && resolved.plan.recording.resume && !StopRequested()) {
+    PrintFinishedAlready(resolved);
     return 0;
   }
-  PrintTrainResult(resolved->config, last);
+  PrintTrainResult(resolved.config, last);
   return 0;
+}
+
+int RunLearner(const std::vector<std::string>&) {
+  absl::StatusOr<ResolvedRun> resolved = ResolveLearnerRun();
+  if (!resolved.ok()) return Fail(kUsageError, resolved.status().message());
+  if (absl::Status status = PrepareRunDirectory(*resolved); !status.ok()) {
+    return Fail(kRuntimeError, status.message());
+  }
+  // Before anything computes (the environment is made below).
+  SetComputeThreads(LearnerThreads(resolved->config.distributed()));
+  LearnerServerConfig server;
+  if (absl::Status status = DescribeServer(*resolved, server); !status.ok()) {
+    return Fail(kUsageError, status.message());
+  }
+  return Serve(*resolved, server);
 }
 
 }  // namespace

@@ -5,7 +5,7 @@
 #include "absl/flags/reflection.h"
 #include "absl/time/time.h"
 #include "deploy/cli/command_line.h"
-#include "deploy/run/learner_server.h"
+#include "learner/server/learner_server.h"
 #include "learner/service/actor_gateway.h"
 #include "learner/service/learner_service.h"
 

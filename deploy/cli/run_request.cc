@@ -6,9 +6,9 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_join.h"
 #include "deploy/run/run_config.h"
-#include "deploy/run/run_directory.h"
 #include "learner/algorithms/algorithm_config.h"
 #include "learner/checkpoint/checkpoint_files.h"
+#include "learner/run/run_directory.h"
 
 namespace vantage {
 namespace {

@@ -10,9 +10,9 @@
 #include <vector>
 
 #include "absl/status/statusor.h"
-#include "deploy/observe/progress_columns.h"
-#include "deploy/run/run_directory.h"
 #include "deploy/run/run_plan.h"
+#include "learner/run/progress_columns.h"
+#include "learner/run/run_directory.h"
 #include "proto/run_config.pb.h"
 
 namespace vantage {

@@ -21,8 +21,8 @@
 #include "deploy/run/launcher.h"
 #include "deploy/run/local_training.h"
 #include "deploy/run/run_config.h"
-#include "deploy/run/run_directory.h"
 #include "learner/algorithms/algorithm_config.h"
+#include "learner/run/run_directory.h"
 
 namespace vantage {
 namespace {

@@ -8,10 +8,10 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_split.h"
 #include "deploy/run/run_config.h"
-#include "deploy/run/run_directory.h"
 #include "google/protobuf/util/json_util.h"
 #include "google/protobuf/util/message_differencer.h"
 #include "learner/checkpoint/checkpoint_files.h"
+#include "learner/run/run_directory.h"
 
 namespace vantage {
 namespace {

@@ -15,7 +15,7 @@
 #include "absl/strings/str_split.h"
 #include "absl/strings/strip.h"
 #include "deploy/experiment/experiment_directory.h"
-#include "deploy/run/run_directory.h"
+#include "learner/run/run_directory.h"
 
 namespace vantage {
 namespace {

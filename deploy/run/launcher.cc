@@ -23,9 +23,9 @@
 #include "common/util/self_process.h"
 #include "deploy/observe/scrape_targets.h"
 #include "deploy/run/run_config.h"
-#include "deploy/run/run_directory.h"
 #include "learner/algorithms/algorithm_config.h"
 #include "learner/checkpoint/checkpoint_files.h"
+#include "learner/run/run_directory.h"
 
 namespace vantage {
 namespace {

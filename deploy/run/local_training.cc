@@ -2,9 +2,9 @@
 
 #include "absl/strings/str_cat.h"
 #include "actor/actor_core.h"
-#include "deploy/run/training_run.h"
 #include "learner/checkpoint/checkpoint.h"
 #include "learner/learner_core.h"
+#include "learner/run/training_run.h"
 
 namespace vantage {
 namespace {

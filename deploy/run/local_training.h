@@ -5,8 +5,8 @@
 #include <functional>
 
 #include "absl/status/status.h"
-#include "deploy/observe/progress_columns.h"
 #include "deploy/run/run_plan.h"
+#include "learner/run/progress_columns.h"
 
 namespace vantage {
 

@@ -10,8 +10,8 @@
 
 #include "absl/status/statusor.h"
 #include "actor/actor_config.h"
-#include "deploy/run/recording_config.h"
 #include "learner/learner_config.h"
+#include "learner/run/recording_config.h"
 #include "proto/run_config.pb.h"
 
 namespace vantage {

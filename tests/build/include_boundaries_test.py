@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Tests of deploy/include_boundaries.py, and the check itself on the
+"""Tests of tests/build/include_boundaries.py, and the check itself on the
 project's tree (the allowed list in tests/build/torch_users.txt).
 
   /usr/bin/python3 tests/build/include_boundaries_test.py
@@ -14,7 +14,7 @@ import unittest
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 REPO = os.path.dirname(os.path.dirname(HERE))
-SCRIPT = os.path.join(REPO, "deploy", "include_boundaries.py")
+SCRIPT = os.path.join(HERE, "include_boundaries.py")
 
 
 def run(*args):
@@ -30,7 +30,7 @@ class ProjectTreeTest(unittest.TestCase):
 
     def test_the_run_configuration_compiles_without_libtorch(self):
         for path in ("deploy/run/run_config.h", "deploy/run/run_config.cc",
-                     "deploy/observe/progress_columns.h", "deploy/run/run_directory.h",
+                     "learner/run/progress_columns.h", "learner/run/run_directory.h",
                      "learner/learner_config.h", "proto/wire_format.h"):
             result = run("--root", REPO, "--explain", path)
             self.assertEqual(result.returncode, 0, result.stderr)

@@ -10,11 +10,11 @@
 
 #include "absl/strings/str_join.h"
 #include "absl/strings/str_split.h"
-#include "deploy/observe/progress_columns.h"
-#include "deploy/run/run_directory.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
 #include "learner/checkpoint/checkpoint.h"
+#include "learner/run/progress_columns.h"
+#include "learner/run/run_directory.h"
 #include "tests/fakes/local_plan.h"
 #include "tests/fakes/run_files.h"
 

@@ -13,9 +13,9 @@
 #include "deploy/cli/run_flags.h"
 #include "deploy/cli/train_command.h"
 #include "deploy/run/run_config.h"
-#include "deploy/run/run_directory.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
+#include "learner/run/run_directory.h"
 #include "tests/deploy/cli/run_vantage.h"
 
 namespace vantage {

@@ -1,11 +1,11 @@
-#include "deploy/run/training_run.h"
+#include "learner/run/training_run.h"
 
 #include <cstdio>
 #include <optional>
 #include <utility>
 
-#include "deploy/run/run_directory.h"
-#include "deploy/run/run_resume.h"
+#include "learner/run/run_directory.h"
+#include "learner/run/run_resume.h"
 
 namespace vantage {
 

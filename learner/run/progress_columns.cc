@@ -1,4 +1,4 @@
-#include "deploy/observe/progress_columns.h"
+#include "learner/run/progress_columns.h"
 
 #include <cmath>
 #include <cstdint>

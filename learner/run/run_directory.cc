@@ -1,4 +1,4 @@
-#include "deploy/run/run_directory.h"
+#include "learner/run/run_directory.h"
 
 #include <algorithm>
 #include <cmath>

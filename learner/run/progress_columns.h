@@ -1,5 +1,5 @@
-#ifndef VANTAGE_DEPLOY_OBSERVE_PROGRESS_COLUMNS_H_
-#define VANTAGE_DEPLOY_OBSERVE_PROGRESS_COLUMNS_H_
+#ifndef VANTAGE_LEARNER_RUN_PROGRESS_COLUMNS_H_
+#define VANTAGE_LEARNER_RUN_PROGRESS_COLUMNS_H_
 
 // The statistics of one update, as progress.csv's columns and as the
 // learner's Prometheus series: one table feeds both, so a statistic added
@@ -44,4 +44,4 @@ std::string FormatProgressRow(const ProgressRow& row);
 
 }  // namespace vantage
 
-#endif  // VANTAGE_DEPLOY_OBSERVE_PROGRESS_COLUMNS_H_
+#endif  // VANTAGE_LEARNER_RUN_PROGRESS_COLUMNS_H_

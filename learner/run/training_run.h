@@ -1,12 +1,12 @@
-#ifndef VANTAGE_DEPLOY_RUN_TRAINING_RUN_H_
-#define VANTAGE_DEPLOY_RUN_TRAINING_RUN_H_
+#ifndef VANTAGE_LEARNER_RUN_TRAINING_RUN_H_
+#define VANTAGE_LEARNER_RUN_TRAINING_RUN_H_
 
 // The life of one training run that local and distributed training share:
 // its run directory created (or opened to resume), its learner created (or
 // loaded from the newest checkpoint that loads), and every update recorded
 // (a progress row, checkpoints). Only where segments come from differs: an
 // in-process actor (deploy/run/local_training.h) or the gRPC service
-// (deploy/run/learner_server.h) fills the queue each update consumes.
+// (learner/server/learner_server.h) fills the queue each update consumes.
 
 #include <functional>
 #include <memory>
@@ -14,11 +14,11 @@
 
 #include "absl/status/statusor.h"
 #include "common/rollout/segment_queue.h"
-#include "deploy/observe/progress_columns.h"
-#include "deploy/run/recording_config.h"
-#include "deploy/run/run_recorder.h"
 #include "learner/checkpoint/checkpoint.h"
 #include "learner/learner_core.h"
+#include "learner/run/progress_columns.h"
+#include "learner/run/recording_config.h"
+#include "learner/run/run_recorder.h"
 
 namespace vantage {
 
@@ -65,4 +65,4 @@ class TrainingRun {
 
 }  // namespace vantage
 
-#endif  // VANTAGE_DEPLOY_RUN_TRAINING_RUN_H_
+#endif  // VANTAGE_LEARNER_RUN_TRAINING_RUN_H_

@@ -1,5 +1,5 @@
-#ifndef VANTAGE_DEPLOY_RUN_RUN_RESUME_H_
-#define VANTAGE_DEPLOY_RUN_RUN_RESUME_H_
+#ifndef VANTAGE_LEARNER_RUN_RUN_RESUME_H_
+#define VANTAGE_LEARNER_RUN_RUN_RESUME_H_
 
 // Continuing a recorded run from its newest checkpoint that loads; the
 // counterpart of the checkpoints RunRecorder writes.
@@ -9,9 +9,9 @@
 
 #include "absl/functional/function_ref.h"
 #include "absl/status/statusor.h"
-#include "deploy/run/run_directory.h"
 #include "learner/checkpoint/checkpoint.h"
 #include "learner/learner_core.h"
+#include "learner/run/run_directory.h"
 
 namespace vantage {
 
@@ -38,4 +38,4 @@ absl::StatusOr<ResumePoint> ResumeFromNewestCheckpoint(RunDirectory& run,
 
 }  // namespace vantage
 
-#endif  // VANTAGE_DEPLOY_RUN_RUN_RESUME_H_
+#endif  // VANTAGE_LEARNER_RUN_RUN_RESUME_H_

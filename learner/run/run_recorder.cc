@@ -1,4 +1,4 @@
-#include "deploy/run/run_recorder.h"
+#include "learner/run/run_recorder.h"
 
 #include <algorithm>
 

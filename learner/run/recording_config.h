@@ -1,11 +1,11 @@
-#ifndef VANTAGE_DEPLOY_RUN_RECORDING_CONFIG_H_
-#define VANTAGE_DEPLOY_RUN_RECORDING_CONFIG_H_
+#ifndef VANTAGE_LEARNER_RUN_RECORDING_CONFIG_H_
+#define VANTAGE_LEARNER_RUN_RECORDING_CONFIG_H_
 
 #include <string>
 
 namespace vantage {
 
-// Where and how a run is recorded (see deploy/run/run_directory.h):
+// Where and how a run is recorded (see learner/run/run_directory.h):
 // config.json with `config_json`, progress.csv, and a checkpoint every
 // `checkpoint_every` updates and at the end, keeping the newest
 // `keep_checkpoints`; no run directory: nothing is written.
@@ -25,4 +25,4 @@ struct RecordingConfig {
 
 }  // namespace vantage
 
-#endif  // VANTAGE_DEPLOY_RUN_RECORDING_CONFIG_H_
+#endif  // VANTAGE_LEARNER_RUN_RECORDING_CONFIG_H_

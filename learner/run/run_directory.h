@@ -1,5 +1,5 @@
-#ifndef VANTAGE_DEPLOY_RUN_RUN_DIRECTORY_H_
-#define VANTAGE_DEPLOY_RUN_RUN_DIRECTORY_H_
+#ifndef VANTAGE_LEARNER_RUN_RUN_DIRECTORY_H_
+#define VANTAGE_LEARNER_RUN_RUN_DIRECTORY_H_
 
 // A training run's directory:
 //   config.json     the resolved run config (`vantage train --config` and
@@ -13,7 +13,7 @@
 
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
-#include "deploy/observe/progress_columns.h"
+#include "learner/run/progress_columns.h"
 
 namespace vantage {
 
@@ -69,4 +69,4 @@ class RunDirectory {
 
 }  // namespace vantage
 
-#endif  // VANTAGE_DEPLOY_RUN_RUN_DIRECTORY_H_
+#endif  // VANTAGE_LEARNER_RUN_RUN_DIRECTORY_H_

@@ -1,4 +1,4 @@
-#include "deploy/run/learner_server.h"
+#include "learner/server/learner_server.h"
 
 #include <malloc.h>
 
@@ -16,8 +16,8 @@
 #include "absl/time/time.h"
 #include "common/net/port_file.h"
 #include "common/util/phase_times.h"
-#include "deploy/observe/progress_columns.h"
-#include "deploy/run/training_run.h"
+#include "learner/run/progress_columns.h"
+#include "learner/run/training_run.h"
 #include "learner/service/actor_gateway.h"
 #include "learner/service/learner_metrics.h"
 #include "learner/service/learner_service.h"

@@ -1,5 +1,5 @@
-#ifndef VANTAGE_DEPLOY_RUN_RUN_RECORDER_H_
-#define VANTAGE_DEPLOY_RUN_RUN_RECORDER_H_
+#ifndef VANTAGE_LEARNER_RUN_RUN_RECORDER_H_
+#define VANTAGE_LEARNER_RUN_RUN_RECORDER_H_
 
 #include <chrono>
 #include <cstdint>
@@ -8,10 +8,10 @@
 
 #include "absl/functional/function_ref.h"
 #include "absl/status/statusor.h"
-#include "deploy/run/recording_config.h"
-#include "deploy/run/run_directory.h"
 #include "learner/checkpoint/checkpoint.h"
 #include "learner/learner_core.h"
+#include "learner/run/recording_config.h"
+#include "learner/run/run_directory.h"
 
 namespace vantage {
 
@@ -62,4 +62,4 @@ class RunRecorder {
 
 }  // namespace vantage
 
-#endif  // VANTAGE_DEPLOY_RUN_RUN_RECORDER_H_
+#endif  // VANTAGE_LEARNER_RUN_RUN_RECORDER_H_

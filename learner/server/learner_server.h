@@ -1,5 +1,5 @@
-#ifndef VANTAGE_DEPLOY_RUN_LEARNER_SERVER_H_
-#define VANTAGE_DEPLOY_RUN_LEARNER_SERVER_H_
+#ifndef VANTAGE_LEARNER_SERVER_LEARNER_SERVER_H_
+#define VANTAGE_LEARNER_SERVER_LEARNER_SERVER_H_
 
 #include <atomic>
 #include <functional>
@@ -8,10 +8,10 @@
 #include "absl/status/status.h"
 #include "common/env/environment.h"
 #include "common/net/security_options.h"
-#include "deploy/observe/progress_columns.h"
-#include "deploy/run/recording_config.h"
 #include "learner/learner_config.h"
 #include "learner/parallel/gloo_replica_group.h"
+#include "learner/run/progress_columns.h"
+#include "learner/run/recording_config.h"
 #include "learner/service/actor_gateway.h"
 #include "proto/run_config.pb.h"
 
@@ -58,4 +58,4 @@ absl::Status RunLearnerServer(
 
 }  // namespace vantage
 
-#endif  // VANTAGE_DEPLOY_RUN_LEARNER_SERVER_H_
+#endif  // VANTAGE_LEARNER_SERVER_LEARNER_SERVER_H_

@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """Which of the project's files reach LibTorch's headers, and through what.
 
-  deploy/include_boundaries.py [--root DIR] [--allowed FILE]
+  tests/build/include_boundaries.py [--root DIR] [--allowed FILE]
       [--explain PATH | --list LEVEL]
 
 Follows the project's own #include graph (quoted and <...> includes that
@@ -149,11 +149,11 @@ def level_name(level):
 
 
 def main():
-    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    here = os.path.dirname(os.path.abspath(__file__))
+    root = os.path.dirname(os.path.dirname(here))  # tests/build/ -> the repo
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--root", default=root)
-    parser.add_argument("--allowed", default=os.path.join(
-        root, "tests", "build", "torch_users.txt"))
+    parser.add_argument("--allowed", default=os.path.join(here, "torch_users.txt"))
     parser.add_argument("--explain", metavar="PATH")
     parser.add_argument("--list", choices=sorted(LEVELS), metavar="LEVEL")
     args = parser.parse_args()

@@ -1,11 +1,11 @@
-#include "deploy/run/run_resume.h"
+#include "learner/run/run_resume.h"
 
 #include <cstdio>
 #include <vector>
 
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
-#include "deploy/run/run_recorder.h"
+#include "learner/run/run_recorder.h"
 
 namespace vantage {
 
