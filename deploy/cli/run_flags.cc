@@ -20,9 +20,11 @@
 // --env, --envs and --seed are the shared flags (deploy/cli/shared_flags).
 // Every default is ResolveRunConfig's (see RunFlagDefaults): a flag's own
 // default below is never read, since only given flags enter the config.
+// The algorithms' names come from their registry.
 ABSL_FLAG(std::string, algo, "",
-          "ppo | a2c | trpo (a --config file's settings of another "
-          "algorithm are dropped)");
+          absl::StrCat(absl::StrJoin(vantage::AlgorithmNames(), " | "),
+                       " (a --config file's settings of another algorithm "
+                       "are dropped)"));
 ABSL_FLAG(std::string, config, "",
           "a JSON run config (as a run directory's config.json); the flags "
           "given override it");
