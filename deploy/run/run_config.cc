@@ -13,9 +13,11 @@
 #include "absl/strings/str_split.h"
 #include "common/advantage/advantage_config.h"
 #include "common/env/frame_stack.h"
+#include "deploy/run/distributed_config.h"
 #include "deploy/run/run_plan.h"
 #include "learner/algorithms/algorithm_config.h"
 #include "learner/exploration/ex2_config.h"
+#include "learner/run/recording_config.h"
 #include "proto/flat_run_config.pb.h"
 
 namespace vantage {
@@ -55,95 +57,10 @@ int64_t DefaultSegmentLength(int64_t horizon) {
   return 1;
 }
 
-absl::Status ResolveDistributed(pb::RunConfig& c) {
-  pb::TrainingSettings& t = *c.mutable_training();
-  pb::DistributedSettings& d = *c.mutable_distributed();
-  // Two actor processes by default; a batch given as --envs alone is
-  // split over them (over one actor if it does not split evenly).
-  if (!d.has_actors()) {
-    const int64_t per_actor = d.has_envs_per_actor() ? d.envs_per_actor() : 0;
-    if (t.has_envs() && per_actor > 0) {
-      d.set_actors(static_cast<int32_t>(t.envs() / per_actor));
-    } else {
-      d.set_actors(t.has_envs() && t.envs() % 2 != 0 ? 1 : 2);
-    }
-  }
-  if (!d.has_envs_per_actor()) {
-    d.set_envs_per_actor(
-        t.has_envs() ? static_cast<int32_t>(t.envs() / std::max(1, d.actors()))
-                     : 1);
-  }
-  if (d.actors() < 1 || d.actors() > 256) {
-    return Invalid("actors", "must be in [1, 256]");
-  }
-  if (d.envs_per_actor() < 1 || d.envs_per_actor() > 4096) {
-    return Invalid("envs_per_actor", "must be in [1, 4096]");
-  }
-  // At most 256 x 4096: the product fits an int32.
-  const int32_t streams = d.actors() * d.envs_per_actor();
-  if (streams > 4096) {
-    return Invalid("envs_per_actor",
-                   absl::StrCat("makes --actors x --envs_per_actor = ", streams,
-                                " streams, more than 4096"));
-  }
-  // The learner's batch holds one rollout per actor environment.
-  if (t.has_envs() && t.envs() != streams) {
-    return Invalid("envs",
-                   absl::StrCat("is the learner's batch of --actors x "
-                                "--envs_per_actor = ",
-                                streams, " streams in a distributed run"));
-  }
-  t.set_envs(streams);
-  if (!d.has_sync()) d.set_sync(true);
-  if (!d.has_max_policy_lag()) {
-    d.set_max_policy_lag(d.sync() ? 0 : 4);
-  }
-  if (d.sync() && d.max_policy_lag() != 0) {
-    return Invalid("max_policy_lag", "must be 0 with --sync");
-  }
-  if (d.max_policy_lag() < 0) return Invalid("max_policy_lag", "must be >= 0");
-  if (!d.has_learners()) d.set_learners(1);
-  if (d.learners() < 1 || d.learners() > 64) {
-    return Invalid("learners", "must be in [1, 64]");
-  }
-  // One thread beat two on the 2-core machines measured (small GEMMs).
-  if (!d.has_learner_threads()) d.set_learner_threads(1);
-  if (d.learner_threads() < 0 || d.learner_threads() > 256) {
-    return Invalid("learner_threads", "must be in [0, 256] (0: automatic)");
-  }
-  if (d.actors() % d.learners() != 0) {
-    return Invalid("learners",
-                   absl::StrCat("must divide --actors (", d.actors(),
-                                "): every learner serves as many actors"));
-  }
-  if (d.sync() && t.horizon() % t.segment_length() != 0) {
-    return Invalid("segment_length",
-                   "must divide --horizon in a --sync run (each actor sends "
-                   "exactly one horizon per policy version)");
-  }
-  return absl::OkStatus();
-}
-
-// The fields of an older run's flat config.json in their sections; the
-// flat fields whose meaning depended on the algorithm go to its section.
-absl::StatusOr<pb::RunConfig> FromFlat(const pb::FlatRunConfig& flat) {
-  pb::RunConfig c;
-  if (flat.has_mode()) c.set_mode(flat.mode());
-  pb::TrainingSettings& t = *c.mutable_training();
-  if (flat.has_env()) t.set_env(flat.env());
-  if (flat.has_seed()) t.set_seed(flat.seed());
-  if (flat.has_steps()) t.set_steps(flat.steps());
-  if (flat.has_envs()) t.set_envs(flat.envs());
-  if (flat.has_horizon()) t.set_horizon(flat.horizon());
-  t.mutable_hidden()->CopyFrom(flat.hidden());
-  if (flat.has_scale_rewards()) t.set_scale_rewards(flat.scale_rewards());
-  if (flat.has_segment_length()) t.set_segment_length(flat.segment_length());
-  pb::AdvantageSettings& a = *c.mutable_advantage();
-  if (flat.has_estimator()) a.set_estimator(flat.estimator());
-  if (flat.has_rho()) a.set_rho(flat.rho());
-  a.mutable_ensemble()->CopyFrom(flat.ensemble());
-  if (flat.has_gamma()) a.set_gamma(flat.gamma());
-  if (flat.has_gae_lambda()) a.set_gae_lambda(flat.gae_lambda());
+// The algorithm of an older run's flat config.json, with the flat fields
+// whose meaning depended on it.
+absl::Status AlgorithmFromFlat(const pb::FlatRunConfig& flat,
+                               pb::RunConfig& c) {
   const std::string algo = flat.has_algo() ? flat.algo() : "ppo";
   if (absl::Status status = SelectAlgorithm(algo, c); !status.ok()) {
     return Invalid("algo:", status.message());
@@ -172,6 +89,32 @@ absl::StatusOr<pb::RunConfig> FromFlat(const pb::FlatRunConfig& flat) {
     if (flat.has_minibatches()) s.set_minibatches(flat.minibatches());
     if (flat.has_learning_rate()) s.set_learning_rate(flat.learning_rate());
     if (flat.has_entropy_coef()) s.set_entropy_coef(flat.entropy_coef());
+  }
+  return absl::OkStatus();
+}
+
+// The fields of an older run's flat config.json in their sections; the
+// flat fields whose meaning depended on the algorithm go to its section.
+absl::StatusOr<pb::RunConfig> FromFlat(const pb::FlatRunConfig& flat) {
+  pb::RunConfig c;
+  if (flat.has_mode()) c.set_mode(flat.mode());
+  pb::TrainingSettings& t = *c.mutable_training();
+  if (flat.has_env()) t.set_env(flat.env());
+  if (flat.has_seed()) t.set_seed(flat.seed());
+  if (flat.has_steps()) t.set_steps(flat.steps());
+  if (flat.has_envs()) t.set_envs(flat.envs());
+  if (flat.has_horizon()) t.set_horizon(flat.horizon());
+  t.mutable_hidden()->CopyFrom(flat.hidden());
+  if (flat.has_scale_rewards()) t.set_scale_rewards(flat.scale_rewards());
+  if (flat.has_segment_length()) t.set_segment_length(flat.segment_length());
+  pb::AdvantageSettings& a = *c.mutable_advantage();
+  if (flat.has_estimator()) a.set_estimator(flat.estimator());
+  if (flat.has_rho()) a.set_rho(flat.rho());
+  a.mutable_ensemble()->CopyFrom(flat.ensemble());
+  if (flat.has_gamma()) a.set_gamma(flat.gamma());
+  if (flat.has_gae_lambda()) a.set_gae_lambda(flat.gae_lambda());
+  if (absl::Status status = AlgorithmFromFlat(flat, c); !status.ok()) {
+    return status;
   }
   pb::RecordingSettings& r = *c.mutable_recording();
   if (flat.has_checkpoint_every()) {
@@ -280,23 +223,6 @@ absl::Status ResolveLocal(pb::RunConfig& c) {
   return absl::OkStatus();
 }
 
-absl::Status ResolveRecording(pb::RecordingSettings& r) {
-  const RecordingConfig recording;
-  if (!r.has_checkpoint_every()) {
-    r.set_checkpoint_every(recording.checkpoint_every);
-  }
-  if (!r.has_keep_checkpoints()) {
-    r.set_keep_checkpoints(recording.keep_checkpoints);
-  }
-  if (r.checkpoint_every() < 1) {
-    return Invalid("checkpoint_every", "must be >= 1");
-  }
-  if (r.keep_checkpoints() < 1) {
-    return Invalid("keep_checkpoints", "must be >= 1");
-  }
-  return absl::OkStatus();
-}
-
 }  // namespace
 
 absl::StatusOr<pb::RunConfig> ResolveRunConfig(const pb::RunConfig& given) {
@@ -332,11 +258,14 @@ absl::StatusOr<pb::RunConfig> ResolveRunConfig(const pb::RunConfig& given) {
     return status;
   }
   if (absl::Status status =
-          c.mode() == "distributed" ? ResolveDistributed(c) : ResolveLocal(c);
+          c.mode() == "distributed"
+              ? ResolveDistributedSettings(*c.mutable_training(),
+                                           *c.mutable_distributed())
+              : ResolveLocal(c);
       !status.ok()) {
     return status;
   }
-  if (absl::Status status = ResolveRecording(*c.mutable_recording());
+  if (absl::Status status = ResolveRecordingSettings(*c.mutable_recording());
       !status.ok()) {
     return status;
   }

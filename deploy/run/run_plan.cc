@@ -57,9 +57,8 @@ absl::StatusOr<RunPlan> PlanRun(const pb::RunConfig& resolved) {
   absl::StatusOr<LearnerConfig> learner = LearnerConfigOf(resolved, plan.actor);
   if (!learner.ok()) return learner.status();
   plan.learner = *std::move(learner);
+  plan.recording = RecordingConfigOf(resolved.recording());
   plan.recording.config_json = RunConfigToJson(resolved);
-  plan.recording.checkpoint_every = resolved.recording().checkpoint_every();
-  plan.recording.keep_checkpoints = resolved.recording().keep_checkpoints();
   return plan;
 }
 

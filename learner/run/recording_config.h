@@ -3,7 +3,12 @@
 
 #include <string>
 
+#include "absl/status/status.h"
+
 namespace vantage {
+namespace pb {
+class RecordingSettings;
+}  // namespace pb
 
 // Where and how a run is recorded (see learner/run/run_directory.h):
 // config.json with `config_json`, progress.csv, and a checkpoint every
@@ -21,7 +26,17 @@ struct RecordingConfig {
   // False for the replicas of a data-parallel run other than rank 0: they
   // read run_dir's checkpoints to resume but write nothing there.
   bool record = true;
+
+  // checkpoint_every and keep_checkpoints are >= 1 (the message names the
+  // flag).
+  absl::Status Validate() const;
 };
+
+// The run config's recording section with every absent setting given its
+// default, checked (its table is in recording_config.cc).
+absl::Status ResolveRecordingSettings(pb::RecordingSettings& settings);
+// The settings of a resolved section over the defaults.
+RecordingConfig RecordingConfigOf(const pb::RecordingSettings& settings);
 
 }  // namespace vantage
 

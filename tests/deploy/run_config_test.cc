@@ -1,5 +1,6 @@
 #include "deploy/run/run_config.h"
 
+#include "deploy/run/distributed_config.h"
 #include "deploy/run/run_plan.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
@@ -71,6 +72,47 @@ TEST(RunConfigTest, DefaultsAreTheComponentsOwn) {
   ASSERT_TRUE(local_run.ok()) << local_run.status();
   EXPECT_FALSE(local_run->has_distributed());
   EXPECT_EQ(local_run->training().envs(), ActorConfig().num_envs);
+}
+
+// The recording and distributed sections are read through their
+// components' tables (learner/run/recording_config.cc,
+// deploy/run/distributed_config.cc): defaults from DistributedConfig and
+// RecordingConfig, each range's message naming the flag.
+TEST(RunConfigTest, SectionTablesGiveDefaultsAndNameTheFlag) {
+  absl::StatusOr<pb::RunConfig> config = Resolve("{}");
+  ASSERT_TRUE(config.ok()) << config.status();
+  const DistributedConfig distributed;
+  EXPECT_EQ(config->distributed().actors(), distributed.actors);
+  EXPECT_EQ(config->distributed().sync(), distributed.sync);
+  EXPECT_EQ(config->distributed().max_policy_lag(), 0);
+  EXPECT_EQ(config->distributed().learners(), distributed.learners);
+  EXPECT_EQ(config->distributed().learner_threads(),
+            distributed.learner_threads);
+  EXPECT_EQ(config->recording().keep_checkpoints(),
+            RecordingConfig().keep_checkpoints);
+  absl::StatusOr<pb::RunConfig> async =
+      Resolve(R"({"distributed": {"sync": false}})");
+  ASSERT_TRUE(async.ok()) << async.status();
+  EXPECT_EQ(async->distributed().max_policy_lag(), 4);
+  const std::pair<const char*, const char*> refusals[] = {
+      {R"({"recording": {"checkpoint_every": 0}})",
+       "--checkpoint_every must be >= 1"},
+      {R"({"recording": {"keep_checkpoints": -2}})",
+       "--keep_checkpoints must be >= 1"},
+      {R"({"distributed": {"actors": 257}})", "--actors must be in [1, 256]"},
+      {R"({"distributed": {"learners": 65}})",
+       "--learners must be in [1, 64]"},
+      {R"({"distributed": {"learner_threads": -1}})",
+       "--learner_threads must be in [0, 256] (0: automatic)"},
+      {R"({"distributed": {"sync": false, "max_policy_lag": -1}})",
+       "--max_policy_lag must be >= 0"},
+      {R"({"distributed": {"actors": 3, "learners": 2}})",
+       "--learners must divide --actors (3): every learner serves as many "
+       "actors"},
+  };
+  for (const auto& [json, message] : refusals) {
+    EXPECT_EQ(Resolve(json).status().message(), message) << json;
+  }
 }
 
 TEST(RunConfigTest, FrameStacksAreOneToSixteen) {

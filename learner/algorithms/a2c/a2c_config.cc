@@ -1,8 +1,8 @@
 #include "learner/algorithms/a2c/a2c_config.h"
 
 #include "absl/strings/str_cat.h"
-#include "learner/algorithms/settings_table.h"
 #include "proto/run_config.pb.h"
+#include "proto/settings_table.h"
 
 namespace vantage {
 

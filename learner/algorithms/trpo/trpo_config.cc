@@ -1,7 +1,7 @@
 #include "learner/algorithms/trpo/trpo_config.h"
 
-#include "learner/algorithms/settings_table.h"
 #include "proto/run_config.pb.h"
+#include "proto/settings_table.h"
 
 namespace vantage {
 namespace {

@@ -8,8 +8,8 @@
 
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
-#include "learner/algorithms/settings_table.h"
 #include "proto/run_config.pb.h"
+#include "proto/settings_table.h"
 
 namespace vantage {
 namespace {

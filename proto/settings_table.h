@@ -1,15 +1,18 @@
-#ifndef VANTAGE_LEARNER_ALGORITHMS_SETTINGS_TABLE_H_
-#define VANTAGE_LEARNER_ALGORITHMS_SETTINGS_TABLE_H_
+#ifndef VANTAGE_PROTO_SETTINGS_TABLE_H_
+#define VANTAGE_PROTO_SETTINGS_TABLE_H_
 
-// An algorithm's settings, each declared once: the config member, the
-// field of its settings message with the same name, and the range the
-// config's Validate() holds it to. Reading the message, writing it back and
-// checking the ranges all walk the one table, by the message's reflection.
-// Only the algorithms' config sources include this (it brings protobuf).
+// A section of the run config (proto/run_config.proto) and the typed config
+// of the component it fills, each setting declared once: the config member,
+// the field of the section's message, and the range the config's Validate()
+// holds it to. Reading the message over the config's defaults, writing the
+// resolved config back and checking the ranges all walk the one table, by
+// the message's reflection. Only the sources that define a component's
+// table include this (it brings protobuf).
 
 #include <google/protobuf/descriptor.h>
 #include <google/protobuf/message.h>
 
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <optional>
@@ -19,6 +22,7 @@
 #include <vector>
 
 #include "absl/status/status.h"
+#include "absl/status/statusor.h"
 #include "absl/strings/str_cat.h"
 
 namespace vantage {
@@ -32,50 +36,74 @@ struct SettingBound {
 inline SettingBound AtLeast(double value) { return {value, true}; }
 inline SettingBound Above(double value) { return {value, false}; }
 inline SettingBound Below(double value) { return {value, false}; }
+inline SettingBound AtMost(double value) { return {value, true}; }
+
+// How a table's messages name a setting: by its section and field, as an
+// algorithm's settings are named ("ppo.clip must be in (0, 1)"), or by the
+// field's flag, as the run's own sections are ("--steps must be >= 1").
+enum class SettingNames { kSectionField, kFlag };
 
 template <typename Config, typename Settings>
 class SettingsTable {
  public:
-  using Member = std::variant<int Config::*, double Config::*, bool Config::*,
-                              std::string Config::*>;
+  using Member =
+      std::variant<int Config::*, int64_t Config::*, uint64_t Config::*,
+                   double Config::*, bool Config::*, std::string Config::*,
+                   std::vector<int64_t> Config::*>;
   struct Row {
     Row(const char* field, Member member,
         std::optional<SettingBound> low = std::nullopt,
-        std::optional<SettingBound> high = std::nullopt)
-        : field(field), member(member), low(low), high(high) {}
-    const char* field;  // in the settings message, and the config's name
+        std::optional<SettingBound> high = std::nullopt, const char* note = "")
+        : field(field), member(member), low(low), high(high), note(note) {}
+    const char* field;  // in the settings message
     Member member;
     std::optional<SettingBound> low;
     std::optional<SettingBound> high;
+    const char* note;  // added to the range's message ("(0: automatic)")
   };
 
   // `section` names the settings in messages ("ppo": "ppo.clip must be
-  // ..."). A row whose field Settings lacks, or a range on a member that is
-  // not a number (a bool, a string), is a programming error: it stops the
-  // program at the first use of the table.
-  SettingsTable(const char* section, std::vector<Row> rows)
-      : section_(section), rows_(std::move(rows)) {
+  // ..."), or `names` says to name them by flag. A row whose field Settings
+  // lacks, or a range on a member that is not a number (a bool, a string,
+  // a list), is a programming error: it stops the program at the first
+  // use of the table.
+  SettingsTable(const char* section, std::vector<Row> rows,
+                SettingNames names = SettingNames::kSectionField)
+      : section_(section), names_(names), rows_(std::move(rows)) {
     for (const Row& row : rows_) {
       if (Settings::descriptor()->FindFieldByName(row.field) == nullptr) {
         Abort(section, row, "settings have no such field");
       }
-      const bool number = std::holds_alternative<int Config::*>(row.member) ||
-                          std::holds_alternative<double Config::*>(row.member);
+      const bool number =
+          std::visit([](auto member) { return IsNumber(member); }, row.member);
       if (!number && (row.low.has_value() || row.high.has_value())) {
         Abort(section, row, "is not a number and can have no range");
       }
     }
   }
 
-  // Each member whose field `settings` holds, over the config's defaults.
+  // Each member whose field `settings` holds (a list: with an element),
+  // over the config's defaults.
   void Read(const Settings& settings, Config& config) const {
     const auto* reflection = settings.GetReflection();
     for (const Row& row : rows_) {
       const google::protobuf::FieldDescriptor* field = Field(settings, row);
-      if (!reflection->HasField(settings, field)) continue;
+      const bool given = field->is_repeated()
+                             ? reflection->FieldSize(settings, field) > 0
+                             : reflection->HasField(settings, field);
+      if (!given) continue;
       std::visit([&](auto member) { Get(settings, *field, config.*member); },
                  row.member);
     }
+  }
+
+  // The config `defaults` with what `settings` holds, checked, and written
+  // back whole into `settings` (every field then says what the run uses).
+  absl::StatusOr<Config> Resolve(Config defaults, Settings& settings) const {
+    Read(settings, defaults);
+    if (absl::Status status = Validate(defaults); !status.ok()) return status;
+    Write(defaults, settings);
+    return defaults;
   }
 
   // Every member into its field.
@@ -96,13 +124,19 @@ class SettingsTable {
           [&](auto member) -> double {
             using Value = std::decay_t<decltype(config.*member)>;
             // The constructor allows ranges on numbers only.
-            if constexpr (std::is_arithmetic_v<Value>) return config.*member;
+            if constexpr (std::is_arithmetic_v<Value>) {
+              return static_cast<double>(config.*member);
+            }
             return 0.0;
           },
           row.member);
       if (InRange(value, row)) continue;
+      const std::string name = names_ == SettingNames::kFlag
+                                   ? absl::StrCat("--", row.field)
+                                   : absl::StrCat(section_, ".", row.field);
       return absl::InvalidArgumentError(
-          absl::StrCat(section_, ".", row.field, " must be ", Range(row)));
+          absl::StrCat(name, " must be ", Range(row),
+                       *row.note == '\0' ? "" : " ", row.note));
     }
     return absl::OkStatus();
   }
@@ -113,9 +147,31 @@ class SettingsTable {
     return settings.GetDescriptor()->FindFieldByName(row.field);
   }
 
+  template <typename Value>
+  static bool IsNumber(Value Config::*) {
+    return std::is_arithmetic_v<Value> && !std::is_same_v<Value, bool>;
+  }
+
   static void Get(const google::protobuf::Message& m,
                   const google::protobuf::FieldDescriptor& f, int& out) {
     out = m.GetReflection()->GetInt32(m, &f);
+  }
+  static void Get(const google::protobuf::Message& m,
+                  const google::protobuf::FieldDescriptor& f, int64_t& out) {
+    out = m.GetReflection()->GetInt64(m, &f);
+  }
+  static void Get(const google::protobuf::Message& m,
+                  const google::protobuf::FieldDescriptor& f, uint64_t& out) {
+    out = m.GetReflection()->GetUInt64(m, &f);
+  }
+  static void Get(const google::protobuf::Message& m,
+                  const google::protobuf::FieldDescriptor& f,
+                  std::vector<int64_t>& out) {
+    const auto* reflection = m.GetReflection();
+    out.clear();
+    for (int i = 0; i < reflection->FieldSize(m, &f); ++i) {
+      out.push_back(reflection->GetRepeatedInt64(m, &f, i));
+    }
   }
   static void Get(const google::protobuf::Message& m,
                   const google::protobuf::FieldDescriptor& f, double& out) {
@@ -133,6 +189,20 @@ class SettingsTable {
   static void Set(int value, const google::protobuf::FieldDescriptor& f,
                   google::protobuf::Message& m) {
     m.GetReflection()->SetInt32(&m, &f, value);
+  }
+  static void Set(int64_t value, const google::protobuf::FieldDescriptor& f,
+                  google::protobuf::Message& m) {
+    m.GetReflection()->SetInt64(&m, &f, value);
+  }
+  static void Set(uint64_t value, const google::protobuf::FieldDescriptor& f,
+                  google::protobuf::Message& m) {
+    m.GetReflection()->SetUInt64(&m, &f, value);
+  }
+  static void Set(const std::vector<int64_t>& values,
+                  const google::protobuf::FieldDescriptor& f,
+                  google::protobuf::Message& m) {
+    m.GetReflection()->ClearField(&m, &f);
+    for (int64_t value : values) m.GetReflection()->AddInt64(&m, &f, value);
   }
   static void Set(double value, const google::protobuf::FieldDescriptor& f,
                   google::protobuf::Message& m) {
@@ -180,9 +250,10 @@ class SettingsTable {
   }
 
   const char* section_;
+  SettingNames names_;
   std::vector<Row> rows_;
 };
 
 }  // namespace vantage
 
-#endif  // VANTAGE_LEARNER_ALGORITHMS_SETTINGS_TABLE_H_
+#endif  // VANTAGE_PROTO_SETTINGS_TABLE_H_
