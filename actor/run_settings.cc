@@ -1,12 +1,87 @@
 #include "actor/run_settings.h"
 
+#include "absl/strings/str_cat.h"
+#include "common/env/frame_stack.h"
+#include "proto/settings_table.h"
+
 namespace vantage {
+namespace {
+
+// The training section's settings of the actor itself (its env streams,
+// --envs, are the run's layout: the distributed or local section decides
+// them), of its environments' wrapping and of its policy network (the torso
+// is a name, read below).
+const SettingsTable<ActorConfig, pb::TrainingSettings>& ActorTable() {
+  using C = ActorConfig;
+  static const auto* table =
+      new SettingsTable<ActorConfig, pb::TrainingSettings>(
+          "training",
+          {{"env", &C::env},
+           {"seed", &C::seed},
+           {"segment_length", &C::segment_length}},
+          SettingNames::kFlag);
+  return *table;
+}
+
+const SettingsTable<EnvOptions, pb::TrainingSettings>& EnvOptionsTable() {
+  using C = EnvOptions;
+  static const auto* table =
+      new SettingsTable<EnvOptions, pb::TrainingSettings>(
+          "training",
+          {{"frame_stack", &C::frame_stack, AtLeast(1),
+            AtMost(kMaxFrameStack)}},
+          SettingNames::kFlag);
+  return *table;
+}
+
+const SettingsTable<NetworkConfig, pb::TrainingSettings>& NetworkTable() {
+  using C = NetworkConfig;
+  static const auto* table =
+      new SettingsTable<NetworkConfig, pb::TrainingSettings>(
+          "training",
+          {{"hidden", &C::hidden}, {"shared_torso", &C::shared_torso}},
+          SettingNames::kFlag);
+  return *table;
+}
+
+absl::Status Invalid(absl::string_view flag, absl::string_view rule) {
+  return absl::InvalidArgumentError(absl::StrCat("--", flag, " ", rule));
+}
+
+// The torso by name; the hidden sizes positive.
+absl::Status ResolveNetwork(pb::TrainingSettings& training) {
+  absl::StatusOr<NetworkConfig> network =
+      NetworkTable().Resolve(NetworkConfig(), training);
+  if (!network.ok()) return network.status();
+  for (int64_t h : network->hidden) {
+    if (h < 1) return Invalid("hidden", "sizes must be >= 1");
+  }
+  if (!training.has_torso()) training.set_torso(TorsoName(network->torso));
+  if (!ParseTorso(training.torso()).ok()) {
+    return Invalid("torso", absl::StrCat("'", training.torso(),
+                                         "' is not one of auto, mlp, minatar, "
+                                         "nature"));
+  }
+  return absl::OkStatus();
+}
+
+}  // namespace
+
+absl::Status ResolveActorSettings(const ActorConfig& defaults,
+                                  pb::TrainingSettings& training) {
+  if (absl::Status status = ActorTable().Resolve(defaults, training).status();
+      !status.ok()) {
+    return status;
+  }
+  if (absl::Status status = ResolveNetwork(training); !status.ok()) {
+    return status;
+  }
+  return EnvOptionsTable().Resolve(EnvOptions(), training).status();
+}
 
 EnvOptions EnvOptionsOf(const pb::RunConfig& run) {
   EnvOptions options;
-  if (run.training().has_frame_stack()) {
-    options.frame_stack = run.training().frame_stack();
-  }
+  EnvOptionsTable().Read(run.training(), options);
   options.python_kwargs = run.training().env_kwargs();
   return options;
 }
@@ -14,25 +89,20 @@ EnvOptions EnvOptionsOf(const pb::RunConfig& run) {
 absl::StatusOr<NetworkConfig> PolicyNetworkOf(const pb::RunConfig& run) {
   const pb::TrainingSettings& training = run.training();
   NetworkConfig network;
-  network.hidden.assign(training.hidden().begin(), training.hidden().end());
+  NetworkTable().Read(training, network);
   absl::StatusOr<Torso> torso =
       ParseTorso(training.has_torso() ? training.torso() : "mlp");
   if (!torso.ok()) return torso.status();
   network.torso = *torso;
-  network.shared_torso = training.shared_torso();
   return network;
 }
 
 absl::StatusOr<ActorConfig> ActorConfigOf(const pb::RunConfig& run) {
   const pb::TrainingSettings& training = run.training();
   ActorConfig actor;
-  actor.env = training.env();
+  ActorTable().Read(training, actor);
   actor.env_options = EnvOptionsOf(run);
   if (training.has_envs()) actor.num_envs = training.envs();
-  if (training.has_segment_length()) {
-    actor.segment_length = training.segment_length();
-  }
-  actor.seed = training.seed();
   absl::StatusOr<NetworkConfig> network = PolicyNetworkOf(run);
   if (!network.ok()) return network.status();
   actor.network = *std::move(network);

@@ -15,6 +15,13 @@
 
 namespace vantage {
 
+// The training section with the actor's settings resolved: absent ones
+// given `defaults`' values (the network's and wrapping's are their
+// components' own), each checked (the message names the flag). Its
+// tables are in run_settings.cc.
+absl::Status ResolveActorSettings(const ActorConfig& defaults,
+                                  pb::TrainingSettings& training);
+
 // The run's environment wrapping (a config from before frame stacking
 // existed stacks none).
 EnvOptions EnvOptionsOf(const pb::RunConfig& run);

@@ -17,6 +17,7 @@
 #include "deploy/run/run_plan.h"
 #include "learner/algorithms/algorithm_config.h"
 #include "learner/exploration/ex2_config.h"
+#include "learner/learner_settings.h"
 #include "learner/run/recording_config.h"
 #include "proto/flat_run_config.pb.h"
 
@@ -134,74 +135,33 @@ absl::StatusOr<pb::RunConfig> FromFlat(const pb::FlatRunConfig& flat) {
   return c;
 }
 
-// The training section's defaults and rules, given the algorithm's.
+// The training section: the learner's settings, then the actor's (whose
+// segments default to a divisor of the horizon); --envs only checked here,
+// since the run's layout (distributed or local) decides it.
 absl::Status ResolveTraining(const AlgorithmConfig& algorithm,
                              const AlgorithmRunDefaults& run_defaults,
                              pb::TrainingSettings& t) {
-  const ActorConfig actor;
-  const LearnerConfig learner;
-  if (!t.has_env()) t.set_env(kDefaultEnv);
-  if (!t.has_seed()) t.set_seed(actor.seed);
-  if (!t.has_steps()) t.set_steps(kDefaultSteps);
-  if (t.steps() < 1) return Invalid("steps", "must be >= 1");
+  LearnerConfig learner;
+  learner.total_env_steps = kDefaultSteps;
+  if (absl::Status status =
+          ResolveLearnerTraining(learner, run_defaults, algorithm.name, t);
+      !status.ok()) {
+    return status;
+  }
   if (t.has_envs() && (t.envs() < 1 || t.envs() > 4096)) {
     return Invalid("envs", "must be in [1, 4096]");
   }
-  if (!t.has_horizon()) t.set_horizon(run_defaults.horizon);
-  if (t.horizon() < 1) return Invalid("horizon", "must be >= 1");
-  if (run_defaults.fixes_horizon && t.horizon() != run_defaults.horizon) {
-    return Invalid(
-        "horizon",
-        absl::StrCat("is ", t.horizon(), " but ", algorithm.name,
-                     "'s own settings make it ", run_defaults.horizon,
-                     "; change those (see `vantage help train`)"));
-  }
-  if (t.hidden_size() == 0) {
-    for (int64_t h : actor.network.hidden) t.add_hidden(h);
-  }
-  for (int64_t h : t.hidden()) {
-    if (h < 1) return Invalid("hidden", "sizes must be >= 1");
-  }
-  if (!t.has_torso()) t.set_torso(TorsoName(actor.network.torso));
-  if (!ParseTorso(t.torso()).ok()) {
-    return Invalid("torso", absl::StrCat("'", t.torso(),
-                                         "' is not one of auto, mlp, minatar, "
-                                         "nature"));
-  }
   // Whether the algorithm can share a torso is the learner's rule, checked
   // with the others once the config is whole.
-  if (!t.has_shared_torso()) t.set_shared_torso(actor.network.shared_torso);
-  if (!t.has_frame_stack()) t.set_frame_stack(actor.env_options.frame_stack);
-  if (t.frame_stack() < 1 || t.frame_stack() > kMaxFrameStack) {
-    return Invalid("frame_stack",
-                   absl::StrCat("must be in [1, ", kMaxFrameStack, "]"));
-  }
-  if (!t.has_scale_rewards()) t.set_scale_rewards(learner.scale_rewards);
-  if (!t.has_segment_length()) {
-    t.set_segment_length(DefaultSegmentLength(t.horizon()));
+  ActorConfig actor;
+  actor.env = kDefaultEnv;
+  actor.segment_length = DefaultSegmentLength(t.horizon());
+  if (absl::Status status = ResolveActorSettings(actor, t); !status.ok()) {
+    return status;
   }
   if (t.segment_length() < 1 || t.segment_length() > t.horizon()) {
     return Invalid("segment_length", "must be in [1, --horizon]");
   }
-  return absl::OkStatus();
-}
-
-// The advantage section's defaults (its rules are the estimator's own,
-// checked once the whole config is resolved).
-absl::Status ResolveAdvantage(const AlgorithmRunDefaults& run_defaults,
-                              pb::AdvantageSettings& a) {
-  const AdvantageConfig advantage;
-  if (!a.has_estimator()) a.set_estimator(StatisticName(advantage.statistic));
-  absl::StatusOr<Statistic> statistic = ParseStatistic(a.estimator());
-  if (!statistic.ok()) {
-    return Invalid("estimator:", statistic.status().message());
-  }
-  if (!a.has_rho()) a.set_rho(advantage.rho);
-  if (a.ensemble_size() == 0) {
-    for (int64_t k : advantage.ensemble) a.add_ensemble(k);
-  }
-  if (!a.has_gamma()) a.set_gamma(advantage.gamma);
-  if (!a.has_gae_lambda()) a.set_gae_lambda(run_defaults.gae_lambda);
   return absl::OkStatus();
 }
 
@@ -253,7 +213,7 @@ absl::StatusOr<pb::RunConfig> ResolveRunConfig(const pb::RunConfig& given) {
     return status;
   }
   if (absl::Status status =
-          ResolveAdvantage(run_defaults, *c.mutable_advantage());
+          ResolveAdvantageSettings(run_defaults, *c.mutable_advantage());
       !status.ok()) {
     return status;
   }
