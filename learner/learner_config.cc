@@ -52,11 +52,13 @@ absl::Status LearnerConfig::ValidateSettings() const {
       return status;
     }
   }
-  if (algorithm.name == "a2c" &&
-      horizon % algorithm.a2c.steps_per_minibatch != 0) {
-    return absl::InvalidArgumentError(absl::StrCat(
-        "a2c needs a horizon that is a multiple of its ",
-        algorithm.a2c.steps_per_minibatch, "-step minibatches; got ", horizon));
+  const int64_t multiple = RunDefaultsOf(algorithm).horizon_multiple;
+  if (multiple > 1 && horizon % multiple != 0) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(algorithm.name,
+                     " needs a horizon that is a multiple of "
+                     "its ",
+                     multiple, "-step minibatches; got ", horizon));
   }
   return absl::OkStatus();
 }

@@ -109,7 +109,7 @@ void DescribeTrainBench(const ResolvedRun& run, const EnvSpec& spec,
   bench.a2c = AlgorithmNameOf(config) == "a2c";
   bench.spec = spec;
   bench.network = run.plan.learner.network;
-  bench.a2c_config = run.plan.learner.algorithm.a2c;
+  bench.a2c_config = run.plan.learner.algorithm.Get<A2cConfig>();
   bench.streams = config.training().envs();
 }
 

@@ -15,6 +15,7 @@
 #include "common/env/frame_stack.h"
 #include "deploy/run/distributed_config.h"
 #include "deploy/run/run_plan.h"
+#include "learner/algorithms/a2c/a2c_config.h"
 #include "learner/algorithms/algorithm_config.h"
 #include "learner/exploration/ex2_config.h"
 #include "learner/learner_settings.h"

@@ -27,32 +27,31 @@ struct Algorithm {
   bool one_optimizer = false;
 };
 
-// An algorithm whose config is AlgorithmConfig::*member, whose settings are
-// the run config's section `get`/`set`, and whose config header declares
-// Validate(), RunDefaults(), FromSettings() and ToSettings().
+// An algorithm whose updater is Updater, whose config is Config and whose
+// settings are the run config's section `get`/`set`; its config header
+// declares Validate(), RunDefaults(), FromSettings() and ToSettings().
 template <typename Updater, typename Config, typename Settings>
-Algorithm Entry(Config AlgorithmConfig::*member,
-                const Settings& (pb::RunConfig::*get)() const,
+Algorithm Entry(const Settings& (pb::RunConfig::*get)() const,
                 Settings* (pb::RunConfig::*set)()) {
   Algorithm algorithm;
   algorithm.read = [=](const pb::RunConfig& run, AlgorithmConfig& config) {
-    config.*member = FromSettings((run.*get)());
+    config.Mutable<Config>() = FromSettings((run.*get)());
   };
   algorithm.write = [=](const AlgorithmConfig& config, pb::RunConfig& run) {
-    ToSettings(config.*member, *(run.*set)());
+    ToSettings(config.Get<Config>(), *(run.*set)());
   };
   algorithm.run_defaults = [=](const AlgorithmConfig& config) {
-    return RunDefaults(config.*member);
+    return RunDefaults(config.Get<Config>());
   };
   algorithm.validate = [=](const AlgorithmConfig& config) {
-    return (config.*member).Validate();
+    return config.Get<Config>().Validate();
   };
   algorithm.make = [=](const AlgorithmConfig& config, PolicyNetwork policy,
                        ValueNetwork value,
                        std::shared_ptr<ReplicaGroup> replicas)
       -> std::unique_ptr<PolicyUpdater> {
     return std::make_unique<Updater>(std::move(policy), std::move(value),
-                                     config.*member, std::move(replicas));
+                                     config.Get<Config>(), std::move(replicas));
   };
   algorithm.one_optimizer = Updater::kOneOptimizer;
   return algorithm;
@@ -61,12 +60,12 @@ Algorithm Entry(Config AlgorithmConfig::*member,
 // The name is also the run config's field of the algorithm's settings.
 const std::map<std::string, Algorithm>& Algorithms() {
   static const auto* algorithms = new std::map<std::string, Algorithm>{
-      {"a2c", Entry<A2cUpdater>(&AlgorithmConfig::a2c, &pb::RunConfig::a2c,
-                                &pb::RunConfig::mutable_a2c)},
-      {"ppo", Entry<PpoUpdater>(&AlgorithmConfig::ppo, &pb::RunConfig::ppo,
-                                &pb::RunConfig::mutable_ppo)},
-      {"trpo", Entry<TrpoUpdater>(&AlgorithmConfig::trpo, &pb::RunConfig::trpo,
-                                  &pb::RunConfig::mutable_trpo)},
+      {"a2c", Entry<A2cUpdater, A2cConfig>(&pb::RunConfig::a2c,
+                                           &pb::RunConfig::mutable_a2c)},
+      {"ppo", Entry<PpoUpdater, PpoConfig>(&pb::RunConfig::ppo,
+                                           &pb::RunConfig::mutable_ppo)},
+      {"trpo", Entry<TrpoUpdater, TrpoConfig>(&pb::RunConfig::trpo,
+                                              &pb::RunConfig::mutable_trpo)},
   };
   return *algorithms;
 }

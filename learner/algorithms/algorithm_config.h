@@ -4,30 +4,50 @@
 // The algorithms' settings and how a run config names them, without
 // LibTorch (the updaters are in learner/algorithms/algorithm.h).
 
+#include <any>
+#include <map>
 #include <string>
+#include <typeindex>
 #include <vector>
 
 #include "absl/status/status.h"
-#include "learner/algorithms/a2c/a2c_config.h"
-#include "learner/algorithms/ppo/ppo_config.h"
 #include "learner/algorithms/run_defaults.h"
-#include "learner/algorithms/trpo/trpo_config.h"
 
 namespace vantage {
 namespace pb {
 class RunConfig;
 }  // namespace pb
 
-// Which algorithm updates the networks, with every algorithm's settings
-// (only the named one's are used).
+// Which algorithm updates the networks, with the settings of any algorithm
+// (only the named one's are used). Each algorithm's config is its
+// folder's type (PpoConfig, A2cConfig, ...), kept by type, so that a new
+// algorithm adds no member here.
 struct AlgorithmConfig {
   std::string name = "ppo";  // see AlgorithmNames()
-  PpoConfig ppo;
-  A2cConfig a2c;
-  TrpoConfig trpo;
+
+  // The settings of the algorithm whose config is `Config`: its defaults
+  // until set.
+  template <typename Config>
+  const Config& Get() const {
+    const auto found = settings_.find(typeid(Config));
+    if (found == settings_.end()) {
+      static const Config defaults;
+      return defaults;
+    }
+    return std::any_cast<const Config&>(found->second);
+  }
+  template <typename Config>
+  Config& Mutable() {
+    std::any& settings = settings_[typeid(Config)];
+    if (!settings.has_value()) settings = Config();
+    return std::any_cast<Config&>(settings);
+  }
 
   // An unknown name lists the valid ones.
   absl::Status Validate() const;
+
+ private:
+  std::map<std::type_index, std::any> settings_;
 };
 
 std::vector<std::string> AlgorithmNames();

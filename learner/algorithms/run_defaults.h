@@ -13,6 +13,9 @@ struct AlgorithmRunDefaults {
   // The algorithm's own settings fix the horizon (A2C's n minibatches of
   // steps_per_minibatch steps): a run may not choose another one.
   bool fixes_horizon = false;
+  // Its updates split each rollout into minibatches of this many steps
+  // (A2C's), so the horizon must be a multiple of it.
+  int64_t horizon_multiple = 1;
 };
 
 }  // namespace vantage

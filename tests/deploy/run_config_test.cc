@@ -4,6 +4,9 @@
 #include "deploy/run/run_plan.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
+#include "learner/algorithms/a2c/a2c_config.h"
+#include "learner/algorithms/ppo/ppo_config.h"
+#include "learner/algorithms/trpo/trpo_config.h"
 
 namespace vantage {
 namespace {
@@ -176,7 +179,7 @@ TEST(RunConfigTest, ThePlanGivesActorAndLearnerTheSameRun) {
   EXPECT_EQ(plan->learner.network.hidden, std::vector<int64_t>{8});
   EXPECT_EQ(plan->actor.observation_clip, plan->learner.observation_clip);
   EXPECT_EQ(plan->learner.algorithm.name, "trpo");
-  EXPECT_EQ(plan->learner.algorithm.trpo.max_kl, 0.02);
+  EXPECT_EQ(plan->learner.algorithm.Get<TrpoConfig>().max_kl, 0.02);
   EXPECT_EQ(plan->learner.advantage.lambda, 0.98);  // TRPO's own default
   EXPECT_EQ(plan->recording.keep_checkpoints, 5);
   EXPECT_EQ(plan->recording.config_json, RunConfigToJson(*config));

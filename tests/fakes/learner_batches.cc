@@ -3,6 +3,7 @@
 #include <ATen/ATen.h>
 
 #include "gtest/gtest.h"
+#include "learner/algorithms/ppo/ppo_config.h"
 
 namespace vantage {
 
@@ -20,8 +21,8 @@ LearnerConfig TestLearnerConfig(const EnvSpec& spec,
   config.advantage.statistic = *ParseStatistic("maxabs");
   config.advantage.rho = 0.5;
   config.algorithm.name = algorithm;
-  config.algorithm.ppo.minibatches = 4;
-  config.algorithm.ppo.epochs = 2;
+  config.algorithm.Mutable<PpoConfig>().minibatches = 4;
+  config.algorithm.Mutable<PpoConfig>().epochs = 2;
   return config;
 }
 

@@ -9,6 +9,8 @@
 #include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
 #include "common/rollout/segment_queue.h"
+#include "learner/algorithms/a2c/a2c_config.h"
+#include "learner/algorithms/ppo/ppo_config.h"
 #include "learner/checkpoint/checkpoint.h"
 
 namespace vantage {
@@ -48,9 +50,9 @@ LearnerConfig FuzzLearnerConfig(const std::string& algorithm) {
   config.advantage.ensemble = {1, 4};
   config.advantage.rho = 0.5;
   config.algorithm.name = algorithm;
-  config.algorithm.ppo.minibatches = 2;
-  config.algorithm.ppo.epochs = 1;
-  config.algorithm.a2c.n = 2;
+  config.algorithm.Mutable<PpoConfig>().minibatches = 2;
+  config.algorithm.Mutable<PpoConfig>().epochs = 1;
+  config.algorithm.Mutable<A2cConfig>().n = 2;
   return config;
 }
 

@@ -349,5 +349,18 @@ TEST(LearnerConfigTest, RefusesBadLimits) {
               HasSubstr("max_buffered_steps must be >= 0"));
 }
 
+// An algorithm whose minibatches are slices of a rollout (A2C's) says so
+// through its run defaults; the learner holds the horizon to them.
+TEST(LearnerConfigTest, A2csHorizonIsWholeMinibatches) {
+  auto actor = MakeTestActor();
+  LearnerConfig config = TestLearnerConfig(actor->spec(), "a2c");
+  config.horizon = 12;
+  EXPECT_EQ(config.Validate().message(),
+            "a2c needs a horizon that is a multiple of its 5-step "
+            "minibatches; got 12");
+  config.horizon = 15;
+  EXPECT_TRUE(config.Validate().ok()) << config.Validate();
+}
+
 }  // namespace
 }  // namespace vantage

@@ -45,6 +45,7 @@ AlgorithmRunDefaults RunDefaults(const A2cConfig& config) {
   defaults.horizon = config.horizon();
   defaults.gae_lambda = 1.0;
   defaults.fixes_horizon = true;
+  defaults.horizon_multiple = config.steps_per_minibatch;
   return defaults;
 }
 

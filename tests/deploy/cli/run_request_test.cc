@@ -15,6 +15,7 @@
 #include "deploy/run/run_config.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
+#include "learner/algorithms/ppo/ppo_config.h"
 #include "learner/run/run_directory.h"
 #include "tests/deploy/cli/run_vantage.h"
 
@@ -85,7 +86,7 @@ TEST(RunRequestTest, TheAlgorithmIsChosenOnce) {
   EXPECT_EQ(switched->config.ppo().epochs(), 3);
   EXPECT_EQ(switched->config.training().seed(), 4);
   EXPECT_EQ(switched->config.training().horizon(), 2048);
-  EXPECT_EQ(switched->plan.learner.algorithm.ppo.epochs, 3);
+  EXPECT_EQ(switched->plan.learner.algorithm.Get<PpoConfig>().epochs, 3);
 }
 
 // --exploration=ex2 selects EX2 with its defaults, the --ex2_ flags

@@ -8,6 +8,9 @@
 
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
+#include "learner/algorithms/a2c/a2c_config.h"
+#include "learner/algorithms/ppo/ppo_config.h"
+#include "learner/algorithms/trpo/trpo_config.h"
 #include "proto/run_config.pb.h"
 #include "proto/settings_table.h"
 
@@ -50,27 +53,28 @@ TEST(AlgorithmTest, AbsentSettingsAreTheStructDefaults) {
   pb::RunConfig run;
   AlgorithmConfig ppo = AlgorithmConfigOf(run);
   EXPECT_EQ(ppo.name, "ppo");
-  EXPECT_EQ(ppo.ppo.minibatches, PpoConfig().minibatches);
+  EXPECT_EQ(ppo.Get<PpoConfig>().minibatches, PpoConfig().minibatches);
   ASSERT_TRUE(SelectAlgorithm("a2c", run).ok());
   run.mutable_a2c()->set_learning_rate(1e-3);
   AlgorithmConfig a2c = AlgorithmConfigOf(run);
   EXPECT_EQ(a2c.name, "a2c");
-  EXPECT_EQ(a2c.a2c.n, A2cConfig().n);
-  EXPECT_EQ(a2c.a2c.learning_rate, 1e-3);
+  EXPECT_EQ(a2c.Get<A2cConfig>().n, A2cConfig().n);
+  EXPECT_EQ(a2c.Get<A2cConfig>().learning_rate, 1e-3);
   pb::RunConfig written;
   SetAlgorithmSettings(a2c, written);
   EXPECT_TRUE(written.a2c().has_n());
   EXPECT_TRUE(written.a2c().has_entropy_coef());
   const AlgorithmConfig again = AlgorithmConfigOf(written);
-  EXPECT_EQ(again.a2c.n, a2c.a2c.n);
-  EXPECT_EQ(again.a2c.learning_rate, 1e-3);
+  EXPECT_EQ(again.Get<A2cConfig>().n, a2c.Get<A2cConfig>().n);
+  EXPECT_EQ(again.Get<A2cConfig>().learning_rate, 1e-3);
 
   run.Clear();
   ASSERT_TRUE(SelectAlgorithm("trpo", run).ok());
   run.mutable_trpo()->set_max_kl(0.05);
   const AlgorithmConfig trpo = AlgorithmConfigOf(run);
-  EXPECT_EQ(trpo.trpo.max_kl, 0.05);
-  EXPECT_EQ(trpo.trpo.value_learning_rate, TrpoConfig().value_learning_rate);
+  EXPECT_EQ(trpo.Get<TrpoConfig>().max_kl, 0.05);
+  EXPECT_EQ(trpo.Get<TrpoConfig>().value_learning_rate,
+            TrpoConfig().value_learning_rate);
 }
 
 TEST(AlgorithmTest, RunDefaultsAreTheBaselines) {
@@ -79,7 +83,7 @@ TEST(AlgorithmTest, RunDefaultsAreTheBaselines) {
   EXPECT_EQ(RunDefaultsOf(config).gae_lambda, 0.95);
   EXPECT_FALSE(RunDefaultsOf(config).fixes_horizon);
   config.name = "a2c";
-  config.a2c.n = 7;
+  config.Mutable<A2cConfig>().n = 7;
   EXPECT_EQ(RunDefaultsOf(config).horizon, 35);
   EXPECT_EQ(RunDefaultsOf(config).gae_lambda, 1.0);
   EXPECT_TRUE(RunDefaultsOf(config).fixes_horizon);
@@ -90,11 +94,11 @@ TEST(AlgorithmTest, RunDefaultsAreTheBaselines) {
 
 TEST(AlgorithmTest, ValidationNamesTheField) {
   AlgorithmConfig config;
-  config.ppo.epochs = 0;
+  config.Mutable<PpoConfig>().epochs = 0;
   EXPECT_EQ(config.Validate().message(), "ppo.epochs must be >= 1");
   config.name = "trpo";  // the ppo settings are not its business
   EXPECT_TRUE(config.Validate().ok());
-  config.trpo.max_kl = -1;
+  config.Mutable<TrpoConfig>().max_kl = -1;
   EXPECT_EQ(config.Validate().message(), "trpo.max_kl must be > 0");
 }
 
@@ -117,21 +121,21 @@ TEST(AlgorithmTest, EverySettingIsWrittenAndRangeChecked) {
         << name << " leaves fields unwritten";
   }
   AlgorithmConfig config;
-  config.ppo.clip = 1;
+  config.Mutable<PpoConfig>().clip = 1;
   EXPECT_EQ(config.Validate().message(), "ppo.clip must be in (0, 1)");
-  config.ppo.clip = 0.999;
+  config.Mutable<PpoConfig>().clip = 0.999;
   EXPECT_TRUE(config.Validate().ok());
-  config.ppo.entropy_coef = std::nan("");
+  config.Mutable<PpoConfig>().entropy_coef = std::nan("");
   EXPECT_EQ(config.Validate().message(), "ppo.entropy_coef must be >= 0");
   config.name = "a2c";
-  config.a2c.rmsprop_alpha = 0;
+  config.Mutable<A2cConfig>().rmsprop_alpha = 0;
   EXPECT_EQ(config.Validate().message(), "a2c.rmsprop_alpha must be in (0, 1)");
-  config.a2c.rmsprop_alpha = 0.5;
-  config.a2c.rmsprop = "adam";
+  config.Mutable<A2cConfig>().rmsprop_alpha = 0.5;
+  config.Mutable<A2cConfig>().rmsprop = "adam";
   EXPECT_THAT(std::string(config.Validate().message()),
               HasSubstr("a2c.rmsprop must be tensorflow or pytorch"));
   config.name = "trpo";
-  config.trpo.cg_damping = -0.1;
+  config.Mutable<TrpoConfig>().cg_damping = -0.1;
   EXPECT_EQ(config.Validate().message(), "trpo.cg_damping must be >= 0");
 }
 

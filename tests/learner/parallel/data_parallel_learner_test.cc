@@ -15,6 +15,8 @@
 #include "absl/strings/str_cat.h"
 #include "common/net/loopback_port.h"
 #include "gtest/gtest.h"
+#include "learner/algorithms/ppo/ppo_config.h"
+#include "learner/algorithms/trpo/trpo_config.h"
 #include "learner/learner_core.h"
 #include "learner/parallel/gloo_replica_group.h"
 #include "learner/parallel/replica_reductions.h"
@@ -151,9 +153,10 @@ LearnerConfig SplittableConfig(const EnvSpec& spec,
                                const std::string& algorithm) {
   LearnerConfig config = TestLearnerConfig(spec, algorithm);
   config.advantage.rho = 1.0;
-  config.algorithm.ppo.minibatches = 1;
-  config.algorithm.ppo.epochs = 3;
-  config.algorithm.trpo.value_minibatch_size = kTestHorizon * kTestEnvs;
+  config.algorithm.Mutable<PpoConfig>().minibatches = 1;
+  config.algorithm.Mutable<PpoConfig>().epochs = 3;
+  config.algorithm.Mutable<TrpoConfig>().value_minibatch_size =
+      kTestHorizon * kTestEnvs;
   return config;
 }
 
