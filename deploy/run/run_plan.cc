@@ -2,7 +2,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "actor/run_settings.h"
-#include "deploy/run/run_config.h"
+#include "deploy/run/run_config_file.h"
 #include "learner/learner_settings.h"
 
 namespace vantage {
