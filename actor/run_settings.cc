@@ -44,23 +44,20 @@ const SettingsTable<NetworkConfig, pb::TrainingSettings>& NetworkTable() {
   return *table;
 }
 
-absl::Status Invalid(absl::string_view flag, absl::string_view rule) {
-  return absl::InvalidArgumentError(absl::StrCat("--", flag, " ", rule));
-}
-
 // The torso by name; the hidden sizes positive.
 absl::Status ResolveNetwork(pb::TrainingSettings& training) {
   absl::StatusOr<NetworkConfig> network =
       NetworkTable().Resolve(NetworkConfig(), training);
   if (!network.ok()) return network.status();
   for (int64_t h : network->hidden) {
-    if (h < 1) return Invalid("hidden", "sizes must be >= 1");
+    if (h < 1) return FlagError("hidden", "sizes must be >= 1");
   }
   if (!training.has_torso()) training.set_torso(TorsoName(network->torso));
   if (!ParseTorso(training.torso()).ok()) {
-    return Invalid("torso", absl::StrCat("'", training.torso(),
-                                         "' is not one of auto, mlp, minatar, "
-                                         "nature"));
+    return FlagError("torso",
+                     absl::StrCat("'", training.torso(),
+                                  "' is not one of auto, mlp, minatar, "
+                                  "nature"));
   }
   return absl::OkStatus();
 }

@@ -24,6 +24,7 @@
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
 #include "absl/strings/str_cat.h"
+#include "absl/strings/string_view.h"
 
 namespace vantage {
 
@@ -37,6 +38,13 @@ inline SettingBound AtLeast(double value) { return {value, true}; }
 inline SettingBound Above(double value) { return {value, false}; }
 inline SettingBound Below(double value) { return {value, false}; }
 inline SettingBound AtMost(double value) { return {value, true}; }
+
+// A rule that a setting breaks, named by its flag, as the tables' own
+// messages name them ("--envs must be in [1, 4096]"): for the rules a table
+// cannot state (those across settings).
+inline absl::Status FlagError(absl::string_view flag, absl::string_view rule) {
+  return absl::InvalidArgumentError(absl::StrCat("--", flag, " ", rule));
+}
 
 // How a table's messages name a setting: by its section and field, as an
 // algorithm's settings are named ("ppo.clip must be in (0, 1)"), or by the

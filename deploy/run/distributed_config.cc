@@ -26,10 +26,6 @@ DistributedTable() {
   return *table;
 }
 
-absl::Status Invalid(absl::string_view flag, absl::string_view rule) {
-  return absl::InvalidArgumentError(absl::StrCat("--", flag, " ", rule));
-}
-
 // The defaults that depend on what else was given: two actor processes,
 // over which a batch given as --envs alone is split (over one actor if it
 // does not split evenly); an asynchronous run's policy lag.
@@ -60,30 +56,30 @@ absl::Status CheckLayout(pb::TrainingSettings& t,
   // At most 256 x 4096: the product fits an int32.
   const int32_t streams = d.actors() * d.envs_per_actor();
   if (streams > 4096) {
-    return Invalid("envs_per_actor",
-                   absl::StrCat("makes --actors x --envs_per_actor = ", streams,
-                                " streams, more than 4096"));
+    return FlagError("envs_per_actor",
+                     absl::StrCat("makes --actors x --envs_per_actor = ",
+                                  streams, " streams, more than 4096"));
   }
   // The learner's batch holds one rollout per actor environment.
   if (t.has_envs() && t.envs() != streams) {
-    return Invalid("envs",
-                   absl::StrCat("is the learner's batch of --actors x "
-                                "--envs_per_actor = ",
-                                streams, " streams in a distributed run"));
+    return FlagError("envs",
+                     absl::StrCat("is the learner's batch of --actors x "
+                                  "--envs_per_actor = ",
+                                  streams, " streams in a distributed run"));
   }
   t.set_envs(streams);
   if (d.sync() && d.max_policy_lag() != 0) {
-    return Invalid("max_policy_lag", "must be 0 with --sync");
+    return FlagError("max_policy_lag", "must be 0 with --sync");
   }
   if (d.actors() % d.learners() != 0) {
-    return Invalid("learners",
-                   absl::StrCat("must divide --actors (", d.actors(),
-                                "): every learner serves as many actors"));
+    return FlagError("learners",
+                     absl::StrCat("must divide --actors (", d.actors(),
+                                  "): every learner serves as many actors"));
   }
   if (d.sync() && t.horizon() % t.segment_length() != 0) {
-    return Invalid("segment_length",
-                   "must divide --horizon in a --sync run (each actor sends "
-                   "exactly one horizon per policy version)");
+    return FlagError("segment_length",
+                     "must divide --horizon in a --sync run (each actor sends "
+                     "exactly one horizon per policy version)");
   }
   return absl::OkStatus();
 }

@@ -10,13 +10,10 @@
 #include "learner/exploration/ex2_config.h"
 #include "learner/learner_settings.h"
 #include "learner/run/recording_config.h"
+#include "proto/settings_table.h"
 
 namespace vantage {
 namespace {
-
-absl::Status Invalid(absl::string_view flag, absl::string_view rule) {
-  return absl::InvalidArgumentError(absl::StrCat("--", flag, " ", rule));
-}
 
 // An algorithm's or exploration method's rule names its field
 // ("ppo.epochs must be >= 1"); the message adds the field's flag
@@ -62,7 +59,7 @@ absl::Status ResolveTraining(const AlgorithmConfig& algorithm,
     return status;
   }
   if (t.has_envs() && (t.envs() < 1 || t.envs() > 4096)) {
-    return Invalid("envs", "must be in [1, 4096]");
+    return FlagError("envs", "must be in [1, 4096]");
   }
   // Whether the algorithm can share a torso is the learner's rule, checked
   // with the others once the config is whole.
@@ -73,7 +70,7 @@ absl::Status ResolveTraining(const AlgorithmConfig& algorithm,
     return status;
   }
   if (t.segment_length() < 1 || t.segment_length() > t.horizon()) {
-    return Invalid("segment_length", "must be in [1, --horizon]");
+    return FlagError("segment_length", "must be in [1, --horizon]");
   }
   return absl::OkStatus();
 }
@@ -89,9 +86,9 @@ absl::Status ResolveLocal(pb::RunConfig& c) {
   pb::TrainingSettings& t = *c.mutable_training();
   if (!t.has_envs()) t.set_envs(ActorConfig().num_envs);
   if (t.horizon() % t.segment_length() != 0) {
-    return Invalid("segment_length",
-                   "must divide --horizon in a local run (its actor sends "
-                   "each rollout as whole segments)");
+    return FlagError("segment_length",
+                     "must divide --horizon in a local run (its actor sends "
+                     "each rollout as whole segments)");
   }
   return absl::OkStatus();
 }
@@ -103,8 +100,8 @@ absl::StatusOr<pb::RunConfig> ResolveRunConfig(const pb::RunConfig& given) {
   // The main job is the distributed one; --mode=local keeps one process.
   if (!c.has_mode()) c.set_mode("distributed");
   if (c.mode() != "local" && c.mode() != "distributed") {
-    return Invalid("mode:", absl::StrCat("unknown mode '", c.mode(),
-                                         "'; available: local, distributed"));
+    return FlagError("mode:", absl::StrCat("unknown mode '", c.mode(),
+                                           "'; available: local, distributed"));
   }
   AlgorithmConfig algorithm = AlgorithmConfigOf(c);
   if (absl::Status status = algorithm.Validate(); !status.ok()) {
