@@ -3,8 +3,31 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_join.h"
 #include "proto/run_config.pb.h"
+#include "proto/settings_table.h"
 
 namespace vantage {
+namespace {
+
+// EX2's settings, each read from and written to its field; their ranges are
+// Validate()'s below, whose messages name the value given.
+const SettingsTable<Ex2Config, pb::Ex2Settings>& Ex2Table() {
+  using C = Ex2Config;
+  static const auto* table = new SettingsTable<Ex2Config, pb::Ex2Settings>(
+      "ex2", {{"hidden", &C::hidden},
+              {"feature_dim", &C::feature_dim},
+              {"learning_rate", &C::learning_rate},
+              {"kl_weight", &C::kl_weight},
+              {"bonus_coeff", &C::bonus_coeff},
+              {"train_iterations", &C::train_iterations},
+              {"first_train_iterations", &C::first_train_iterations},
+              {"replay_min", &C::replay_min},
+              {"replay_size", &C::replay_size},
+              {"batch_size", &C::batch_size},
+              {"use_actions", &C::use_actions}});
+  return *table;
+}
+
+}  // namespace
 
 absl::Status Ex2Config::Validate() const {
   if (hidden.empty()) {
@@ -89,38 +112,14 @@ void SetExplorationSettings(const ExplorationConfig& config,
   ToSettings(*config.ex2, *run.mutable_exploration()->mutable_ex2());
 }
 
-Ex2Config FromSettings(const pb::Ex2Settings& s) {
-  Ex2Config c;
-  if (s.hidden_size() > 0)
-    c.hidden.assign(s.hidden().begin(), s.hidden().end());
-  if (s.has_feature_dim()) c.feature_dim = s.feature_dim();
-  if (s.has_learning_rate()) c.learning_rate = s.learning_rate();
-  if (s.has_kl_weight()) c.kl_weight = s.kl_weight();
-  if (s.has_bonus_coeff()) c.bonus_coeff = s.bonus_coeff();
-  if (s.has_train_iterations()) c.train_iterations = s.train_iterations();
-  if (s.has_first_train_iterations()) {
-    c.first_train_iterations = s.first_train_iterations();
-  }
-  if (s.has_replay_min()) c.replay_min = s.replay_min();
-  if (s.has_replay_size()) c.replay_size = s.replay_size();
-  if (s.has_batch_size()) c.batch_size = s.batch_size();
-  if (s.has_use_actions()) c.use_actions = s.use_actions();
-  return c;
+Ex2Config FromSettings(const pb::Ex2Settings& settings) {
+  Ex2Config config;
+  Ex2Table().Read(settings, config);
+  return config;
 }
 
-void ToSettings(const Ex2Config& c, pb::Ex2Settings& s) {
-  s.clear_hidden();
-  for (int64_t h : c.hidden) s.add_hidden(h);
-  s.set_feature_dim(c.feature_dim);
-  s.set_learning_rate(c.learning_rate);
-  s.set_kl_weight(c.kl_weight);
-  s.set_bonus_coeff(c.bonus_coeff);
-  s.set_train_iterations(c.train_iterations);
-  s.set_first_train_iterations(c.first_train_iterations);
-  s.set_replay_min(c.replay_min);
-  s.set_replay_size(c.replay_size);
-  s.set_batch_size(c.batch_size);
-  s.set_use_actions(c.use_actions);
+void ToSettings(const Ex2Config& config, pb::Ex2Settings& settings) {
+  Ex2Table().Write(config, settings);
 }
 
 }  // namespace vantage
