@@ -25,8 +25,8 @@ class OutputArchive;
 
 namespace vantage {
 
-// The state every algorithm works on: the two networks it changes and the
-// data-parallel replicas it averages over.
+// An algorithm's update, and what every algorithm works on: the two
+// networks it changes and the data-parallel replicas it averages over.
 class PolicyUpdater {
  public:
   virtual ~PolicyUpdater() = default;
