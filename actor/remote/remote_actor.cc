@@ -18,6 +18,7 @@
 #include "common/net/grpc_security.h"
 #include "common/net/port_file.h"
 #include "common/util/phase_times.h"
+#include "common/util/split_mix.h"
 #include "proto/vantage.grpc.pb.h"
 #include "proto/wire_format.h"
 
@@ -396,14 +397,7 @@ void SleepUnlessStopped(absl::Duration duration,
 }  // namespace
 
 uint64_t ActorEnvSeed(uint64_t run_seed, int64_t actor_id) {
-  // SplitMix64's output for state run_seed + (id + 1) * its odd increment:
-  // each step a bijection of 64-bit words, so distinct ids never share a
-  // seed, and the seeds scatter far from the launcher's run_seed + i.
-  uint64_t z =
-      run_seed + 0x9E3779B97F4A7C15ULL * (static_cast<uint64_t>(actor_id) + 1);
-  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ULL;
-  z = (z ^ (z >> 27)) * 0x94D049BB133111EBULL;
-  return z ^ (z >> 31);
+  return SplitMixSeed(run_seed, static_cast<uint64_t>(actor_id));
 }
 
 absl::Status RunRemoteActor(const RemoteActorConfig& config,

@@ -21,6 +21,7 @@
 #include "common/net/loopback_port.h"
 #include "common/net/port_file.h"
 #include "common/util/self_process.h"
+#include "common/util/split_mix.h"
 #include "deploy/observe/scrape_targets.h"
 #include "deploy/run/run_config.h"
 #include "learner/algorithms/algorithm_config.h"
@@ -230,7 +231,8 @@ class Supervisor {
         ports_(learner_count_, "0"),
         learners_(learner_count_, -1),
         finished_(learner_count_, false),
-        actors_(actor_count_, -1) {}
+        actors_(actor_count_, -1),
+        actor_lives_(actor_count_, 0) {}
 
   absl::Status Run();
 
@@ -284,6 +286,7 @@ class Supervisor {
   std::vector<pid_t> learners_;
   std::vector<bool> finished_;
   std::vector<pid_t> actors_;
+  std::vector<int> actor_lives_;  // each actor's restarts so far
   int actor_restarts_ = 0;
   int learner_restarts_ = 0;
 };
@@ -355,7 +358,8 @@ absl::StatusOr<pid_t> Supervisor::StartActor(int i) {
       "--env=" + run_.training().env(),
       "--env_kwargs=" + run_.training().env_kwargs(),
       absl::StrCat("--envs=", run_.distributed().envs_per_actor()),
-      absl::StrCat("--seed=", run_.training().seed() + i),
+      absl::StrCat("--seed=",
+                   ActorLifeSeed(run_.training().seed(), i, actor_lives_[i])),
       absl::StrCat("--name=actor-", i)};
   args.insert(args.end(), security_args_.begin(), security_args_.end());
   const std::vector<std::string> metrics_args = metrics_.ActorArgs(i);
@@ -428,8 +432,13 @@ absl::Status Supervisor::OnActorExit(int i, int status) {
                      actor_restarts_, " restarts; giving up"));
   }
   ++actor_restarts_;
-  std::fprintf(stderr, "launcher: actor %d ended (%s); restarting it\n", i,
-               Describe(status).c_str());
+  ++actor_lives_[i];
+  std::fprintf(stderr,
+               "launcher: actor %d ended (%s); restarting it (life %d, env "
+               "seed %llu)\n",
+               i, Describe(status).c_str(), actor_lives_[i] + 1,
+               static_cast<unsigned long long>(
+                   ActorLifeSeed(run_.training().seed(), i, actor_lives_[i])));
   absl::StatusOr<pid_t> pid = StartActor(i);
   actors_[i] = pid.ok() ? *pid : -1;
   return absl::OkStatus();
@@ -499,6 +508,12 @@ absl::Status Supervisor::Run() {
 }
 
 }  // namespace
+
+uint64_t ActorLifeSeed(uint64_t run_seed, int actor, int life) {
+  const uint64_t first = run_seed + static_cast<uint64_t>(actor);
+  return life == 0 ? first
+                   : SplitMixSeed(first, static_cast<uint64_t>(life - 1));
+}
 
 absl::Status RunDistributedTraining(const LaunchConfig& config,
                                     const std::atomic<bool>& stop) {

@@ -48,7 +48,8 @@ struct LaunchConfig {
 // distributed.learners = K > 1, K data-parallel learners, rank 0 serving
 // their rendezvous on another free port), then the actors (actor i gets
 // seed + i, so one actor repeats a local run, and serves learner i mod K),
-// restarts an actor that dies (logged), restarts a learner that dies from
+// restarts an actor that dies with seeds of its own (ActorLifeSeed, logged),
+// restarts a learner that dies from
 // the run's last checkpoint on the same port (with K > 1 every learner, as
 // replicas only train together; the actors reconnect keeping their
 // environments), forwards `stop` (SIGINT/SIGTERM) to every process, and
@@ -57,6 +58,12 @@ struct LaunchConfig {
 // through.
 absl::Status RunDistributedTraining(const LaunchConfig& config,
                                     const std::atomic<bool>& stop);
+
+// The environments' seed of actor `actor` in its `life`-th life (0: the
+// first start) in a run seeded `run_seed`: run_seed + actor first, then a
+// seed of the actor's and the life's, so that an actor restarted after a
+// crash that its episodes cause does not replay them and crash again.
+uint64_t ActorLifeSeed(uint64_t run_seed, int actor, int life);
 
 }  // namespace vantage
 

@@ -8,6 +8,7 @@
 #include <chrono>
 #include <filesystem>
 #include <random>
+#include <set>
 #include <string>
 #include <thread>
 #include <vector>
@@ -80,6 +81,21 @@ TEST(ChaosTest, TheRunSurvivesKilledActorsAndLearners) {
   EXPECT_EQ(CountOf(log, "the learner ended (signal 9); resuming it"), 2)
       << log;
   EXPECT_GE(CountOf(log, "ended (signal 9); restarting it"), 20) << log;
+  // Each restart is a new life of its actor, with environment seeds no
+  // earlier life had (a crash its episodes caused would repeat otherwise).
+  std::set<std::string> seeds;
+  int lives = 0;
+  for (absl::string_view line : absl::StrSplit(log, '\n')) {
+    const size_t at = line.find(", env seed ");
+    if (line.find("restarting it (life ") == absl::string_view::npos ||
+        at == absl::string_view::npos) {
+      continue;
+    }
+    seeds.insert(std::string(line.substr(at)));
+    ++lives;
+  }
+  EXPECT_GE(lives, 20) << log;
+  EXPECT_EQ(static_cast<int>(seeds.size()), lives) << log;
 
   const std::vector<std::string> rows = DeterministicProgress(run);
   // 120000 steps of 2 x 256-step rollouts: 235 updates (the last batch
