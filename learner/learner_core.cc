@@ -10,6 +10,7 @@
 #include <limits>
 #include <mutex>
 #include <numeric>
+#include <set>
 #include <utility>
 
 #include "absl/strings/str_cat.h"
@@ -246,6 +247,18 @@ absl::StatusOr<UpdateStats> LearnerCore::Update(std::vector<Rollout> rollouts) {
   }
 }
 
+void LearnerCore::CountFeeders(const std::vector<Rollout>& rollouts,
+                               UpdateStats& stats) {
+  std::set<int64_t> actors;
+  std::set<std::pair<int64_t, int64_t>> streams;
+  for (const Rollout& rollout : rollouts) {
+    actors.insert(rollout.actor_id);
+    streams.insert({rollout.actor_id, rollout.env_slot});
+  }
+  stats.batch_actors = static_cast<int64_t>(actors.size());
+  stats.batch_env_slots = static_cast<int64_t>(streams.size());
+}
+
 absl::StatusOr<UpdateStats> LearnerCore::Optimise(
     std::vector<Rollout>& rollouts, UpdateGuard& guard) {
   const auto update_start = Clock::now();
@@ -271,6 +284,7 @@ absl::StatusOr<UpdateStats> LearnerCore::Optimise(
     return status;
   }
   stats.rollout_policy_lags = std::move(prepared->lags);
+  CountFeeders(rollouts, stats);
   stats.update_seconds = SecondsSince(update_start);
   return stats;
 }

@@ -55,6 +55,9 @@ class LearnerCore {
   // Frees the stitching state of an actor that is gone (its registration
   // expired); rollouts it already completed still train.
   void ForgetActor(int64_t actor_id) { intake_.ForgetActor(actor_id); }
+  // Who decides the batch's size (null: the config's rollouts_per_batch);
+  // it must outlive the updates.
+  void SetBatchPlan(BatchPlan* plan) { intake_.SetPlan(plan); }
   const SegmentIntake& intake() const { return intake_; }
   const RolloutStitcher& stitcher() const { return intake_.stitcher(); }
   // Steps held for later batches: partial rollouts and complete ones that
@@ -109,6 +112,9 @@ class LearnerCore {
   // the algorithm's optimisation, the statistics summed over the replicas,
   // and the new version committed (Commit).
   absl::StatusOr<UpdateStats> Update(std::vector<Rollout> rollouts);
+  // The actors and env streams whose rollouts make the batch.
+  static void CountFeeders(const std::vector<Rollout>& rollouts,
+                           UpdateStats& stats);
   absl::StatusOr<UpdateStats> Optimise(std::vector<Rollout>& rollouts,
                                        UpdateGuard& guard);
   // Keeps the update or, when its statistics are faulty, rolls it back;

@@ -14,9 +14,11 @@
 #include "actor/actor_core.h"
 #include "actor/envs/env_registry.h"
 #include "actor/remote/actor_metrics.h"
+#include "actor/remote/round_watchdog.h"
 #include "actor/run_settings.h"
 #include "common/net/grpc_security.h"
 #include "common/net/port_file.h"
+#include "common/rollout/horizon_pacer.h"
 #include "common/util/phase_times.h"
 #include "common/util/split_mix.h"
 #include "proto/vantage.grpc.pb.h"
@@ -42,6 +44,12 @@ bool IsRefusal(const absl::Status& status) {
 // subscription to say whether the run is over.
 constexpr absl::Duration kRunOverGrace = absl::Seconds(3);
 
+// What each env slot may act with a version (a learner that predates the
+// grant allows one horizon).
+int64_t GrantedHorizons(const pb::Weights& weights) {
+  return weights.has_horizons() ? weights.horizons() : 1;
+}
+
 // The phases of the actor's time split.
 constexpr size_t kInferencePhase = 0;
 constexpr size_t kPhysicsPhase = 1;
@@ -51,13 +59,19 @@ constexpr size_t kSendPhase = 2;
 class StreamSink : public SegmentSink {
  public:
   StreamSink(grpc::ClientWriter<pb::Segment>& writer, ActorMetrics* metrics,
-             PhaseTimes& times)
-      : writer_(writer), metrics_(metrics), times_(times) {}
+             PhaseTimes& times, RoundWatchdog& watchdog)
+      : writer_(writer),
+        metrics_(metrics),
+        times_(times),
+        watchdog_(watchdog) {}
   absl::Status Send(Segment segment) override {
     const auto start = std::chrono::steady_clock::now();
     pb::Segment proto;
     SegmentToProto(segment, &proto);
-    if (!writer_.Write(proto)) {
+    watchdog_.Idle();
+    const bool written = writer_.Write(proto);
+    watchdog_.Busy();
+    if (!written) {
       return absl::UnavailableError("the learner closed the segment stream");
     }
     const double seconds =
@@ -75,14 +89,18 @@ class StreamSink : public SegmentSink {
   grpc::ClientWriter<pb::Segment>& writer_;
   ActorMetrics* metrics_;
   PhaseTimes& times_;
+  RoundWatchdog& watchdog_;
 };
 
 // The newest weights a subscription delivered.
 class WeightsSlot {
  public:
+  // A newer version, or the same one with another grant of horizons.
   void Put(pb::Weights weights) {
     std::lock_guard<std::mutex> lock(mutex_);
-    if (weights_ == nullptr || weights.version() > weights_->version()) {
+    if (weights_ == nullptr || weights.version() > weights_->version() ||
+        (weights.version() == weights_->version() &&
+         GrantedHorizons(weights) != GrantedHorizons(*weights_))) {
       weights_ = std::make_shared<pb::Weights>(std::move(weights));
     }
   }
@@ -123,11 +141,12 @@ class Session {
  public:
   Session(const RemoteActorConfig& config,
           std::shared_ptr<grpc::Channel> channel, ActorMetrics* metrics,
-          PhaseTimes& times)
+          PhaseTimes& times, RoundWatchdog& watchdog)
       : config_(config),
         stub_(pb::Learner::NewStub(channel)),
         metrics_(metrics),
-        times_(times) {}
+        times_(times),
+        watchdog_(watchdog) {}
 
   // Registers, then acts and streams until an error or `stop`.
   // `progressed` tells whether the learner accepted us at all.
@@ -138,6 +157,12 @@ class Session {
       return status;
     }
     progressed = true;
+    const pb::DistributedSettings& distributed =
+        response.run_config().distributed();
+    watchdog_.SetTimeout(
+        distributed.has_actor_stall_timeout_s()
+            ? absl::Seconds(distributed.actor_stall_timeout_s())
+            : absl::ZeroDuration());
     if (actor == nullptr) {
       absl::StatusOr<std::unique_ptr<ActorCore>> created =
           CreateActor(response);
@@ -202,7 +227,10 @@ class Session {
   // The session's weights subscription and segment stream around Act.
   absl::Status Stream(const pb::RegisterResponse& response, ActorCore& actor,
                       const std::atomic<bool>& stop) {
+    // The registration's weights carry the grant in force then; the
+    // subscription starts with the grant in force when it opens.
     WeightsSlot slot;
+    slot.Put(response.weights());
     grpc::ClientContext subscription_context;
     AddAuthToken(config_.security, subscription_context);
     subscription_context.AddMetadata(kSessionMetadataKey, response.session());
@@ -223,7 +251,7 @@ class Session {
     pb::SegmentAck ack;
     std::unique_ptr<grpc::ClientWriter<pb::Segment>> writer =
         stub_->StreamSegments(&stream_context, &ack);
-    StreamSink sink(*writer, metrics_, times_);
+    StreamSink sink(*writer, metrics_, times_, watchdog_);
     const absl::Status status =
         Act(response.run_config(), actor, slot, sink, stop);
     writer->WritesDone();
@@ -248,49 +276,30 @@ class Session {
   }
 
   // Acts and sends until an error, the subscription's end or `stop` (OK).
-  // Pacing: horizon h (counted from this registration) may start once the
-  // learner has published h - ahead versions since then. A sync run (ahead
-  // 0) acts one horizon per version, exactly on-policy; an async actor acts
-  // up to two horizons ahead (no more than the allowed policy lag), during
-  // the learner's updates, which is how acting hides behind learning (one
-  // horizon ahead leaves the learner waiting whenever an actor is slowed
-  // down), and never so far ahead that its segments would grow stale or
-  // memory would grow.
+  // Pacing (HorizonPacer): each horizon begins only within the learner's
+  // grant of horizons per version, with the newest weights. A sync actor
+  // (lead 0) acts exactly its grant with each version, all on-policy; an
+  // asynchronous one may lead by up to two versions (no
+  // more than the allowed policy lag), acting during the learner's
+  // updates, which is how acting hides behind learning, and never so far
+  // ahead that its segments would grow stale or memory would grow.
   absl::Status Act(const pb::RunConfig& run, ActorCore& actor,
                    const WeightsSlot& slot, SegmentSink& sink,
                    const std::atomic<bool>& stop) {
     const int64_t rounds_per_horizon = std::max<int64_t>(
         1, run.training().horizon() / run.training().segment_length());
-    const int64_t ahead =
+    HorizonPacer pacer(
         run.distributed().sync()
             ? 0
-            : std::min<int64_t>(2, run.distributed().max_policy_lag());
-    const int64_t first_version = actor.policy_version();
-    auto known = [&] {
-      std::shared_ptr<const pb::Weights> newest = slot.Get();
-      return std::max(actor.policy_version(),
-                      newest == nullptr ? -1 : newest->version());
-    };
+            : std::min<int64_t>(2, run.distributed().max_policy_lag()));
     for (int64_t rounds = 0; !stop; ++rounds) {
+      absl::Status ready = rounds % rounds_per_horizon == 0
+                               ? AwaitGrant(pacer, actor, slot, stop)
+                               : ApplyNewest(actor, slot);
+      if (!ready.ok()) return ready;
+      if (stop) break;
       if (rounds % rounds_per_horizon == 0) {
-        const int64_t needed =
-            first_version + rounds / rounds_per_horizon - ahead;
-        while (!stop && !slot.ended() && known() < needed) {
-          std::this_thread::sleep_for(std::chrono::milliseconds(2));
-        }
-        if (stop) break;
-      }
-      if (std::shared_ptr<const pb::Weights> newest = slot.Get();
-          newest != nullptr && newest->version() > actor.policy_version()) {
-        if (absl::Status status = Apply(*newest, actor); !status.ok()) {
-          return status;
-        }
-      }
-      if (slot.ended()) {
-        const absl::Status status = slot.end_status();
-        return status.ok()
-                   ? absl::UnavailableError("the weights subscription ended")
-                   : status;
+        pacer.Add(actor.policy_version(), 1);
       }
       if (absl::Status status = CollectRound(actor, sink); !status.ok()) {
         return status;
@@ -299,11 +308,47 @@ class Session {
     return absl::OkStatus();
   }
 
+  // Waits until a horizon may begin with the newest weights (applied);
+  // the subscription's end is an error (Unavailable if it ended cleanly).
+  absl::Status AwaitGrant(const HorizonPacer& pacer, ActorCore& actor,
+                          const WeightsSlot& slot,
+                          const std::atomic<bool>& stop) {
+    while (!stop) {
+      if (absl::Status status = ApplyNewest(actor, slot); !status.ok()) {
+        return status;
+      }
+      std::shared_ptr<const pb::Weights> newest = slot.Get();
+      if (newest != nullptr && newest->version() == actor.policy_version() &&
+          pacer.Credit(newest->version(), GrantedHorizons(*newest)) > 0) {
+        return absl::OkStatus();
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    }
+    return absl::OkStatus();
+  }
+
+  // The subscription's newest weights, if newer than the actor's.
+  absl::Status ApplyNewest(ActorCore& actor, const WeightsSlot& slot) {
+    if (std::shared_ptr<const pb::Weights> newest = slot.Get();
+        newest != nullptr && newest->version() > actor.policy_version()) {
+      if (absl::Status status = Apply(*newest, actor); !status.ok()) {
+        return status;
+      }
+    }
+    if (!slot.ended()) return absl::OkStatus();
+    const absl::Status status = slot.end_status();
+    return status.ok()
+               ? absl::UnavailableError("the weights subscription ended")
+               : status;
+  }
+
   // One segment from every env, timed and counted.
   absl::Status CollectRound(ActorCore& actor, SegmentSink& sink) {
     const double inference_before = actor.inference_seconds();
     const double env_before = actor.env_seconds();
+    watchdog_.Busy();
     const absl::Status status = actor.CollectSegments(sink);
+    watchdog_.Idle();
     const double inference = actor.inference_seconds() - inference_before;
     const double physics = actor.env_seconds() - env_before;
     times_.Add(kInferencePhase, inference);
@@ -327,6 +372,7 @@ class Session {
   std::unique_ptr<pb::Learner::Stub> stub_;
   ActorMetrics* metrics_;
   PhaseTimes& times_;
+  RoundWatchdog& watchdog_;
 };
 
 // Prints the actor's time split when it stops, however it stops.
@@ -412,13 +458,14 @@ absl::Status RunRemoteActor(const RemoteActorConfig& config,
   if (!started.ok()) return started.status();
   const std::unique_ptr<ActorMetrics> metrics = *std::move(started);
   TimeSplitReport report(config.name);
+  RoundWatchdog watchdog(config.name, config.env);
   std::unique_ptr<ActorCore> actor;  // kept across reconnects
   int failures = 0;
   absl::Duration backoff = config.initial_backoff;
   while (!stop) {
     const std::shared_ptr<grpc::Channel> channel =
         grpc::CreateCustomChannel(config.learner, *credentials, arguments);
-    Session session(config, channel, metrics.get(), report.times());
+    Session session(config, channel, metrics.get(), report.times(), watchdog);
     bool progressed = false;
     const absl::Status status = session.Run(*spec, actor, stop, progressed);
     if (stop) break;
@@ -439,9 +486,9 @@ absl::Status RunRemoteActor(const RemoteActorConfig& config,
     }
     ++failures;
     if (metrics != nullptr) metrics->AddReconnect();
-    std::fprintf(stderr, "%s: %s; reconnecting in %s\n", config.name.c_str(),
-                 std::string(status.message()).c_str(),
-                 absl::FormatDuration(backoff).c_str());
+    std::fprintf(stderr, "%s: %s; reconnecting to %s in %s\n",
+                 config.name.c_str(), std::string(status.message()).c_str(),
+                 config.learner.c_str(), absl::FormatDuration(backoff).c_str());
     SleepUnlessStopped(backoff, stop);
     backoff = std::min(backoff * 2, config.max_backoff);
   }

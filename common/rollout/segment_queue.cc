@@ -17,8 +17,18 @@ absl::Status SegmentQueue::Send(Segment segment) {
 }
 
 absl::StatusOr<Segment> SegmentQueue::Receive() {
+  return ReceiveFor(absl::InfiniteDuration());
+}
+
+absl::StatusOr<Segment> SegmentQueue::ReceiveFor(absl::Duration timeout) {
   std::unique_lock<std::mutex> lock(mutex_);
-  not_empty_.wait(lock, [&] { return closed_ || !segments_.empty(); });
+  auto ready = [&] { return closed_ || !segments_.empty(); };
+  if (timeout == absl::InfiniteDuration()) {
+    not_empty_.wait(lock, ready);
+  } else if (!not_empty_.wait_for(lock, absl::ToChronoNanoseconds(timeout),
+                                  ready)) {
+    return absl::DeadlineExceededError("no segment arrived");
+  }
   if (segments_.empty()) return absl::CancelledError("segment queue closed");
   Segment segment = std::move(segments_.front());
   segments_.pop_front();

@@ -8,6 +8,7 @@
 
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
+#include "absl/time/time.h"
 #include "common/rollout/segment.h"
 
 namespace vantage {
@@ -27,6 +28,11 @@ class SegmentSource {
   virtual ~SegmentSource() = default;
   // Blocks until a segment arrives; Cancelled once closed and drained.
   virtual absl::StatusOr<Segment> Receive() = 0;
+  // As Receive, but DeadlineExceeded once `timeout` passed without one
+  // (a source that cannot wait less blocks as Receive does).
+  virtual absl::StatusOr<Segment> ReceiveFor(absl::Duration timeout) {
+    return Receive();
+  }
   // Whether whoever filled it already checked every segment against the
   // run's spec and limits (the learner's gateway does, to answer its
   // sender), so that the receiver need not check them again.
@@ -43,6 +49,7 @@ class SegmentQueue : public SegmentSink, public SegmentSource {
 
   absl::Status Send(Segment segment) override;
   absl::StatusOr<Segment> Receive() override;
+  absl::StatusOr<Segment> ReceiveFor(absl::Duration timeout) override;
   // Wakes every waiter; later Sends fail, Receives drain what is left.
   void Close();
   size_t size() const;

@@ -48,17 +48,37 @@ absl::StatusOr<pb::RunConfig> MergeFlags(const RunRequest& request) {
   return config;
 }
 
+// How a run is served, not what it is: the actors the launcher starts and
+// how long one may owe segments. A resumed run may change them (its
+// learner's pool is elastic); its batch (`--envs`) stays.
+bool ServesTheRun(const std::string& flag) {
+  return flag == "actors" || flag == "envs_per_actor" ||
+         flag == "actor_stall_timeout_s";
+}
+
 // Resuming continues the run exactly as configured; flags that would change
 // it are refused rather than silently ignored.
 absl::Status CheckNoOverrides(const RunRequest& request) {
-  if (request.given_flags.empty()) return absl::OkStatus();
   std::vector<std::string> given;
   for (const std::string& name : request.given_flags) {
-    given.push_back(absl::StrCat("--", name));
+    if (!ServesTheRun(name)) given.push_back(absl::StrCat("--", name));
   }
-  return absl::InvalidArgumentError(
-      absl::StrCat("--resume continues the run as its config.json says; drop ",
-                   absl::StrJoin(given, ", ")));
+  if (given.empty()) return absl::OkStatus();
+  return absl::InvalidArgumentError(absl::StrCat(
+      "--resume continues the run as its config.json says (only --actors, "
+      "--envs_per_actor and --actor_stall_timeout_s may change); drop ",
+      absl::StrJoin(given, ", ")));
+}
+
+// The serving flags given with --resume, over the run's own config.
+void ApplyServingFlags(const RunRequest& request, pb::RunConfig& config) {
+  pb::DistributedSettings& d = *config.mutable_distributed();
+  const pb::DistributedSettings& given = request.flags.distributed();
+  if (given.has_actors()) d.set_actors(given.actors());
+  if (given.has_envs_per_actor()) d.set_envs_per_actor(given.envs_per_actor());
+  if (given.has_actor_stall_timeout_s()) {
+    d.set_actor_stall_timeout_s(given.actor_stall_timeout_s());
+  }
 }
 
 // --resume_if_exists: what the directory holds decides between starting,
@@ -80,7 +100,17 @@ absl::Status ApplyResumeIfExists(const RunRequest& request, ResolvedRun& run) {
         absl::StrCat(dir, "/config.json holds settings this vantage refuses: ",
                      held.status().message()));
   }
-  if (const std::string difference = RunConfigDifference(*held, run.config);
+  // How it is served may differ (an elastic pool); nothing else may.
+  pb::RunConfig comparable = *held;
+  if (comparable.has_distributed() && run.config.has_distributed()) {
+    const pb::DistributedSettings& now = run.config.distributed();
+    pb::DistributedSettings& d = *comparable.mutable_distributed();
+    d.set_actors(now.actors());
+    d.set_envs_per_actor(now.envs_per_actor());
+    d.set_actor_stall_timeout_s(now.actor_stall_timeout_s());
+  }
+  if (const std::string difference =
+          RunConfigDifference(comparable, run.config);
       !difference.empty()) {
     return absl::InvalidArgumentError(
         absl::StrCat(dir, " holds a run made with other settings (", difference,
@@ -112,6 +142,7 @@ absl::StatusOr<ResolvedRun> ResolveRunRequest(const RunRequest& request) {
         ReadRunConfigFile(request.resume + "/config.json");
     if (!saved.ok()) return saved.status();
     given = *saved;
+    ApplyServingFlags(request, given);
   } else {
     absl::StatusOr<pb::RunConfig> merged = MergeFlags(request);
     if (!merged.ok()) return merged.status();

@@ -21,7 +21,9 @@ DistributedTable() {
            {"max_policy_lag", &C::max_policy_lag, AtLeast(0)},
            {"learners", &C::learners, AtLeast(1), AtMost(64)},
            {"learner_threads", &C::learner_threads, AtLeast(0), AtMost(256),
-            "(0: automatic)"}},
+            "(0: automatic)"},
+           {"actor_stall_timeout_s", &C::actor_stall_timeout_s, AtLeast(1),
+            AtMost(86400)}},
           SettingNames::kFlag);
   return *table;
 }
@@ -48,9 +50,12 @@ void InferLayout(const pb::TrainingSettings& t, pb::DistributedSettings& d) {
   }
 }
 
-// The rules across settings: the streams are the learner's batch, sync
-// means no lag, the learners share the actors evenly, and a sync actor
-// sends whole horizons.
+// The rules across settings: the batch defaults to one rollout per actor
+// environment, sync means no lag, the learners share the actors evenly,
+// and a sync actor sends whole horizons. The batch and the actors'
+// environments may differ: the learner has each live environment act as
+// many horizons per version as fill the batch (an elastic pool), so a run
+// keeps its batch whatever number of actors serve it.
 absl::Status CheckLayout(pb::TrainingSettings& t,
                          const pb::DistributedSettings& d) {
   // At most 256 x 4096: the product fits an int32.
@@ -60,14 +65,7 @@ absl::Status CheckLayout(pb::TrainingSettings& t,
                      absl::StrCat("makes --actors x --envs_per_actor = ",
                                   streams, " streams, more than 4096"));
   }
-  // The learner's batch holds one rollout per actor environment.
-  if (t.has_envs() && t.envs() != streams) {
-    return FlagError("envs",
-                     absl::StrCat("is the learner's batch of --actors x "
-                                  "--envs_per_actor = ",
-                                  streams, " streams in a distributed run"));
-  }
-  t.set_envs(streams);
+  if (!t.has_envs()) t.set_envs(streams);
   if (d.sync() && d.max_policy_lag() != 0) {
     return FlagError("max_policy_lag", "must be 0 with --sync");
   }
@@ -75,6 +73,11 @@ absl::Status CheckLayout(pb::TrainingSettings& t,
     return FlagError("learners",
                      absl::StrCat("must divide --actors (", d.actors(),
                                   "): every learner serves as many actors"));
+  }
+  if (t.envs() % d.learners() != 0) {
+    return FlagError("learners",
+                     absl::StrCat("must divide the batch's --envs (", t.envs(),
+                                  "): every learner takes an equal share"));
   }
   if (d.sync() && t.horizon() % t.segment_length() != 0) {
     return FlagError("segment_length",

@@ -25,6 +25,9 @@ struct DistributedConfig {
   // LibTorch intra-op threads of each learner (0: the cores over the
   // learners); one beat two on the 2-core machines measured (small GEMMs).
   int learner_threads = 1;
+  // An actor that owes segments and sends none for this long is replaced
+  // (see pb::DistributedSettings).
+  double actor_stall_timeout_s = 60;
 
   // Each setting within its range (the message names the flag).
   absl::Status Validate() const;

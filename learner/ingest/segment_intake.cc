@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <iterator>
+#include <map>
 #include <utility>
 
 #include "absl/strings/str_cat.h"
@@ -28,16 +29,29 @@ SegmentIntake::SegmentIntake(const LearnerConfig& config)
 absl::StatusOr<std::vector<Rollout>> SegmentIntake::NextBatch(
     SegmentSource& source, int64_t version) {
   DropStale(version);
-  while (static_cast<int64_t>(pending_.size()) < rollouts_per_batch_) {
-    absl::StatusOr<Segment> segment = source.Receive();
+  int64_t size = 0;
+  while ((size = BatchSize(version)) == 0) {
+    absl::StatusOr<Segment> segment =
+        plan_ == nullptr ? source.Receive()
+                         : source.ReceiveFor(plan_->recheck_interval());
+    if (absl::IsDeadlineExceeded(segment.status())) continue;
     if (!segment.ok()) return segment.status();
     Accept(*std::move(segment), source.checked(), version);
   }
-  std::vector<Rollout> batch(
-      std::make_move_iterator(pending_.begin()),
-      std::make_move_iterator(pending_.begin() + rollouts_per_batch_));
-  pending_.erase(pending_.begin(), pending_.begin() + rollouts_per_batch_);
+  std::vector<Rollout> batch(std::make_move_iterator(pending_.begin()),
+                             std::make_move_iterator(pending_.begin() + size));
+  pending_.erase(pending_.begin(), pending_.begin() + size);
   return batch;
+}
+
+int64_t SegmentIntake::BatchSize(int64_t version) const {
+  const int64_t total = static_cast<int64_t>(pending_.size());
+  if (plan_ == nullptr) {
+    return total >= rollouts_per_batch_ ? rollouts_per_batch_ : 0;
+  }
+  std::map<int64_t, int64_t> held;
+  for (const Rollout& rollout : pending_) ++held[rollout.actor_id];
+  return std::min(total, plan_->BatchSize(version, held, total));
 }
 
 void SegmentIntake::DropStale(int64_t version) {

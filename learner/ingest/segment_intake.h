@@ -13,6 +13,7 @@
 #include "absl/status/statusor.h"
 #include "common/rollout/segment.h"
 #include "common/rollout/segment_queue.h"
+#include "learner/ingest/batch_plan.h"
 #include "learner/ingest/rollout_stitcher.h"
 #include "learner/ingest/segment_check.h"
 #include "learner/learner_config.h"
@@ -32,13 +33,16 @@ class SegmentIntake {
 
   explicit SegmentIntake(const LearnerConfig& config);
 
-  // Receives from `source` until `rollouts_per_batch` rollouts whose steps
-  // are all recent enough to train the policy at `version` are complete;
-  // returns that many, oldest first, and keeps the rest for later batches.
-  // Steps too stale for `version` are dropped first, whether buffered or
-  // arriving. Returns the source's error once it fails (closed).
+  // Receives from `source` until the rollouts complete and recent enough
+  // to train the policy at `version` make a batch: `rollouts_per_batch` of
+  // them, or as many as the plan says (SetPlan); returns them, oldest
+  // first, and keeps the rest for later batches. Steps too stale for
+  // `version` are dropped first, whether buffered or arriving. Returns the
+  // source's error once it fails (closed).
   absl::StatusOr<std::vector<Rollout>> NextBatch(SegmentSource& source,
                                                  int64_t version);
+  // Null: the fixed batch. The plan must outlive the intake's use of it.
+  void SetPlan(BatchPlan* plan) { plan_ = plan; }
 
   // Frees the stitching state of an actor that is gone (its registration
   // expired); rollouts it already completed still train.
@@ -69,6 +73,8 @@ class SegmentIntake {
   // Drops what became too stale for `version` among the complete rollouts
   // and the partial ones.
   void DropStale(int64_t version);
+  // How many of the complete rollouts make the batch now (0: not yet).
+  int64_t BatchSize(int64_t version) const;
   // Checks, stitches and counts one segment.
   void Accept(Segment segment, bool checked, int64_t version);
   void Reject(int64_t actor_id, int64_t env_slot, const absl::Status& why);
@@ -78,6 +84,7 @@ class SegmentIntake {
   const int64_t rollouts_per_batch_;
   const int64_t max_buffered_steps_;
   RolloutStitcher stitcher_;
+  BatchPlan* plan_ = nullptr;
   std::vector<Rollout> pending_;
   std::deque<double> recent_returns_;
   Counts unreported_;

@@ -92,6 +92,19 @@ std::vector<ProgressColumn> DiscardedWorkColumns() {
   };
 }
 
+// Who fed the batch: with an elastic pool of remote actors, the actors and
+// env streams live when it was taken.
+std::vector<ProgressColumn> FeederColumns() {
+  return {
+      {"batch_actors", "batch_actors", Metric::kGauge, Format::kInteger,
+       "Actors whose rollouts made the last batch.",
+       [](const ProgressRow& r) { return double(r.stats.batch_actors); }},
+      {"batch_env_slots", "batch_env_slots", Metric::kGauge, Format::kInteger,
+       "Env streams (actor, slot) whose rollouts made the last batch.",
+       [](const ProgressRow& r) { return double(r.stats.batch_env_slots); }},
+  };
+}
+
 std::vector<ProgressColumn> ExplorationColumns() {
   return {
       {"exploration_loss", "exploration_model_loss", Metric::kGauge,
@@ -131,7 +144,7 @@ const std::vector<ProgressColumn>& ProgressColumns() {
     std::vector<ProgressColumn> all;
     for (const std::vector<ProgressColumn>& group :
          {RunProgressColumns(), UpdateColumns(), DiscardedWorkColumns(),
-          ExplorationColumns(), TimeColumns()}) {
+          FeederColumns(), ExplorationColumns(), TimeColumns()}) {
       all.insert(all.end(), group.begin(), group.end());
     }
     return all;

@@ -18,6 +18,7 @@
 #include "common/util/phase_times.h"
 #include "learner/run/progress_columns.h"
 #include "learner/run/training_run.h"
+#include "learner/server/elastic_batch_plan.h"
 #include "learner/service/actor_gateway.h"
 #include "learner/service/learner_metrics.h"
 #include "learner/service/learner_service.h"
@@ -69,50 +70,47 @@ absl::StatusOr<ServerCheckpointState> ReadServerState(
   return state;
 }
 
-// A sync learner takes each update's rollouts from every env stream of its
-// batch, so with fewer streams registered it waits without end: said once
-// per shortfall that lasts kGrace (actors take a moment to register), and
-// always in the missing_env_slots series.
-class EnvSlotShortfall {
+// Says how the pool of live actors compares with the run's own layout
+// (distributed.actors x envs_per_actor, this learner's share) once a
+// change has lasted kSettle: fewer env slots fill the batch with more
+// horizons each (slower), more fill it sooner, none means no update.
+class PoolNotice {
  public:
-  static constexpr absl::Duration kGrace = absl::Seconds(10);
+  static constexpr absl::Duration kSettle = absl::Seconds(5);
 
-  EnvSlotShortfall(bool sync, int64_t needed) : sync_(sync), needed_(needed) {}
+  explicit PoolNotice(int64_t planned_slots) : planned_(planned_slots) {}
 
-  // The streams missing now, given those of the registered actors.
-  int64_t Check(int64_t live_env_slots, absl::Time now = absl::Now()) {
-    const int64_t missing =
-        sync_ ? std::max<int64_t>(0, needed_ - live_env_slots) : 0;
-    if (missing == 0) {
-      if (said_) {
-        std::fprintf(stderr,
-                     "learner: all %ld env streams of the batch are "
-                     "registered again\n",
-                     static_cast<long>(needed_));
-      }
-      since_ = absl::InfiniteFuture();
-      said_ = false;
-      return 0;
+  void Check(const PoolView& pool, absl::Time now = absl::Now()) {
+    const int64_t slots = pool.live_env_slots();
+    const int64_t actors = static_cast<int64_t>(pool.members.size());
+    if (slots != pending_) {
+      pending_ = slots;
+      since_ = now;
     }
-    if (since_ == absl::InfiniteFuture()) since_ = now;
-    if (!said_ && now - since_ >= kGrace) {
+    if (slots == said_ || now - since_ < kSettle) return;
+    if (slots == 0) {
       std::fprintf(stderr,
-                   "learner: a sync update takes a rollout from each of %ld "
-                   "env streams and the registered actors have %ld: no "
-                   "update until %ld more register\n",
-                   static_cast<long>(needed_),
-                   static_cast<long>(live_env_slots),
-                   static_cast<long>(missing));
-      said_ = true;
+                   "learner: no actor is live (the run plans %ld env slots): "
+                   "no update until one registers\n",
+                   static_cast<long>(planned_));
+    } else {
+      std::fprintf(stderr,
+                   "learner: %ld actors with %ld env slots are live (the run "
+                   "plans %ld); version %ld grants %ld horizons per slot\n",
+                   static_cast<long>(actors), static_cast<long>(slots),
+                   static_cast<long>(planned_), static_cast<long>(pool.version),
+                   static_cast<long>(pool.horizons));
     }
-    return missing;
+    said_ = slots;
   }
 
  private:
-  const bool sync_;
-  const int64_t needed_;
-  absl::Time since_ = absl::InfiniteFuture();
-  bool said_ = false;
+  const int64_t planned_;
+  // What was last said, and the live slots seen since `since_`; the run's
+  // own layout goes unsaid.
+  int64_t said_ = planned_;
+  int64_t pending_ = -1;
+  absl::Time since_;
 };
 
 // The learner process: opens the run (Open), serves actors (Serve), trains
@@ -160,6 +158,8 @@ class LearnerProcess {
   // ingest metrics fresh while updates block.
   void Watch();
   void RecordGateway();
+  // Expires the actors that stalled, saying who they were.
+  void ExpireStalledActors();
   // Frees what the stitcher holds for registrations that expired (the
   // stitcher belongs to the update loop's thread).
   void ForgetExpiredActors();
@@ -180,8 +180,8 @@ class LearnerProcess {
   RunningServer server_;
   std::unique_ptr<LearnerMetrics> metrics_;
   std::thread watcher_;
+  std::unique_ptr<ElasticBatchPlan> plan_;
   std::atomic<int64_t> buffered_steps_{0};
-  std::atomic<int64_t> missing_env_slots_{0};
   std::mutex expired_mutex_;
   std::vector<int64_t> expired_;
   // Where the learner's time goes, printed when it stops; the rest is
@@ -270,7 +270,25 @@ absl::Status LearnerProcess::Serve() {
   gateway_config.first_actor_id = first_actor_id_;
   gateway_config.spec = config_.spec;
   gateway_config.limits = config_.limits;
+  const pb::DistributedSettings& layout = run_config.distributed();
+  gateway_config.batch_rollouts = own_streams_;
+  gateway_config.horizon_steps =
+      std::max<int64_t>(
+          1, config_.learner.horizon / std::max<int64_t>(1, segment_length)) *
+      segment_length;
+  gateway_config.lead =
+      layout.sync() ? 0 : std::min<int64_t>(2, layout.max_policy_lag());
+  gateway_config.stall_timeout =
+      layout.has_actor_stall_timeout_s()
+          ? absl::Seconds(layout.actor_stall_timeout_s())
+          : absl::ZeroDuration();
   gateway_ = std::make_unique<ActorGateway>(gateway_config, *queue_);
+  plan_ = std::make_unique<ElasticBatchPlan>(
+      *gateway_, layout.sync(), own_streams_,
+      static_cast<int64_t>(layout.actors()) * layout.envs_per_actor() /
+          std::max(1, config_.replicas.world_size),
+      [this] { return static_cast<int64_t>(queue_->size()); });
+  run_->learner().SetBatchPlan(plan_.get());
   // Nothing larger than the run's largest valid segment is ever read.
   ServiceLimits service_limits = config_.service_limits;
   service_limits.max_segment_message_bytes =
@@ -314,8 +332,10 @@ absl::Status LearnerProcess::StartMetrics() {
 }
 
 void LearnerProcess::Watch() {
-  EnvSlotShortfall shortfall(config_.run_config.distributed().sync(),
-                             own_streams_);
+  const pb::DistributedSettings& layout = config_.run_config.distributed();
+  PoolNotice notice(static_cast<int64_t>(layout.actors()) *
+                    layout.envs_per_actor() /
+                    std::max(1, config_.replicas.world_size));
   int64_t ticks = 0;
   while (!stop_ && !gateway_->closed()) {
     std::this_thread::sleep_for(std::chrono::milliseconds(50));
@@ -323,8 +343,9 @@ void LearnerProcess::Watch() {
     // keeps the freed pages of a refused 200 MB message resident; give them
     // back every 10 s.
     if (++ticks % 200 == 0) malloc_trim(0);
-    missing_env_slots_ = shortfall.Check(gateway_->counters().live_env_slots);
+    notice.Check(gateway_->Pool());
     service_->CancelIdleStreams();
+    ExpireStalledActors();
     std::vector<int64_t> gone = gateway_->ExpireIdle();
     if (!gone.empty()) {
       std::lock_guard<std::mutex> lock(expired_mutex_);
@@ -335,14 +356,31 @@ void LearnerProcess::Watch() {
   queue_->Close();
 }
 
+void LearnerProcess::ExpireStalledActors() {
+  for (const StalledActor& actor : gateway_->ExpireStalled()) {
+    std::fprintf(
+        stderr,
+        "learner: actor %ld (%s at %s, env %s) owed %ld steps and sent none "
+        "for %s (--actor_stall_timeout_s); its registration expires and the "
+        "batch goes on without it\n",
+        static_cast<long>(actor.actor_id), actor.name.c_str(),
+        actor.peer.c_str(), config_.spec.name.c_str(),
+        static_cast<long>(actor.owed_steps),
+        absl::FormatDuration(absl::Trunc(actor.silent, absl::Seconds(1)))
+            .c_str());
+  }
+}
+
 void LearnerProcess::RecordGateway() {
   if (metrics_ == nullptr) return;
   const GatewayCounters counters = gateway_->counters();
   metrics_->RecordSegmentsAccepted(counters.accepted_segments);
   metrics_->RecordRejected(counters.rejected);
+  const PoolView pool = gateway_->Pool();
   metrics_->RecordActors({counters.live_actors, service_->open_streams(),
                           counters.registrations, counters.expirations,
-                          missing_env_slots_.load()});
+                          counters.stalls, pool.live_env_slots(),
+                          pool.horizons});
   metrics_->SetQueueDepth(static_cast<int64_t>(queue_->size()),
                           buffered_steps_.load());
   std::vector<LearnerMetrics::ActorActivity> actors;

@@ -1,5 +1,6 @@
 #include "learner/service/actor_gateway.h"
 
+#include <algorithm>
 #include <random>
 #include <utility>
 
@@ -72,8 +73,7 @@ absl::StatusOr<pb::RegisterResponse> ActorGateway::Register(
     return status;
   }
   std::string secret = NewSecret();
-  absl::StatusOr<int64_t> actor_id =
-      AddRegistration(peer, request.num_envs(), secret);
+  absl::StatusOr<int64_t> actor_id = AddRegistration(peer, request, secret);
   if (!actor_id.ok()) return actor_id.status();
   std::shared_ptr<const pb::Weights> weights =
       WaitForWeightsNewerThan(-1, timeout);
@@ -116,7 +116,9 @@ absl::Status ActorGateway::CheckRegisterRequest(
 }
 
 absl::StatusOr<int64_t> ActorGateway::AddRegistration(
-    absl::string_view peer, int64_t num_envs, const std::string& secret) {
+    absl::string_view peer, const pb::RegisterRequest& request,
+    const std::string& secret) {
+  const int64_t num_envs = request.num_envs();
   std::unique_lock<std::mutex> lock(mutex_);
   if (run_over_) return absl::OutOfRangeError(kRunOver);
   if (closed_) return absl::UnavailableError("the learner is shutting down");
@@ -137,7 +139,9 @@ absl::StatusOr<int64_t> ActorGateway::AddRegistration(
   Registration& registration = actors_[actor_id];
   registration.secret = secret;
   registration.peer = std::string(peer);
+  registration.name = request.actor_name().substr(0, 128);
   registration.num_envs = num_envs;
+  registration.admitted = HorizonPacer(config_.lead);
   registration.next_sequence.assign(num_envs, 0);
   registration.last_seen = now;
   ++counters_.registrations;
@@ -172,6 +176,7 @@ absl::StatusOr<int64_t> ActorGateway::Attach(absl::string_view session) {
   ++it->second.open_calls;
   it->second.claimed = true;
   it->second.last_seen = absl::Now();
+  it->second.last_progress = it->second.last_seen;
   return actor_id;
 }
 
@@ -282,6 +287,18 @@ absl::Status ActorGateway::Admit(int64_t actor_id, const pb::Segment& proto,
   if (dropped != nullptr) dropped->clear();
   absl::StatusOr<int64_t> newest = CheckSender(actor_id, proto);
   if (!newest.ok()) return newest.status();
+  // CheckSender counted this call in `admitting`; it ends here.
+  struct Admitting {
+    ActorGateway& gateway;
+    int64_t actor_id;
+    ~Admitting() {
+      std::lock_guard<std::mutex> lock(gateway.mutex_);
+      if (auto it = gateway.actors_.find(actor_id);
+          it != gateway.actors_.end()) {
+        --it->second.admitting;
+      }
+    }
+  } admitting{*this, actor_id};
   absl::StatusOr<Segment> segment = DecodeSegment(proto, *newest);
   if (!segment.ok()) return segment.status();
   if (check_.TooStale(segment->policy_version, *newest)) {
@@ -318,6 +335,7 @@ absl::StatusOr<int64_t> ActorGateway::CheckSender(int64_t actor_id,
         actor_id, "'s ", it->second.num_envs, " env slots"));
   }
   it->second.last_seen = absl::Now();
+  ++it->second.admitting;
   return weights_ == nullptr ? -1 : weights_->version();
 }
 
@@ -360,6 +378,7 @@ bool ActorGateway::AdvanceSequence(int64_t actor_id, const Segment& segment,
 
 absl::Status ActorGateway::Deliver(int64_t actor_id, Segment segment) {
   const int64_t steps = segment.steps();
+  const int64_t version = segment.policy_version;
   if (absl::Status status = sink_.Send(std::move(segment)); !status.ok()) {
     return absl::UnavailableError("the learner is shutting down");
   }
@@ -368,6 +387,8 @@ absl::Status ActorGateway::Deliver(int64_t actor_id, Segment segment) {
   counters_.accepted_steps += steps;
   if (auto it = actors_.find(actor_id); it != actors_.end()) {
     it->second.accepted_steps += steps;
+    it->second.admitted.Add(version, steps);
+    it->second.last_progress = absl::Now();
   }
   return absl::OkStatus();
 }
@@ -376,8 +397,80 @@ void ActorGateway::Publish(const PolicyWeights& weights) {
   auto proto = std::make_shared<pb::Weights>();
   WeightsToProto(weights, proto.get());
   std::lock_guard<std::mutex> lock(mutex_);
+  proto->set_horizons(GrantedLocked());
   weights_ = std::move(proto);
+  ++weights_sequence_;
+  granted_at_ = absl::Now();
   changed_.notify_all();
+}
+
+int64_t ActorGateway::GrantedLocked() const {
+  int64_t live_slots = 0;
+  for (const auto& [actor_id, registration] : actors_) {
+    if (registration.open_calls > 0) live_slots += registration.num_envs;
+  }
+  if (live_slots == 0) return 1;
+  return (config_.batch_rollouts + live_slots - 1) / live_slots;
+}
+
+void ActorGateway::Grant(int64_t version, int64_t horizons) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (weights_ == nullptr || weights_->version() != version ||
+      weights_->horizons() == horizons) {
+    return;
+  }
+  // A copy: subscriptions may be writing the message in force.
+  auto proto = std::make_shared<pb::Weights>(*weights_);
+  proto->set_horizons(horizons);
+  weights_ = std::move(proto);
+  ++weights_sequence_;
+  granted_at_ = absl::Now();
+  changed_.notify_all();
+}
+
+int64_t ActorGateway::OwedStepsLocked(const Registration& registration) const {
+  if (weights_ == nullptr) return 0;
+  return registration.admitted.Credit(
+      weights_->version(), weights_->horizons(),
+      registration.num_envs * config_.horizon_steps);
+}
+
+PoolView ActorGateway::Pool() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  PoolView view;
+  if (weights_ != nullptr) {
+    view.version = weights_->version();
+    view.horizons = weights_->horizons();
+  }
+  for (const auto& [actor_id, registration] : actors_) {
+    if (registration.open_calls == 0) continue;
+    view.members.push_back(
+        {actor_id, registration.num_envs, OwedStepsLocked(registration)});
+  }
+  return view;
+}
+
+std::vector<StalledActor> ActorGateway::ExpireStalled(absl::Time now) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  std::vector<StalledActor> stalled;
+  if (config_.stall_timeout <= absl::ZeroDuration()) return stalled;
+  for (auto it = actors_.begin(); it != actors_.end();) {
+    const Registration& registration = it->second;
+    const int64_t owed = OwedStepsLocked(registration);
+    const absl::Duration silent =
+        now - std::max(registration.last_progress, granted_at_);
+    if (registration.open_calls > 0 && registration.admitting == 0 &&
+        owed > 0 && silent > config_.stall_timeout) {
+      stalled.push_back(
+          {it->first, registration.name, registration.peer, owed, silent});
+      evicted_.push_back(it->first);
+      ++counters_.stalls;
+      RemoveLocked(it++);
+    } else {
+      ++it;
+    }
+  }
+  return stalled;
 }
 
 std::shared_ptr<const pb::Weights> ActorGateway::WaitForWeightsNewerThan(
@@ -387,6 +480,17 @@ std::shared_ptr<const pb::Weights> ActorGateway::WaitForWeightsNewerThan(
     return closed_ || (weights_ != nullptr && weights_->version() > version);
   });
   if (!newer || closed_) return nullptr;
+  return weights_;
+}
+
+std::shared_ptr<const pb::Weights> ActorGateway::WaitForWeightsAfter(
+    int64_t* seen, absl::Duration timeout) {
+  std::unique_lock<std::mutex> lock(mutex_);
+  const bool newer = changed_.wait_for(lock, ToChrono(timeout), [&] {
+    return closed_ || (weights_ != nullptr && weights_sequence_ > *seen);
+  });
+  if (!newer || closed_) return nullptr;
+  *seen = weights_sequence_;
   return weights_;
 }
 

@@ -19,6 +19,7 @@
 #include "absl/time/time.h"
 #include "common/env/environment.h"
 #include "common/nn/policy_weights.h"
+#include "common/rollout/horizon_pacer.h"
 #include "common/rollout/segment.h"
 #include "common/rollout/segment_queue.h"
 #include "learner/ingest/segment_check.h"
@@ -80,6 +81,16 @@ struct GatewayConfig {
   // Ids are never reused within a run: a resumed learner continues after
   // the ids its checkpoint had handed out.
   int64_t first_actor_id = 0;
+  // The elastic pool: the rollouts of `horizon_steps` steps this learner's
+  // batch takes, which Publish shares out over the live env slots as a
+  // grant of horizons per slot (pb::Weights.horizons); the versions an
+  // actor may lead by (0: sync; see HorizonPacer).
+  int64_t batch_rollouts = 1;
+  int64_t horizon_steps = 1;
+  int64_t lead = 0;
+  // An actor that owes segments and sends none for this long is stalled
+  // (ExpireStalled); zero or less: never.
+  absl::Duration stall_timeout = absl::Seconds(60);
   GatewayLimits limits;
 };
 
@@ -88,6 +99,7 @@ struct GatewayCounters {
   int64_t registrations = 0;  // granted, over the run of this process
   int64_t refused_registrations = 0;
   int64_t expirations = 0;  // idle past their expiry, or evicted
+  int64_t stalls = 0;       // expired for owing segments too long
   int64_t live_actors = 0;  // registrations not expired
   int64_t live_env_slots = 0;
   int64_t accepted_segments = 0;
@@ -103,6 +115,35 @@ struct ActorActivity {
   int64_t accepted_steps = 0;
   absl::Time last_seen;
   bool connected = false;
+};
+
+// The actors that feed the learner now, as the elastic pool sees them: the
+// registrations with a call open, and the grant in force.
+struct PoolView {
+  struct Member {
+    int64_t actor_id = 0;
+    int64_t env_slots = 0;
+    // Steps its grant still allows (0 or less: it has sent all it may
+    // until the next grant), counted from the segments admitted.
+    int64_t owed_steps = 0;
+  };
+  int64_t version = -1;
+  int64_t horizons = 0;  // per env slot, at `version`
+  std::vector<Member> members;
+  int64_t live_env_slots() const {
+    int64_t slots = 0;
+    for (const Member& member : members) slots += member.env_slots;
+    return slots;
+  }
+};
+
+// A registration that owed segments and sent none for the stall timeout.
+struct StalledActor {
+  int64_t actor_id = 0;
+  std::string name;  // as it registered
+  std::string peer;  // its host
+  int64_t owed_steps = 0;
+  absl::Duration silent;
 };
 
 class ActorGateway {
@@ -150,13 +191,34 @@ class ActorGateway {
   // that the learner can free them.
   std::vector<int64_t> ExpireIdle(absl::Time now = absl::Now());
 
+  // Expires the registrations that owe segments (their grant allows more
+  // than they sent) and have sent none, with no call blocked sending one,
+  // for the stall timeout since the later of their last segment, their
+  // attaching and the grant; returns them (their ids also go to the next
+  // ExpireIdle). A hung actor stops holding up the batch.
+  std::vector<StalledActor> ExpireStalled(absl::Time now = absl::Now());
+
   const EnvSpec& spec() const { return config_.spec; }
 
+  // Publishes a new version with a grant that lets the live env slots (or,
+  // with none live, the batch's own number of them) fill the batch:
+  // ceil(batch_rollouts / live env slots) horizons each.
   void Publish(const PolicyWeights& weights);
+  // Sends `version` again with a grant of `horizons` (when the live actors
+  // cannot fill the batch with the grant they have, or 0 once a sync batch
+  // is complete); no-op if `version` is no longer the newest.
+  void Grant(int64_t version, int64_t horizons);
+  PoolView Pool() const;
+
   // The newest weights if newer than `version`, waiting up to `timeout`;
   // null on timeout or once closed.
   std::shared_ptr<const pb::Weights> WaitForWeightsNewerThan(
       int64_t version, absl::Duration timeout);
+  // The weights as last published or granted, once that happened after
+  // `*seen` (updated; -1 at first: the weights in force), waiting up to
+  // `timeout`; null on timeout or once closed.
+  std::shared_ptr<const pb::Weights> WaitForWeightsAfter(
+      int64_t* seen, absl::Duration timeout);
   int64_t published_version() const;
   // The id the next registration gets (saved in checkpoints).
   int64_t next_actor_id() const;
@@ -179,6 +241,7 @@ class ActorGateway {
   struct Registration {
     std::string secret;
     std::string peer;
+    std::string name;
     int64_t num_envs = 0;
     bool claimed = false;  // has opened a call
     // Per env slot: the lowest sequence number not yet admitted.
@@ -186,7 +249,17 @@ class ActorGateway {
     int64_t open_calls = 0;
     int64_t accepted_steps = 0;
     absl::Time last_seen;
+    // The steps admitted per policy version (the learner's count of the
+    // actor's HorizonPacer), the last admission or attach, and the calls
+    // inside Admit now (a stream blocked on a full queue is no stall).
+    HorizonPacer admitted{0};
+    absl::Time last_progress;
+    int64_t admitting = 0;
   };
+
+  // With mutex_ held.
+  int64_t OwedStepsLocked(const Registration& registration) const;
+  int64_t GrantedLocked() const;
 
   absl::Status Reject(const std::string& reason, absl::Status status);
 
@@ -194,7 +267,7 @@ class ActorGateway {
   // then (taking mutex_) the new registration's id, or why there is no room.
   absl::Status CheckRegisterRequest(const pb::RegisterRequest& request) const;
   absl::StatusOr<int64_t> AddRegistration(absl::string_view peer,
-                                          int64_t num_envs,
+                                          const pb::RegisterRequest& request,
                                           const std::string& secret);
 
   // Admit's steps. Each takes mutex_ only around what it reads or writes of
@@ -228,6 +301,10 @@ class ActorGateway {
   int64_t next_actor_id_ = 0;
   std::vector<int64_t> evicted_;  // not yet returned by ExpireIdle
   std::shared_ptr<const pb::Weights> weights_;
+  // Counts Publish and Grant (what WaitForWeightsAfter waits on), and when
+  // the grant in force was made.
+  int64_t weights_sequence_ = 0;
+  absl::Time granted_at_;
   bool closed_ = false;
   bool run_over_ = false;
   GatewayCounters counters_;

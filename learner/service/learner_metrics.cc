@@ -58,11 +58,18 @@ LearnerMetrics::LearnerMetrics()
           metrics_.AddGauge("live_streams",
                             "Open segment streams and weight subscriptions "
                             "of registered actors.")),
-      missing_env_slots_(metrics_.AddGauge(
-          "missing_env_slots",
-          "Env streams a sync run's batch needs beyond those of the "
-          "registered actors: while above 0 no update can happen (0 in "
-          "async runs).")),
+      live_env_slots_(metrics_.AddGauge(
+          "live_env_slots",
+          "Env slots of the actors with a call open: the elastic pool that "
+          "fills the batch (0: no update can happen).")),
+      granted_horizons_(metrics_.AddGauge(
+          "granted_horizons",
+          "Horizons each live env slot may act with the newest version, "
+          "shared out so that the live slots fill the batch.")),
+      stalls_(metrics_.AddCounter(
+          "actor_stalls_total",
+          "Registrations expired because their actor owed segments and "
+          "sent none for --actor_stall_timeout_s.")),
       registrations_(metrics_.AddCounter("registrations_total",
                                          "Actor registrations granted.")),
       expirations_(metrics_.AddCounter(
@@ -100,6 +107,7 @@ LearnerMetrics::LearnerMetrics()
       segments_accepted_total_(segments_accepted_),
       registrations_total_(registrations_),
       expirations_total_(expirations_),
+      stalls_total_(stalls_),
       rolled_back_total_(rolled_back_updates_) {
   for (const char* reason : kKnownRejectReasons) RejectedTotal(reason);
   statistics_ = {{"policy_version", &policy_version_},
@@ -167,7 +175,9 @@ void LearnerMetrics::RecordActors(const Actors& actors) {
   std::lock_guard<std::mutex> lock(mutex_);
   live_actors_.Set(static_cast<double>(actors.live_actors));
   live_streams_.Set(static_cast<double>(actors.live_streams));
-  missing_env_slots_.Set(static_cast<double>(actors.missing_env_slots));
+  live_env_slots_.Set(static_cast<double>(actors.live_env_slots));
+  granted_horizons_.Set(static_cast<double>(actors.granted_horizons));
+  stalls_total_.Record(actors.stalls_total);
   registrations_total_.Record(actors.registrations_total);
   expirations_total_.Record(actors.expirations_total);
 }

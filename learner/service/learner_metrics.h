@@ -55,15 +55,17 @@ class LearnerMetrics {
   // stitcher's buffers and pending rollouts.
   void SetQueueDepth(int64_t segments, int64_t buffered_steps);
   // Who is connected: live registrations, their open segment streams and
-  // weight subscriptions, the running totals of registrations granted and
-  // expired, and the env streams a sync batch needs beyond those
-  // registered (while > 0 no update can happen).
+  // weight subscriptions, the running totals of registrations granted,
+  // expired and expired as stalled, the env slots of the actors with a
+  // call open (the pool) and the grant of horizons each has.
   struct Actors {
     int64_t live_actors = 0;
     int64_t live_streams = 0;
     int64_t registrations_total = 0;
     int64_t expirations_total = 0;
-    int64_t missing_env_slots = 0;
+    int64_t stalls_total = 0;
+    int64_t live_env_slots = 0;
+    int64_t granted_horizons = 0;
   };
   void RecordActors(const Actors& actors);
 
@@ -124,7 +126,9 @@ class LearnerMetrics {
   prometheus::Counter& episodes_;
   prometheus::Gauge& live_actors_;
   prometheus::Gauge& live_streams_;
-  prometheus::Gauge& missing_env_slots_;
+  prometheus::Gauge& live_env_slots_;
+  prometheus::Gauge& granted_horizons_;
+  prometheus::Counter& stalls_;
   prometheus::Counter& registrations_;
   prometheus::Counter& expirations_;
   prometheus::Counter& rolled_back_updates_;
@@ -145,6 +149,7 @@ class LearnerMetrics {
   TotalCounter segments_accepted_total_;
   TotalCounter registrations_total_;
   TotalCounter expirations_total_;
+  TotalCounter stalls_total_;
   TotalCounter rolled_back_total_;
   std::map<std::string, TotalCounter> rejected_totals_;
   // The statistics' gauges by name (the ones above among them).

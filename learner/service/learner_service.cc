@@ -246,14 +246,15 @@ grpc::Status LearnerService::StreamedSubscribeWeights(
         !read.ok()) {
       return read;
     }
-    int64_t known = request.known_version();
+    // The weights in force first (with the grant in force, which the
+    // actor's registration may predate), then every version and grant.
+    int64_t seen = -1;
     while (!context->IsCancelled() && !gateway_.closed()) {
       std::shared_ptr<const pb::Weights> weights =
-          gateway_.WaitForWeightsNewerThan(known, kPoll);
+          gateway_.WaitForWeightsAfter(&seen, kPoll);
       if (weights == nullptr) continue;
       if (!streamer->Write(*weights)) break;
       Touch(*key);
-      known = weights->version();
     }
     if (gateway_.run_over()) {
       return grpc::Status(grpc::StatusCode::OUT_OF_RANGE, kRunOver);

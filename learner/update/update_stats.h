@@ -47,6 +47,10 @@ struct UpdateStats {
   // included), and the algorithm's optimisation.
   double advantage_seconds = 0.0;
   double optimisation_seconds = 0.0;
+  // Who fed this batch: the actors and the env streams (actor, slot) of its
+  // rollouts (a learner's own share, with data-parallel replicas).
+  int64_t batch_actors = 0;
+  int64_t batch_env_slots = 0;
   // Per rollout of this batch: how many versions behind the updated policy
   // its oldest step was acted (0 throughout in sync mode).
   std::vector<int64_t> rollout_policy_lags;

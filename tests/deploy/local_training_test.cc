@@ -98,7 +98,8 @@ TEST(LocalTrainingTest, SameSeedSameProgressCsv) {
             "env_steps,updates,policy_version,episodes,mean_return,"
             "policy_loss,value_loss,entropy,approx_kl,clip_fraction,"
             "explained_variance,biased_fraction,mean_abs_bias,"
-            "rejected_segments,rolled_back_updates,exploration_loss,"
+            "rejected_segments,rolled_back_updates,batch_actors,"
+            "batch_env_slots,exploration_loss,"
             "exploration_accuracy,exploration_bonus");
   EXPECT_EQ(first, DeterministicProgress(b));
   EXPECT_NE(first, DeterministicProgress(c));

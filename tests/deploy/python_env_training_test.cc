@@ -82,14 +82,46 @@ TEST(PythonEnvTrainingTest, PpoLearnsCartPoleLocally) {
 }
 
 // Distributed runs reached 500 with seeds 0-2 under the Haswell and
-// SkylakeX kernels alike (2026-12-06).
+// SkylakeX kernels alike on an idle machine (2026-12-06), but seed 1 ended
+// at 430 once under the full suite's load, where actors and learner time
+// share two cores differently: the bar is the median of seeds 0-2, as
+// locally.
 TEST(PythonEnvTrainingTest, PpoLearnsCartPoleDistributed) {
-  const std::string run = FreshDirectory("python_cartpole_distributed");
+  std::vector<double> best;
+  for (int seed : {0, 1, 2}) {
+    const std::string run =
+        FreshDirectory(absl::StrCat("python_cartpole_distributed_", seed));
+    const Outcome outcome = RunVantage(
+        absl::StrCat("train ", kCartPole, " --seed=", seed,
+                     " --actors=2 --envs_per_actor=4 --run_dir=", run));
+    ASSERT_EQ(outcome.exit_code, 0) << outcome.err;
+    best.push_back(BestMeanReturn(run));
+    std::printf("distributed cartpole seed %d: best mean return %.1f\n", seed,
+                best.back());
+  }
+  std::sort(best.begin(), best.end());
+  EXPECT_GE(best[1], 450.0);
+}
+
+// An environment whose step() now and then never returns: the hung actor's
+// watchdog names the call and exits after --actor_stall_timeout_s, the
+// launcher restarts it with environment seeds of its new life (so the same
+// hang does not come back at the same step), and the run finishes.
+TEST(PythonEnvTrainingTest, AHungEnvironmentIsReplacedAndTheRunFinishes) {
+  const std::string run = FreshDirectory("python_hangs");
   const Outcome outcome = RunVantage(
-      absl::StrCat("train ", kCartPole,
-                   " --seed=1 --actors=2 --envs_per_actor=4 --run_dir=", run));
+      "train --env=python:broken_envs:hangs_sometimes "
+      "--env_kwargs='{\"p\": 0.0005}' --steps=8192 --actors=2 "
+      "--envs_per_actor=2 --horizon=64 --actor_stall_timeout_s=2 --seed=3 "
+      "--run_dir=" +
+      run);
   ASSERT_EQ(outcome.exit_code, 0) << outcome.err;
-  EXPECT_GE(BestMeanReturn(run), 450.0);
+  EXPECT_THAT(outcome.err,
+              HasSubstr("python:broken_envs:hangs_sometimes: step() has not "
+                        "returned after 2s, beyond the run's actor stall "
+                        "timeout (2s); exiting (code 75)"));
+  EXPECT_THAT(outcome.err, HasSubstr("restarting it (life 2, env seed"));
+  EXPECT_THAT(outcome.out, HasSubstr("RESULT train"));
 }
 
 TEST(PythonEnvTrainingTest, AFactoryThatCannotBeImportedIsAUsageError) {

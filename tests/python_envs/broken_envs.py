@@ -19,6 +19,23 @@ class RaisesInStep(CartPole):
         raise ValueError(f"the simulator crashed on {action}")
 
 
+class HangsSometimes(CartPole):
+    """A simulator that, now and then, never returns from step(): with
+    probability `p` per step, drawn from the episode's own generator, so a
+    hang depends on the seed as a real one depends on the state."""
+
+    def __init__(self, p=2e-4):
+        super().__init__()
+        self.p = p
+
+    def step(self, action):
+        if self.rng.random() < self.p:
+            import time
+            while True:
+                time.sleep(3600)
+        return super().step(action)
+
+
 class WrongShape(CartPole):
     def reset(self, seed=None, options=None):
         return np.zeros(3, dtype=np.float32), {}
@@ -56,6 +73,10 @@ class DictObservations(CartPole):
 
 def raises_in_step():
     return RaisesInStep()
+
+
+def hangs_sometimes(p=2e-4):
+    return HangsSometimes(p)
 
 
 def wrong_shape():

@@ -17,6 +17,7 @@
 #include "absl/strings/str_join.h"
 #include "absl/strings/strip.h"
 #include "actor/envs/python/python_runtime.h"
+#include "common/util/call_watch.h"
 #include "common/util/state_bytes.h"
 
 namespace py = pybind11;
@@ -48,6 +49,9 @@ struct ObservationLayout {
 template <typename Result, typename Body>
 absl::StatusOr<Result> WithPython(const std::string& name, const char* call,
                                   Body&& body) {
+  // Watched from before the GIL is taken: a call that hangs holding it
+  // stops every other environment's call at that point.
+  const WatchedCall watched(name, call);
   py::gil_scoped_acquire gil;
   try {
     return body();

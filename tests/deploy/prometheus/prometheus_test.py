@@ -238,7 +238,8 @@ class PrometheusTest(unittest.TestCase):
     rules = {r["name"]: r for g in groups for r in g["rules"]}
     for name in ("VantageLearnerDown", "VantageNoUpdate",
                  "VantageRejectedSegments", "VantagePolicyLagAboveLimit",
-                 "VantageActorGone", "VantageSyncBatchShortOfEnvStreams"):
+                 "VantageActorGone", "VantageNoLiveActors",
+                 "VantageActorStalled"):
       self.assertIn(name, rules)
       self.assertIn(name, text)
       self.query(rules[name]["query"])  # raises unless it evaluates

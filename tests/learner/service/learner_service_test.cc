@@ -727,7 +727,8 @@ TEST_F(LearnerServiceTest, GetWeightsIsUnavailableUntilPublished) {
   ExpectWeightsAre(weights, published);
 }
 
-TEST_F(LearnerServiceTest, SubscriptionDeliversEachNewerVersionUntilCancelled) {
+TEST_F(LearnerServiceTest,
+       SubscriptionDeliversTheWeightsInForceThenEachNewerVersion) {
   StartRegistered();  // publishes version 0
   grpc::ClientContext context;
   SetDeadline(context);
@@ -737,9 +738,12 @@ TEST_F(LearnerServiceTest, SubscriptionDeliversEachNewerVersionUntilCancelled) {
   request.set_known_version(0);
   std::unique_ptr<grpc::ClientReader<pb::Weights>> reader =
       stub_->SubscribeWeights(&context, request);
-  // Give the server time to start waiting, so that one which resent the
-  // known version 0 would be caught by the first read.
-  std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  // First the weights in force, whatever version the actor knows: their
+  // grant of horizons may be newer than its registration's.
+  pb::Weights in_force;
+  ASSERT_TRUE(reader->Read(&in_force));
+  EXPECT_EQ(in_force.version(), 0);
+  EXPECT_TRUE(in_force.has_horizons());
 
   for (int64_t version : {1, 2}) {
     const PolicyWeights published = MakeWeights(version);
