@@ -84,7 +84,7 @@ packages=(
 # to validate them. A machine that has kubectl or npm from elsewhere keeps
 # them (Debian's packages would conflict).
 test_packages=(libgtest-dev libgmock-dev clang-format ffmpeg
-  slurm-wlm munge buildah debootstrap python3-yaml)
+  slurm-wlm munge buildah debootstrap python3-yaml iproute2 util-linux)
 command -v kubectl >/dev/null || test_packages+=(kubernetes-client)
 command -v npm >/dev/null || test_packages+=(nodejs npm)
 

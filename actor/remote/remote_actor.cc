@@ -227,10 +227,10 @@ class Session {
   // The session's weights subscription and segment stream around Act.
   absl::Status Stream(const pb::RegisterResponse& response, ActorCore& actor,
                       const std::atomic<bool>& stop) {
-    // The registration's weights carry the grant in force then; the
-    // subscription starts with the grant in force when it opens.
+    // Empty until the subscription's first message: the weights and grant
+    // in force once this actor is in the learner's pool (its calls are
+    // open), so that it never acts for a sync batch completed without it.
     WeightsSlot slot;
-    slot.Put(response.weights());
     grpc::ClientContext subscription_context;
     AddAuthToken(config_.security, subscription_context);
     subscription_context.AddMetadata(kSessionMetadataKey, response.session());
@@ -277,12 +277,12 @@ class Session {
 
   // Acts and sends until an error, the subscription's end or `stop` (OK).
   // Pacing (HorizonPacer): each horizon begins only within the learner's
-  // grant of horizons per version, with the newest weights. A sync actor
-  // (lead 0) acts exactly its grant with each version, all on-policy; an
-  // asynchronous one may lead by up to two versions (no
-  // more than the allowed policy lag), acting during the learner's
-  // updates, which is how acting hides behind learning, and never so far
-  // ahead that its segments would grow stale or memory would grow.
+  // grant of horizons per version, with the newest weights; the first waits
+  // for the subscription's first message. A sync actor (lead 0) acts exactly
+  // its grant with each version, all on-policy; an asynchronous one may lead by
+  // up to two versions (no more than the allowed policy lag), acting during the
+  // learner's updates, which is how acting hides behind learning, and never so
+  // far ahead that its segments would grow stale or memory would grow.
   absl::Status Act(const pb::RunConfig& run, ActorCore& actor,
                    const WeightsSlot& slot, SegmentSink& sink,
                    const std::atomic<bool>& stop) {

@@ -96,10 +96,9 @@ class PoolNotice {
     } else {
       std::fprintf(stderr,
                    "learner: %ld actors with %ld env slots are live (the run "
-                   "plans %ld); version %ld grants %ld horizons per slot\n",
+                   "plans %ld)\n",
                    static_cast<long>(actors), static_cast<long>(slots),
-                   static_cast<long>(planned_), static_cast<long>(pool.version),
-                   static_cast<long>(pool.horizons));
+                   static_cast<long>(planned_));
     }
     said_ = slots;
   }

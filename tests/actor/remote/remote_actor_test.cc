@@ -50,12 +50,15 @@ class CompletingLearner final : public pb::Learner::Service {
     WeightsToProto(
         ExportPolicyWeights(*policy, RunningMeanStd(spec.observation_size), 0),
         response->mutable_weights());
+    weights_ = response->weights();
     return grpc::Status::OK;
   }
 
-  grpc::Status SubscribeWeights(grpc::ServerContext* context,
-                                const pb::WeightsRequest*,
-                                grpc::ServerWriter<pb::Weights>*) override {
+  grpc::Status SubscribeWeights(
+      grpc::ServerContext* context, const pb::WeightsRequest*,
+      grpc::ServerWriter<pb::Weights>* writer) override {
+    // As a learner does, the weights in force first.
+    writer->Write(weights_);
     std::unique_lock<std::mutex> lock(mutex_);
     while (!cut_ && !context->IsCancelled()) {
       changed_.wait_for(lock, std::chrono::milliseconds(10));
@@ -85,6 +88,7 @@ class CompletingLearner final : public pb::Learner::Service {
  private:
   const std::chrono::milliseconds run_over_delay_;
   std::atomic<int> registrations_{0};
+  pb::Weights weights_;  // those of the last registration
   std::mutex mutex_;
   std::condition_variable changed_;
   bool cut_ = false;

@@ -1,0 +1,123 @@
+#!/usr/bin/env bash
+# A run across hosts: tests/cluster/hosts.sh makes a learner host and three
+# actor hosts (network namespaces on a bridge, each with its own address
+# and hostname). With mutual TLS whose certificates name the hosts, the
+# learner on vc-learner trains InvertedPendulum from one actor on each
+# actor host, while
+#   - an actor that dials the learner by an address its certificate does
+#     not name is refused;
+#   - vc-actor1's link is cut for 30 s mid-run: its registration stalls out
+#     and the batch goes on without it; when the link is back it rejoins;
+#   - every process of vc-actor2 is killed, and its actor started again;
+# the run keeps updating throughout, finishes, reaches a mean return of
+# 900 (a random policy gets 5-8) and keeps its checkpoints.
+#
+#   cluster_test.sh VANTAGE     exit 0: passed, 77: namespaces unavailable
+set -uo pipefail
+
+readonly VANTAGE=$(realpath "$1")
+readonly HOSTS="$(dirname "$(realpath "$0")")/hosts.sh"
+readonly WORK=$(mktemp -d /tmp/vantage-cluster.XXXXXX)
+pids=()
+
+cleanup() {
+  for pid in "${pids[@]}"; do kill -9 "$pid" 2>/dev/null; done
+  "$HOSTS" down >/dev/null 2>&1
+  [ "${KEEP:-0}" = 1 ] || rm -rf "$WORK"
+}
+trap cleanup EXIT
+
+fail() {
+  echo "FAIL: $*"
+  for log in "$WORK"/*.log; do echo "--- $log"; tail -n 15 "$log"; done
+  exit 1
+}
+
+if ! "$HOSTS" up 4 >"$WORK/hosts.log" 2>&1; then
+  if grep -q "hosts.sh:" "$WORK/hosts.log"; then
+    echo "SKIP: $(cat "$WORK/hosts.log")"
+    exit 77
+  fi
+  fail "hosts.sh up: $(cat "$WORK/hosts.log")"
+fi
+
+# A CA, a server certificate for vc-learner, one client certificate per
+# actor host.
+cd "$WORK"
+certs() {
+  openssl req -x509 -newkey rsa:2048 -nodes -days 1 -subj /CN=vantage-test-ca \
+    -keyout ca.key -out ca.crt 2>/dev/null || return 1
+  local name
+  for name in vc-learner vc-actor1 vc-actor2 vc-actor3; do
+    openssl req -newkey rsa:2048 -nodes -subj "/CN=$name" -keyout "$name.key" \
+      -out "$name.csr" 2>/dev/null || return 1
+    printf 'subjectAltName=DNS:%s\n' "$name" >"$name.ext"
+    openssl x509 -req -in "$name.csr" -CA ca.crt -CAkey ca.key -CAcreateserial \
+      -days 1 -extfile "$name.ext" -out "$name.crt" 2>/dev/null || return 1
+  done
+}
+certs || fail "openssl could not make the certificates"
+
+learner() {
+  "$HOSTS" run vc-learner "$VANTAGE" learner --listen=0.0.0.0:50051 \
+    --env=InvertedPendulum --envs=3 --horizon=1024 --algo=ppo \
+    --estimator=maxabs --rho=0.4 --steps=800000 --seed=1 \
+    --actor_stall_timeout_s=10 --checkpoint_every=5 --keep_checkpoints=3 \
+    --run_dir="$WORK/run" --tls_cert=vc-learner.crt --tls_key=vc-learner.key \
+    --tls_ca=ca.crt >>"$WORK/learner.log" 2>&1
+}
+actor() {  # HOST [ADDRESS]
+  "$HOSTS" run "$1" "$VANTAGE" actor --learner="${2:-vc-learner}:50051" \
+    --env=InvertedPendulum --envs=1 --name="$1" --tls_cert="$1.crt" \
+    --tls_key="$1.key" --tls_ca=ca.crt "${@:3}" >>"$WORK/$1.log" 2>&1
+}
+updates() { [ -f run/progress.csv ] && echo $(($(wc -l <run/progress.csv) - 1)) || echo 0; }
+wait_updates() {  # N SECONDS
+  local i
+  for i in $(seq 1 $((10 * $2))); do
+    [ "$(updates)" -ge "$1" ] && return 0
+    sleep 0.1
+  done
+  return 1
+}
+
+learner & pids+=($!)
+for host in vc-actor1 vc-actor2 vc-actor3; do actor "$host" & pids+=($!); done
+
+wait_updates 5 120 || fail "no 5 updates within 120 s"
+# The learner's certificate names vc-learner, not its address: an actor that
+# dials the address cannot verify it and is refused.
+if actor vc-actor3 "$("$HOSTS" address vc-learner)" --max_reconnects=0; then
+  fail "an actor that dialled the learner's bare address was let in"
+fi
+grep -q "giving up after 0 reconnects: registration: .*\(certificate\|handshake\|SSL\|ssl\|TLS\|tls\)" \
+  vc-actor3.log || fail "the actor at the wrong name was not refused for its certificate"
+echo "cluster: $(updates) updates before the faults"
+"$HOSTS" cut vc-actor1
+"$HOSTS" kill vc-actor2
+cut_at=$(updates)
+sleep 30
+during=$(( $(updates) - cut_at ))
+"$HOSTS" heal vc-actor1
+actor vc-actor2 & pids+=($!)
+echo "cluster: $during updates during the 30 s with vc-actor1 cut off and vc-actor2 killed"
+[ "$during" -ge 2 ] || fail "the run stalled while two hosts were away ($during updates)"
+
+wait "${pids[0]}"
+status=$?
+[ "$status" = 0 ] || fail "the learner exited with $status"
+grep -q "owed .* steps and sent none" learner.log ||
+  fail "the cut-off actor was never reported as stalled"
+[ "$(grep -c "vc-actor1: registered as actor" vc-actor1.log)" -ge 2 ] ||
+  fail "vc-actor1 did not register again after its link came back"
+best=$(python3 - "$WORK/run/progress.csv" <<'PY'
+import csv, sys
+rows = list(csv.DictReader(open(sys.argv[1])))
+print(max(float(r["mean_return"]) for r in rows if r["mean_return"]))
+PY
+)
+echo "cluster: best mean return $best over $(updates) updates"
+python3 -c "import sys; sys.exit(0 if float('$best') >= 900 else 1)" ||
+  fail "best mean return $best < 900"
+ls run/checkpoints/checkpoint-*.pt >/dev/null 2>&1 || fail "no checkpoint kept"
+echo "PASS"
