@@ -13,6 +13,7 @@
 #include <thread>
 
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
 #include "bench/bare_ppo.h"
 #include "bench/blas_library.h"
 #include "bench/fastest.h"
@@ -68,19 +69,24 @@ struct DataParallelFigures {
   double update_seconds = 0.0;     // the whole update, fastest
 };
 
-PpoConfig BenchPpoConfig() {
+PpoConfig BenchPpoConfig(int minibatches = kMinibatches, int epochs = kEpochs) {
   PpoConfig config;
-  config.minibatches = kMinibatches;
-  config.epochs = kEpochs;
+  config.minibatches = minibatches;
+  config.epochs = epochs;
   return config;
 }
+
+// The scaling sweep's batch: 8192 samples (4096 per replica), 4 epochs.
+constexpr int64_t kScalingBatch = 8192;
+constexpr int kScalingEpochs = 4;
 
 // Replica `rank` of two learner processes joined over loopback Gloo as in
 // `vantage train --learners=2`, each updating on its half of `batch` with
 // the gradients averaged every minibatch (so the global minibatch is the
 // single learner's).
 DataParallelFigures RunReplica(int rank, const std::string& rendezvous,
-                               const UpdateBatch& batch) {
+                               const UpdateBatch& batch,
+                               const PpoConfig& config = BenchPpoConfig()) {
   ReplicaGroupConfig group_config;
   group_config.rank = rank;
   group_config.world_size = 2;
@@ -118,7 +124,7 @@ DataParallelFigures RunReplica(int rank, const std::string& rendezvous,
   own.behaviour_log_probs = rows(batch.behaviour_log_probs);
   own.advantages = rows(batch.advantages);
   own.returns = rows(batch.returns);
-  PpoUpdater ppo(policy, value, BenchPpoConfig(), group);
+  PpoUpdater ppo(policy, value, config, group);
   std::mt19937_64 rng(rank);
   figures.update_seconds = std::numeric_limits<double>::infinity();
   // The first is a warm-up; both replicas run in lockstep.
@@ -136,15 +142,22 @@ DataParallelFigures RunReplica(int rank, const std::string& rendezvous,
 // The second replica in a child process: the replicas of a real run are
 // processes, and two threads of one process measured several times
 // slower collectives than two processes.
-absl::StatusOr<DataParallelFigures> MeasureTwoReplicas(
-    const UpdateBatch& batch) {
+// `minibatch` > 0: the scaling sweep's shape with that (global) minibatch
+// size; 0: the benchmark's own.
+absl::StatusOr<DataParallelFigures> MeasureTwoReplicas(const UpdateBatch& batch,
+                                                       int64_t minibatch = 0) {
   absl::StatusOr<int> port = FreeLoopbackPort();
   if (!port.ok()) return port.status();
   const std::string rendezvous = absl::StrCat("127.0.0.1:", *port);
   absl::StatusOr<pid_t> child =
-      SpawnSelf({"bench", "learner", "--bench_replica_of=" + rendezvous});
+      SpawnSelf({"bench", "learner", "--bench_replica_of=" + rendezvous,
+                 absl::StrCat("--bench_replica_minibatch=", minibatch)});
   if (!child.ok()) return child.status();
-  const DataParallelFigures figures = RunReplica(0, rendezvous, batch);
+  const DataParallelFigures figures =
+      minibatch > 0 ? RunReplica(0, rendezvous, batch,
+                                 BenchPpoConfig(kScalingBatch / minibatch,
+                                                kScalingEpochs))
+                    : RunReplica(0, rendezvous, batch);
   int status = 0;
   waitpid(*child, &status, 0);
   if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
@@ -155,11 +168,99 @@ absl::StatusOr<DataParallelFigures> MeasureTwoReplicas(
 
 }  // namespace
 
-int RunLearnerBenchmarkReplica(const std::string& rendezvous) {
+int RunLearnerBenchmarkReplica(const std::string& rendezvous,
+                               int64_t minibatch) {
   SetComputeThreads(1);
   at::manual_seed(0);
-  const UpdateBatch batch = SyntheticBatch();
-  RunReplica(1, rendezvous, batch);
+  if (minibatch > 0) {
+    RunReplica(1, rendezvous, SyntheticBatch(BenchShape(), kScalingBatch),
+               BenchPpoConfig(kScalingBatch / minibatch, kScalingEpochs));
+  } else {
+    RunReplica(1, rendezvous, SyntheticBatch());
+  }
+  return 0;
+}
+
+namespace {
+
+// Samples/s of one PPO update of `batch` (fastest of three after a
+// warm-up) with `threads` intra-op threads.
+double OneLearnerRate(const UpdateBatch& batch, const PpoConfig& config,
+                      int threads) {
+  SetComputeThreads(threads);
+  NetworkConfig network;
+  PolicyNetwork policy(HalfCheetahSpec(), network);
+  ValueNetwork value(kObservations, network);
+  PpoUpdater ppo(policy, value, config);
+  std::mt19937_64 rng(0);
+  double best = std::numeric_limits<double>::infinity();
+  for (int i = 0; i <= 3; ++i) {
+    const auto start = std::chrono::steady_clock::now();
+    benchmark::DoNotOptimize(ppo.Update(batch, 0.999, rng));
+    if (i > 0) best = std::min(best, SecondsSince(start));
+  }
+  SetComputeThreads(1);
+  return static_cast<double>(batch.observations.size(0)) * config.epochs / best;
+}
+
+}  // namespace
+
+int RunLearnerScalingBenchmark(const std::vector<int64_t>& minibatches,
+                               const std::vector<int>& thread_counts) {
+  SetComputeThreads(1);
+  at::manual_seed(0);
+  const UpdateBatch batch = SyntheticBatch(BenchShape(), kScalingBatch);
+  std::printf(
+      "learner scaling: PPO updates of %ld samples x %d epochs, obs %ld, act "
+      "%ld, 64x64 tanh networks, against the minibatch size; one learner at "
+      "each thread count, and two replicas (processes over loopback Gloo, "
+      "one thread each, half the batch and of each minibatch each)\n",
+      static_cast<long>(kScalingBatch), kScalingEpochs,
+      static_cast<long>(kObservations), static_cast<long>(kActions));
+  std::string header = "  minibatch";
+  for (int threads : thread_counts) {
+    absl::StrAppend(&header, absl::StrFormat("  %2d thread(s)", threads));
+  }
+  std::printf("%s  two replicas  (x one, 1 thread)  all-reduce share\n",
+              header.c_str());
+  std::string result = "RESULT learner_scaling";
+  for (int64_t minibatch : minibatches) {
+    if (minibatch < 2 || kScalingBatch % minibatch != 0) {
+      std::fprintf(
+          stderr, "bench learner_scaling: minibatch %ld must divide %ld\n",
+          static_cast<long>(minibatch), static_cast<long>(kScalingBatch));
+      return 2;
+    }
+    const PpoConfig config =
+        BenchPpoConfig(kScalingBatch / minibatch, kScalingEpochs);
+    std::string row = absl::StrFormat("  %9ld", static_cast<long>(minibatch));
+    double one = 0;
+    for (int threads : thread_counts) {
+      const double rate = OneLearnerRate(batch, config, threads);
+      if (threads == thread_counts.front()) one = rate;
+      absl::StrAppend(&row, absl::StrFormat("  %12.0f", rate));
+      absl::StrAppend(&result, " mb", minibatch, "_t", threads, "=",
+                      absl::StrFormat("%.0f", rate));
+    }
+    absl::StatusOr<DataParallelFigures> two =
+        MeasureTwoReplicas(batch, minibatch);
+    if (!two.ok()) {
+      std::fprintf(stderr, "bench learner_scaling: %s\n",
+                   std::string(two.status().message()).c_str());
+      return 1;
+    }
+    const double two_rate = static_cast<double>(kScalingBatch) *
+                            kScalingEpochs / two->update_seconds;
+    const double share = two->allreduce_seconds * (kScalingBatch / minibatch) *
+                         kScalingEpochs / two->update_seconds;
+    std::printf("%s  %12.0f  %17.2f  %16.0f%%\n", row.c_str(), two_rate,
+                two_rate / one, 100 * share);
+    absl::StrAppend(
+        &result, " mb", minibatch,
+        "_two_replicas=", absl::StrFormat("%.0f", two_rate), " mb", minibatch,
+        "_two_replicas_speedup=", absl::StrFormat("%.2f", two_rate / one));
+  }
+  std::printf("%s\n", result.c_str());
   return 0;
 }
 

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "absl/flags/flag.h"
+#include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_join.h"
 #include "actor/envs/env_registry.h"
@@ -37,6 +38,15 @@ ABSL_FLAG(double, bench_seconds, 5.0,
 ABSL_FLAG(std::string, bench_replica_of, "",
           "learner: run as the second data-parallel replica of the `bench "
           "learner` whose rendezvous is this HOST:PORT (started by it)");
+ABSL_FLAG(int64_t, bench_replica_minibatch, 0,
+          "learner: the second replica's minibatch size in the "
+          "learner_scaling sweep (set by it; 0: bench learner's shape)");
+ABSL_FLAG(std::vector<std::string>, bench_minibatches,
+          std::vector<std::string>({"64", "256", "1024", "4096"}),
+          "learner_scaling: minibatch sizes (dividing 8192)");
+ABSL_FLAG(std::vector<std::string>, bench_threads,
+          std::vector<std::string>({"1", "2"}),
+          "learner_scaling: intra-op thread counts of one learner");
 
 namespace vantage {
 namespace {
@@ -219,8 +229,39 @@ int RunConnectionsBench() {
 
 int RunLearnerBench() {
   const std::string replica_of = absl::GetFlag(FLAGS_bench_replica_of);
-  return replica_of.empty() ? RunLearnerBenchmark()
-                            : RunLearnerBenchmarkReplica(replica_of);
+  return replica_of.empty()
+             ? RunLearnerBenchmark()
+             : RunLearnerBenchmarkReplica(
+                   replica_of, absl::GetFlag(FLAGS_bench_replica_minibatch));
+}
+
+int RunLearnerScalingBench() {
+  std::vector<int64_t> minibatches;
+  for (const std::string& size : absl::GetFlag(FLAGS_bench_minibatches)) {
+    int64_t value = 0;
+    if (!absl::SimpleAtoi(size, &value)) {
+      std::fprintf(stderr, "--bench_minibatches: '%s' is not a number\n",
+                   size.c_str());
+      return kUsageError;
+    }
+    minibatches.push_back(value);
+  }
+  std::vector<int> threads;
+  for (const std::string& count : absl::GetFlag(FLAGS_bench_threads)) {
+    int value = 0;
+    if (!absl::SimpleAtoi(count, &value) || value < 1 || value > 256) {
+      std::fprintf(stderr, "--bench_threads: '%s' is not 1..256\n",
+                   count.c_str());
+      return kUsageError;
+    }
+    threads.push_back(value);
+  }
+  if (minibatches.empty() || threads.empty()) {
+    std::fprintf(stderr,
+                 "--bench_minibatches and --bench_threads need a value\n");
+    return kUsageError;
+  }
+  return RunLearnerScalingBenchmark(minibatches, threads);
 }
 
 const std::map<std::string, std::function<int()>>& Benchmarks() {
@@ -233,6 +274,7 @@ const std::map<std::string, std::function<int()>>& Benchmarks() {
           {"train", RunTrainBench},
           {"connections", RunConnectionsBench},
           {"learner", RunLearnerBench},
+          {"learner_scaling", RunLearnerScalingBench},
       };
   return *benchmarks;
 }
@@ -273,13 +315,16 @@ Command BenchCommand() {
   command.summary = "benchmarks: ratios against a baseline of the same run";
   command.usage =
       "vantage bench (advantages | actor | connections | env | ingest | "
-      "learner | train) [flags] [--benchmark_*]";
+      "learner | learner_scaling | train) [flags] [--benchmark_*]";
   command.description =
       "advantages: the path-ensemble estimators against GAE; env: the\n"
       "environment layer against raw physics (a MinAtar game: its bare\n"
       "rules; the raycast maze: its own rates only; a Python env: the same\n"
       "env in a plain Python loop); learner: a PPO update\n"
-      "against a bare LibTorch loop; ingest: the learner's segment ingest in\n"
+      "against a bare LibTorch loop; learner_scaling: PPO samples/s against\n"
+      "the minibatch size, for one learner at each thread count and for two\n"
+      "data-parallel replicas against one; ingest: the learner's segment "
+      "ingest in\n"
       "actors; actor: a streaming actor against raw physics; connections: a\n"
       "learner's memory and threads per connected actor against its idle\n"
       "footprint; train: the distributed main job (`vantage train` with the\n"
@@ -288,8 +333,15 @@ Command BenchCommand() {
       "loop's limit beside it). Each ends with a\n"
       "line `RESULT <name> ... ratio=...` measured in the same run. Google\n"
       "Benchmark's --benchmark_* flags apply.";
-  command.flags = {"bench_steps",   "bench_streams",    "bench_clients",
-                   "bench_seconds", "bench_replica_of", "env",
+  command.flags = {"bench_steps",
+                   "bench_streams",
+                   "bench_clients",
+                   "bench_seconds",
+                   "bench_replica_of",
+                   "bench_replica_minibatch",
+                   "bench_minibatches",
+                   "bench_threads",
+                   "env",
                    "envs"};
   // train: the run flags, as `vantage train` takes them.
   command.declared_flags = RunSettingFlags();
