@@ -39,7 +39,7 @@ pids+=($!)
   --envs="$ENVS" >"$WORK/actor.log" 2>&1 &
 pids+=($!)
 
-steps() { tail -n 1 "$WORK/run/progress.csv" 2>/dev/null | cut -d, -f1; }
+steps() { awk -F, 'NR > 1 {last = $1} END {print last}' "$WORK/run/progress.csv" 2>/dev/null; }
 tx_bytes() { cat /sys/class/net/vcv2/statistics/rx_bytes; }  # from vc-actor1
 rx_bytes() { cat /sys/class/net/vcv2/statistics/tx_bytes; }  # to vc-actor1
 for _ in $(seq 1 300); do [ -n "$(steps)" ] && break; sleep 0.1; done

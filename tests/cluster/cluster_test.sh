@@ -10,7 +10,10 @@
 #     and the batch goes on without it; when the link is back it rejoins;
 #   - every process of vc-actor2 is killed, and its actor started again;
 # the run keeps updating throughout, finishes, reaches a mean return of
-# 900 (a random policy gets 5-8) and keeps its checkpoints.
+# 900 (a random policy gets 5-8) and keeps its checkpoints. Then two
+# data-parallel learner replicas on vc-learner and vc-actor1, averaging
+# their gradients over Gloo across the bridge, each serving the actor of
+# another host, train it to 900 as well.
 #
 #   cluster_test.sh VANTAGE     exit 0: passed, 77: namespaces unavailable
 set -uo pipefail
@@ -110,14 +113,39 @@ grep -q "owed .* steps and sent none" learner.log ||
   fail "the cut-off actor was never reported as stalled"
 [ "$(grep -c "vc-actor1: registered as actor" vc-actor1.log)" -ge 2 ] ||
   fail "vc-actor1 did not register again after its link came back"
-best=$(python3 - "$WORK/run/progress.csv" <<'PY'
+best_return() {  # RUN_DIR
+  python3 - "$1/progress.csv" <<'PY'
 import csv, sys
 rows = list(csv.DictReader(open(sys.argv[1])))
 print(max(float(r["mean_return"]) for r in rows if r["mean_return"]))
 PY
-)
+}
+at_least() { python3 -c "import sys; sys.exit(0 if float('$1') >= $2 else 1)"; }
+best=$(best_return "$WORK/run")
 echo "cluster: best mean return $best over $(updates) updates"
-python3 -c "import sys; sys.exit(0 if float('$best') >= 900 else 1)" ||
-  fail "best mean return $best < 900"
+at_least "$best" 900 || fail "best mean return $best < 900"
 ls run/checkpoints/checkpoint-*.pt >/dev/null 2>&1 || fail "no checkpoint kept"
+
+replica() {  # HOST RANK
+  "$HOSTS" run "$1" "$VANTAGE" learner --listen=0.0.0.0:50052 --rank="$2" \
+    --learners=2 --rendezvous=vc-learner:29500 --env=InvertedPendulum \
+    --envs=2 --horizon=1024 --algo=ppo --estimator=maxabs --rho=0.4 \
+    --steps=300000 --seed=1 --run_dir="$WORK/replicas" \
+    >>"$WORK/replica$2.log" 2>&1
+}
+replica vc-learner 0 & rank0=$!
+replica vc-actor1 1 & rank1=$!
+pids+=("$rank0" "$rank1")
+for pair in vc-actor2:vc-learner vc-actor3:vc-actor1; do
+  "$HOSTS" run "${pair%%:*}" "$VANTAGE" actor --learner="${pair#*:}:50052" \
+    --env=InvertedPendulum --envs=1 >>"$WORK/${pair%%:*}.dp.log" 2>&1 &
+  pids+=($!)
+done
+wait "$rank0" || fail "learner replica 0 failed"
+wait "$rank1" || fail "learner replica 1 failed"
+grep -q "replica 1 of 2 joined at vc-learner:29500" replica1.log ||
+  fail "replica 1 did not join replica 0 across the bridge"
+best=$(best_return "$WORK/replicas")
+echo "cluster: two replicas on two hosts, best mean return $best"
+at_least "$best" 900 || fail "two replicas: best mean return $best < 900"
 echo "PASS"
