@@ -13,12 +13,16 @@
 # 900 (a random policy gets 5-8) and keeps its checkpoints. Then two
 # data-parallel learner replicas on vc-learner and vc-actor1, averaging
 # their gradients over Gloo across the bridge, each serving the actor of
-# another host, train it to 900 as well.
+# another host, train it to 900 as well. Last, one host floods a learner
+# with registrations it never uses (valid credentials, no stream): actors on
+# the other hosts still register at once and train.
 #
-#   cluster_test.sh VANTAGE     exit 0: passed, 77: namespaces unavailable
+#   cluster_test.sh VANTAGE REGISTER_FLOOD
+#     exit 0: passed, 77: namespaces unavailable
 set -uo pipefail
 
 readonly VANTAGE=$(realpath "$1")
+readonly FLOOD=$(realpath "$2")
 readonly HOSTS="$(dirname "$(realpath "$0")")/hosts.sh"
 readonly WORK=$(mktemp -d /tmp/vantage-cluster.XXXXXX)
 pids=()
@@ -69,8 +73,8 @@ learner() {
     --run_dir="$WORK/run" --tls_cert=vc-learner.crt --tls_key=vc-learner.key \
     --tls_ca=ca.crt >>"$WORK/learner.log" 2>&1
 }
-actor() {  # HOST [ADDRESS]
-  "$HOSTS" run "$1" "$VANTAGE" actor --learner="${2:-vc-learner}:50051" \
+actor() {  # HOST [HOST:PORT]
+  "$HOSTS" run "$1" "$VANTAGE" actor --learner="${2:-vc-learner:50051}" \
     --env=InvertedPendulum --envs=1 --name="$1" --tls_cert="$1.crt" \
     --tls_key="$1.key" --tls_ca=ca.crt "${@:3}" >>"$WORK/$1.log" 2>&1
 }
@@ -90,7 +94,7 @@ for host in vc-actor1 vc-actor2 vc-actor3; do actor "$host" & pids+=($!); done
 wait_updates 5 120 || fail "no 5 updates within 120 s"
 # The learner's certificate names vc-learner, not its address: an actor that
 # dials the address cannot verify it and is refused.
-if actor vc-actor3 "$("$HOSTS" address vc-learner)" --max_reconnects=0; then
+if actor vc-actor3 "$("$HOSTS" address vc-learner):50051" --max_reconnects=0; then
   fail "an actor that dialled the learner's bare address was let in"
 fi
 grep -q "giving up after 0 reconnects: registration: .*\(certificate\|handshake\|SSL\|ssl\|TLS\|tls\)" \
@@ -148,4 +152,42 @@ grep -q "replica 1 of 2 joined at vc-learner:29500" replica1.log ||
 best=$(best_return "$WORK/replicas")
 echo "cluster: two replicas on two hosts, best mean return $best"
 at_least "$best" 900 || fail "two replicas: best mean return $best < 900"
+
+"$HOSTS" run vc-learner "$VANTAGE" learner --listen=0.0.0.0:50053 \
+  --env=InvertedPendulum --envs=2 --horizon=256 --steps=20480 --seed=2 \
+  --run_dir="$WORK/flooded" --tls_cert=vc-learner.crt --tls_key=vc-learner.key \
+  --tls_ca=ca.crt >>"$WORK/flooded.log" 2>&1 &
+flooded=$!
+pids+=("$flooded")
+for _ in $(seq 1 200); do
+  grep -q "serving on port" flooded.log && break
+  sleep 0.05
+done
+"$HOSTS" run vc-actor3 "$FLOOD" vc-learner:50053 12 InvertedPendulum \
+  vc-actor3.crt vc-actor3.key ca.crt >"$WORK/flood.out" 2>&1 &
+flood=$!
+pids+=("$flood")
+sleep 3  # the flood is on
+registrations() { grep -c "registered as actor" "$1.log"; }
+declare -A before
+for host in vc-actor1 vc-actor2; do before[$host]=$(registrations "$host"); done
+started=$(date +%s%N)
+for host in vc-actor1 vc-actor2; do
+  actor "$host" vc-learner:50053 &
+  pids+=($!)
+done
+for host in vc-actor1 vc-actor2; do
+  for _ in $(seq 1 100); do
+    [ "$(registrations "$host")" -gt "${before[$host]}" ] && break
+    sleep 0.05
+  done
+done
+took=$(( ($(date +%s%N) - started) / 1000000 ))
+wait "$flood"
+cat flood.out
+echo "cluster: during the flood, the other hosts' actors registered within ${took} ms"
+[ "$took" -le 5000 ] || fail "actors waited ${took} ms to register during a flood"
+grep -q "register_flood: code 8" flood.out ||
+  fail "the flooding host was never refused (RESOURCE_EXHAUSTED)"
+wait "$flooded" || fail "the flooded learner did not finish"
 echo "PASS"
