@@ -354,6 +354,26 @@ TEST(DistributedTest, ASyncLearnerServedByFewerActorsThanPlannedTrainsOn) {
   EXPECT_EQ(ProgressValues(run, "rejected_segments").back(), "0");
 }
 
+// An asynchronous run served by fewer actors than planned fills its
+// batches too: the one actor's grant grows until it can (its lead of two
+// versions' grants would otherwise run out before the batch is full).
+TEST(DistributedTest, AnAsynchronousLearnerServedByFewerActorsTrainsOn) {
+  const std::string run = FreshDirectory("short_async");
+  const Learner learner = StartLearner(
+      "--steps=4096 --horizon=256 --envs=8 --nosync --max_policy_lag=4 "
+      "--seed=3 --run_dir=" +
+      run);
+  const int actor = StartVantage(ActorCommand(learner, 1), TempPath("a.out"),
+                                 TempPath("a.err"));
+  EXPECT_EQ(WaitVantage(learner.pid, 120), 0) << ReadFile(learner.err);
+  EXPECT_EQ(WaitVantage(actor, 20), 0);
+  EXPECT_THAT(ReadFile(learner.err),
+              HasSubstr("1 actors with 1 env slots are live (the run plans 8) "
+                        "and have sent their grant"));
+  EXPECT_EQ(ProgressValues(run, "batch_actors"),
+            (std::vector<std::string>{"1", "1"}));
+}
+
 // More actors than planned make bigger batches, sooner: every slot acts one
 // horizon per version, and every rollout they send is trained on (none is
 // stale, none thrown away).

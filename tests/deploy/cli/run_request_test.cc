@@ -176,6 +176,53 @@ TEST(RunRequestTest, ResumingRefusesChangesAndOtherDirectories) {
               HasSubstr("drop --config and --run_dir"));
 }
 
+// The actors serving a run are not the run (the learner's pool is
+// elastic): a resumed run takes another --actors, --envs_per_actor or
+// --actor_stall_timeout_s and keeps its batch; any other flag is refused,
+// and --resume_if_exists recognises its run under another layout.
+TEST(RunRequestTest, AResumedRunMayBeServedByOtherActors) {
+  const std::string dir = FreshDirectory("served_by_others");
+  RunRequest original =
+      FromJson(R"({"training": {"steps": 4096}, "distributed": {"actors": 2, )"
+               R"("envs_per_actor": 2}})");
+  original.run_dir = dir;
+  absl::StatusOr<ResolvedRun> first = ResolveRunRequest(original);
+  ASSERT_TRUE(first.ok()) << first.status();
+  ASSERT_TRUE(
+      RunDirectory::Create(dir, first->plan.recording.config_json).ok());
+  std::ofstream(dir + "/checkpoints/checkpoint-00000002.pt") << "x";
+
+  RunRequest more =
+      FromJson(R"({"distributed": {"actors": 5, "envs_per_actor": 1, )"
+               R"("actor_stall_timeout_s": 20}})");
+  more.given_flags = {"actors", "envs_per_actor", "actor_stall_timeout_s"};
+  more.resume = dir;
+  absl::StatusOr<ResolvedRun> resumed = ResolveRunRequest(more);
+  ASSERT_TRUE(resumed.ok()) << resumed.status();
+  EXPECT_EQ(resumed->config.distributed().actors(), 5);
+  EXPECT_EQ(resumed->config.distributed().envs_per_actor(), 1);
+  EXPECT_EQ(resumed->config.distributed().actor_stall_timeout_s(), 20);
+  EXPECT_EQ(resumed->config.training().envs(), 4);  // the batch stays
+  EXPECT_EQ(resumed->plan.learner.rollouts_per_batch, 4);
+
+  RunRequest steps = FromJson(R"({"training": {"steps": 8192}})");
+  steps.given_flags = {"actors", "steps"};
+  steps.resume = dir;
+  EXPECT_THAT(std::string(ResolveRunRequest(steps).status().message()),
+              HasSubstr("(only --actors, --envs_per_actor and "
+                        "--actor_stall_timeout_s may change); drop --steps"));
+
+  RunRequest again =
+      FromJson(R"({"training": {"steps": 4096, "envs": 4}, "distributed": )"
+               R"({"actors": 3, "envs_per_actor": 1}})");
+  again.run_dir = dir;
+  again.resume_if_exists = true;
+  absl::StatusOr<ResolvedRun> continued = ResolveRunRequest(again);
+  ASSERT_TRUE(continued.ok()) << continued.status();
+  EXPECT_TRUE(continued->plan.recording.resume);
+  EXPECT_EQ(continued->config.distributed().actors(), 3);
+}
+
 TEST(RunRequestTest, ARunThatCannotStartIsRefusedBeforeItStarts) {
   absl::StatusOr<ResolvedRun> unknown =
       ResolveRunRequest(FromJson(R"({"training": {"env": "Nope"}})"));
