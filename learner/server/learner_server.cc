@@ -143,6 +143,15 @@ class LearnerProcess {
 
  private:
   LearnerConfig LearnerConfigFor(const EnvSpec& spec) const;
+  // The gateway of this learner, its segments `segment_length` steps.
+  GatewayConfig GatewayConfigFor(int64_t segment_length) const;
+  // The env slots the run plans for this learner (its share of
+  // distributed.actors x envs_per_actor).
+  int64_t planned_env_slots() const {
+    const pb::DistributedSettings& layout = config_.run_config.distributed();
+    return static_cast<int64_t>(layout.actors()) * layout.envs_per_actor() /
+           std::max(1, config_.replicas.world_size);
+  }
   absl::Status RestoreServerState(const std::string& path,
                                   const CheckpointExtras& extras);
   absl::StatusOr<CheckpointExtras> ServerState() const {
@@ -248,6 +257,29 @@ absl::Status LearnerProcess::Open() {
   return absl::OkStatus();
 }
 
+GatewayConfig LearnerProcess::GatewayConfigFor(int64_t segment_length) const {
+  const pb::DistributedSettings& layout = config_.run_config.distributed();
+  GatewayConfig gateway;
+  gateway.run_config = config_.run_config;
+  gateway.max_segment_steps = segment_length;
+  gateway.max_policy_lag = layout.max_policy_lag();
+  gateway.first_actor_id = first_actor_id_;
+  gateway.spec = config_.spec;
+  gateway.limits = config_.limits;
+  gateway.batch_rollouts = own_streams_;
+  // An actor paces whole horizons of whole segments.
+  gateway.horizon_steps =
+      std::max<int64_t>(
+          1, config_.learner.horizon / std::max<int64_t>(1, segment_length)) *
+      segment_length;
+  gateway.lead =
+      layout.sync() ? 0 : std::min<int64_t>(2, layout.max_policy_lag());
+  gateway.stall_timeout = layout.has_actor_stall_timeout_s()
+                              ? absl::Seconds(layout.actor_stall_timeout_s())
+                              : absl::ZeroDuration();
+  return gateway;
+}
+
 absl::Status LearnerProcess::Serve() {
   const pb::RunConfig& run_config = config_.run_config;
   const int64_t segment_length = run_config.training().segment_length();
@@ -262,30 +294,11 @@ absl::Status LearnerProcess::Serve() {
   queue_ = std::make_unique<SegmentQueue>(
       static_cast<size_t>(std::max<int64_t>(8, 2 * batch_segments)),
       /*checked=*/true);
-  GatewayConfig gateway_config;
-  gateway_config.run_config = run_config;
-  gateway_config.max_segment_steps = segment_length;
-  gateway_config.max_policy_lag = run_config.distributed().max_policy_lag();
-  gateway_config.first_actor_id = first_actor_id_;
-  gateway_config.spec = config_.spec;
-  gateway_config.limits = config_.limits;
+  gateway_ =
+      std::make_unique<ActorGateway>(GatewayConfigFor(segment_length), *queue_);
   const pb::DistributedSettings& layout = run_config.distributed();
-  gateway_config.batch_rollouts = own_streams_;
-  gateway_config.horizon_steps =
-      std::max<int64_t>(
-          1, config_.learner.horizon / std::max<int64_t>(1, segment_length)) *
-      segment_length;
-  gateway_config.lead =
-      layout.sync() ? 0 : std::min<int64_t>(2, layout.max_policy_lag());
-  gateway_config.stall_timeout =
-      layout.has_actor_stall_timeout_s()
-          ? absl::Seconds(layout.actor_stall_timeout_s())
-          : absl::ZeroDuration();
-  gateway_ = std::make_unique<ActorGateway>(gateway_config, *queue_);
   plan_ = std::make_unique<ElasticBatchPlan>(
-      *gateway_, layout.sync(), own_streams_,
-      static_cast<int64_t>(layout.actors()) * layout.envs_per_actor() /
-          std::max(1, config_.replicas.world_size),
+      *gateway_, layout.sync(), own_streams_, planned_env_slots(),
       [this] { return static_cast<int64_t>(queue_->size()); });
   run_->learner().SetBatchPlan(plan_.get());
   // Nothing larger than the run's largest valid segment is ever read.
@@ -331,10 +344,7 @@ absl::Status LearnerProcess::StartMetrics() {
 }
 
 void LearnerProcess::Watch() {
-  const pb::DistributedSettings& layout = config_.run_config.distributed();
-  PoolNotice notice(static_cast<int64_t>(layout.actors()) *
-                    layout.envs_per_actor() /
-                    std::max(1, config_.replicas.world_size));
+  PoolNotice notice(planned_env_slots());
   int64_t ticks = 0;
   while (!stop_ && !gateway_->closed()) {
     std::this_thread::sleep_for(std::chrono::milliseconds(50));
