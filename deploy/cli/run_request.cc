@@ -72,8 +72,12 @@ absl::Status CheckNoOverrides(const RunRequest& request) {
 
 // The serving flags given with --resume, over the run's own config.
 void ApplyServingFlags(const RunRequest& request, pb::RunConfig& config) {
-  pb::DistributedSettings& d = *config.mutable_distributed();
   const pb::DistributedSettings& given = request.flags.distributed();
+  if (!given.has_actors() && !given.has_envs_per_actor() &&
+      !given.has_actor_stall_timeout_s()) {
+    return;  // a local run has no distributed section to touch
+  }
+  pb::DistributedSettings& d = *config.mutable_distributed();
   if (given.has_actors()) d.set_actors(given.actors());
   if (given.has_envs_per_actor()) d.set_envs_per_actor(given.envs_per_actor());
   if (given.has_actor_stall_timeout_s()) {

@@ -98,17 +98,23 @@ TEST(ChaosTest, TheRunSurvivesKilledActorsAndLearners) {
   EXPECT_EQ(static_cast<int>(seeds.size()), lives) << log;
 
   const std::vector<std::string> rows = DeterministicProgress(run);
-  // 120000 steps of 2 x 256-step rollouts: 235 updates (the last batch
-  // passes the step count).
-  ASSERT_EQ(rows.size(), 1u + 235);
+  // 120000 steps of batches of at least 2 x 256-step rollouts: at most 235
+  // updates (the last batch passes the step count). A batch is larger
+  // while one actor stands in for a killed one (its grant grows) and the
+  // restarted one joins it, so a few updates fewer, never a gap.
+  ASSERT_LE(rows.size(), 1u + 235);
+  ASSERT_GE(rows.size(), 1u + 200);
+  int64_t last_steps = 0;
   for (size_t v = 1; v < rows.size(); ++v) {
     const std::vector<std::string> fields = absl::StrSplit(rows[v], ',');
     ASSERT_GE(fields.size(), 3u);
+    last_steps = std::stoll(fields[0]);
     EXPECT_EQ(fields[1], std::to_string(v)) << rows[v];
     EXPECT_EQ(fields[2], std::to_string(v)) << rows[v];
     EXPECT_THAT(rows[v], ::testing::Not(HasSubstr("nan"))) << rows[v];
     EXPECT_THAT(rows[v], ::testing::Not(HasSubstr("inf"))) << rows[v];
   }
+  EXPECT_GE(last_steps, 120000);
   int checkpoints = 0;
   for (const auto& entry :
        std::filesystem::directory_iterator(run + "/checkpoints")) {
