@@ -12,6 +12,7 @@
 #include "actor/envs/bullet/bullet_hopper.h"
 #include "actor/envs/bullet/terrain_biped.h"
 #include "actor/envs/maze/first_person_maze.h"
+#include "actor/envs/memory/cue_recall.h"
 #include "actor/envs/minatar/minatar_env.h"
 #include "actor/envs/mujoco/gym_tasks.h"
 #include "actor/envs/mujoco/humanoid_env.h"
@@ -47,6 +48,7 @@ const std::map<std::string, Factory>& Factories() {
         {"BipedWalkFlat", Plain(MakeBipedWalkFlat)},
         {"BipedWalkIncline", Plain(MakeBipedWalkIncline)},
         {"BulletHopper", Plain(MakeBulletHopper)},
+        {"CueRecall", MakeCueRecall},
         {"FirstPersonMaze", Plain(MakeFirstPersonMaze)},
         {"Humanoid", Plain(MakeHumanoid)},
         {"InvertedDoublePendulum", Plain(MakeInvertedDoublePendulum)},
@@ -107,6 +109,7 @@ absl::StatusOr<std::unique_ptr<Environment>> MakeEnvironment(
 }
 
 std::vector<EnvOptionInfo> EnvironmentOptions(const std::string& name) {
+  if (name == "CueRecall") return CueRecallOptions();
   return GymTaskOptions(name);
 }
 
