@@ -148,6 +148,10 @@ std::vector<EnvOption> LocomotionOptions(LocomotionTask& task) {
       {"sparse_either_way",
        "the sparse reward pays beyond the threshold either way",
        &task.sparse_either_way},
+      {"hide_velocities",
+       "observe positions only (partially observable: velocities must be "
+       "inferred over time)",
+       &task.hide_velocities},
   };
 }
 

@@ -69,7 +69,7 @@ class LocomotionEnv : public MujocoEnv {
     const mjData* d = data();
     double* out = observation;
     for (int i = task_.observe_qpos_from; i < m->nq; ++i) *out++ = d->qpos[i];
-    for (int i = 0; i < m->nv; ++i) {
+    for (int i = 0; !task_.hide_velocities && i < m->nv; ++i) {
       *out++ = std::clamp(d->qvel[i], -task_.qvel_clip, task_.qvel_clip);
     }
     if (task_.subtree_com) {
@@ -140,7 +140,8 @@ absl::StatusOr<std::unique_ptr<Environment>> MakeLocomotionEnv(
     return absl::InvalidArgumentError(
         absl::StrCat(task.name, ": subtree_com needs a forward body"));
   }
-  spec.observation_size = model->nq - task.observe_qpos_from + model->nv +
+  spec.observation_size = model->nq - task.observe_qpos_from +
+                          (task.hide_velocities ? 0 : model->nv) +
                           (task.subtree_com ? 3 : 0);
   spec.max_episode_steps = task.max_episode_steps;
   return std::unique_ptr<Environment>(new LocomotionEnv(

@@ -38,6 +38,9 @@ struct LocomotionTask {
   // Observation = (qpos[observe_qpos_from:], clip(qvel, +-qvel_clip)).
   int observe_qpos_from = 0;
   double qvel_clip = std::numeric_limits<double>::infinity();
+  // Positions only, no qvel: a partially observable task (velocities must
+  // be inferred from the positions seen over time).
+  bool hide_velocities = false;
   // Reset: qpos += U(-noise, noise); qvel += noise * N(0, 1) if
   // normal_qvel_noise, else U(-noise, noise).
   double reset_noise = 0.0;

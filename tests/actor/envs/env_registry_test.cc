@@ -345,6 +345,30 @@ TEST(EnvOptionsTest, AVariantIsTheTaskWithOptions) {
   EXPECT_EQ(silent->reward, 0.0);
 }
 
+// hide_velocities: the same task observed through its positions alone.
+TEST(EnvOptionsTest, HiddenVelocitiesLeaveThePositions) {
+  std::unique_ptr<Environment> full = Make("HalfCheetah");
+  std::unique_ptr<Environment> hidden =
+      Make("HalfCheetah:hide_velocities=true");
+  ASSERT_NE(full, nullptr);
+  ASSERT_NE(hidden, nullptr);
+  ASSERT_EQ(full->spec().observation_size, 17);
+  ASSERT_EQ(hidden->spec().observation_size, 8);  // qpos less the x
+  std::vector<double> seen(17), positions(8);
+  ASSERT_TRUE(full->Reset(4, absl::MakeSpan(seen)).ok());
+  ASSERT_TRUE(hidden->Reset(4, absl::MakeSpan(positions)).ok());
+  const std::vector<double> push(6, 0.5);
+  for (int t = 0; t < 20; ++t) {
+    EXPECT_EQ(positions, std::vector<double>(seen.begin(), seen.begin() + 8))
+        << "step " << t;
+    absl::StatusOr<StepResult> a = full->Step(push, absl::MakeSpan(seen));
+    absl::StatusOr<StepResult> b =
+        hidden->Step(push, absl::MakeSpan(positions));
+    ASSERT_TRUE(a.ok() && b.ok());
+    EXPECT_EQ(a->reward, b->reward);
+  }
+}
+
 TEST(EnvOptionsTest, BadOptionsAreRefusedByName) {
   const std::pair<std::string, std::string> cases[] = {
       {"HalfCheetah:bogus=1",
