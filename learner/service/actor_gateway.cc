@@ -139,7 +139,12 @@ absl::StatusOr<int64_t> ActorGateway::AddRegistration(
   Registration& registration = actors_[actor_id];
   registration.secret = secret;
   registration.peer = std::string(peer);
+  // For the learner's log: at most 128 printable characters (a name is
+  // whatever the client sent).
   registration.name = request.actor_name().substr(0, 128);
+  for (char& c : registration.name) {
+    if (c < 0x20 || c > 0x7e) c = '?';
+  }
   registration.num_envs = num_envs;
   registration.admitted = HorizonPacer(config_.lead);
   registration.next_sequence.assign(num_envs, 0);

@@ -82,10 +82,11 @@ class ElasticPoolTest : public ::testing::Test {
 
   // Registers an actor of `slots` env slots, with a call open unless
   // `attach` is false; returns its id.
-  int64_t Join(int64_t slots, bool attach = true) {
+  int64_t Join(int64_t slots, bool attach = true,
+               const std::string& name = "pool-actor") {
     pb::RegisterRequest request;
     EnvSpecToProto(PendulumSpec(), request.mutable_spec());
-    request.set_actor_name("pool-actor");
+    request.set_actor_name(name);
     request.set_num_envs(static_cast<int32_t>(slots));
     absl::StatusOr<pb::RegisterResponse> response =
         gateway_->Register(request, "10.0.0.7", absl::Seconds(5));
@@ -167,7 +168,8 @@ TEST_F(ElasticPoolTest, AnActorThatOwesSegmentsAndSendsNoneExpiresAsStalled) {
   Start(/*batch=*/2);
   gateway_->Publish(Weights(0));
   const int64_t sender = Join(1);
-  const int64_t silent = Join(1);
+  // A name is the client's: the log gets it printable.
+  const int64_t silent = Join(1, true, "pool-actor\nlearner: forged");
   SendHorizon(sender, 1, 0);  // its whole grant: it owes nothing
   const absl::Time now = absl::Now();
   EXPECT_TRUE(gateway_->ExpireStalled(now).empty());
@@ -175,7 +177,7 @@ TEST_F(ElasticPoolTest, AnActorThatOwesSegmentsAndSendsNoneExpiresAsStalled) {
       gateway_->ExpireStalled(now + absl::Seconds(11));
   ASSERT_EQ(stalled.size(), 1u);
   EXPECT_EQ(stalled[0].actor_id, silent);
-  EXPECT_EQ(stalled[0].name, "pool-actor");
+  EXPECT_EQ(stalled[0].name, "pool-actor?learner: forged");
   EXPECT_EQ(stalled[0].peer, "10.0.0.7");
   EXPECT_EQ(stalled[0].owed_steps, kSteps);
   const GatewayCounters counters = gateway_->counters();
