@@ -11,18 +11,13 @@
 #include "absl/strings/str_cat.h"
 #include "common/nn/cpu_sampling.h"
 #include "common/nn/distributions.h"
+#include "common/nn/float_copy.h"
 #include "common/nn/networks.h"
 #include "common/nn/running_mean_std.h"
 #include "common/util/scratch_buffer.h"
 
 namespace vantage {
 namespace {
-
-std::vector<float> FloatVector(const at::Tensor& tensor) {
-  const at::Tensor flat = tensor.detach().to(at::kFloat).contiguous();
-  return std::vector<float>(flat.data_ptr<float>(),
-                            flat.data_ptr<float>() + flat.numel());
-}
 
 std::vector<double> DoubleVector(const at::Tensor& tensor) {
   const at::Tensor flat = tensor.detach().to(at::kDouble).contiguous();

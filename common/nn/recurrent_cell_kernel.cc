@@ -3,18 +3,14 @@
 #include <ATen/ATen.h>
 #include <cblas.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "absl/strings/str_cat.h"
+#include "common/nn/float_copy.h"
 
 namespace vantage {
 namespace {
-
-std::vector<float> FloatVector(const at::Tensor& tensor) {
-  const at::Tensor flat = tensor.detach().to(at::kFloat).contiguous();
-  return std::vector<float>(flat.data_ptr<float>(),
-                            flat.data_ptr<float>() + flat.numel());
-}
 
 float Sigmoid(float x) { return 1.0f / (1.0f + std::exp(-x)); }
 

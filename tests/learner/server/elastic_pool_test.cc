@@ -8,6 +8,7 @@
 #include <map>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "absl/time/clock.h"
@@ -102,6 +103,21 @@ class ElasticPoolTest : public ::testing::Test {
           gateway_->Admit(id, SegmentOf(id, slot, version, sequence_[id]++))
               .ok());
     }
+  }
+
+  // A sync learner of a 4-rollout batch at version 0 and two live actors of
+  // two env slots each (the run's plan); returns their ids.
+  std::pair<int64_t, int64_t> StartSyncPool() {
+    Start(/*batch=*/4);
+    gateway_->Publish(Weights(0));
+    const int64_t a = Join(2);
+    return {a, Join(2)};
+  }
+  // Its plan, raising without a grace.
+  ElasticBatchPlan SyncPlan() {
+    return ElasticBatchPlan(
+        *gateway_, /*sync=*/true, 4, /*planned_slots=*/4, [] { return 0; },
+        absl::ZeroDuration());
   }
 
   int64_t Horizons() {
@@ -205,13 +221,8 @@ TEST_F(ElasticPoolTest, AWaitingActorIsNoStallNorIsANewGrantAtOnce) {
 }
 
 TEST_F(ElasticPoolTest, ASyncBatchWaitsForEveryLiveActorThenClosesTheGrant) {
-  Start(/*batch=*/4);
-  gateway_->Publish(Weights(0));
-  const int64_t a = Join(2);
-  const int64_t b = Join(2);
-  ElasticBatchPlan plan(
-      *gateway_, /*sync=*/true, 4, /*planned_slots=*/4, [] { return 0; },
-      absl::ZeroDuration());
+  const auto [a, b] = StartSyncPool();
+  ElasticBatchPlan plan = SyncPlan();
   EXPECT_EQ(plan.BatchSize(0, {{a, 2}}, 2), 0);  // b owes its horizon
   // A newcomer during the version takes the grant in force and is waited
   // for: the batch grows.
@@ -223,13 +234,8 @@ TEST_F(ElasticPoolTest, ASyncBatchWaitsForEveryLiveActorThenClosesTheGrant) {
 }
 
 TEST_F(ElasticPoolTest, ASyncBatchShortOfActorsRaisesTheGrant) {
-  Start(/*batch=*/4);
-  gateway_->Publish(Weights(0));
-  const int64_t a = Join(2);
-  const int64_t b = Join(2);
-  ElasticBatchPlan plan(
-      *gateway_, /*sync=*/true, 4, /*planned_slots=*/4, [] { return 0; },
-      absl::ZeroDuration());
+  const auto [a, b] = StartSyncPool();
+  ElasticBatchPlan plan = SyncPlan();
   gateway_->Detach(b);  // b left after sending one of its slots' rollouts
   EXPECT_EQ(plan.BatchSize(0, {{a, 2}, {b, 1}}, 3), 0);
   EXPECT_EQ(Horizons(), 2);  // a's two slots act one more horizon each
