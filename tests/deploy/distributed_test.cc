@@ -426,7 +426,7 @@ TEST(DistributedTest, AKilledActorDoesNotStallASyncLearner) {
 TEST(DistributedTest, PrometheusCountersAgreeWithProgressCsv) {
   const std::string run = FreshDirectory("metrics");
   const Learner learner = StartLearner(
-      "--steps=6144 --horizon=256 --envs=2 --seed=2 --metrics=127.0.0.1:0 "
+      "--steps=12288 --horizon=256 --envs=2 --seed=2 --metrics=127.0.0.1:0 "
       "--run_dir=" +
       run);
   const std::string actor_err = TempPath("actor.err");
@@ -440,15 +440,21 @@ TEST(DistributedTest, PrometheusCountersAgreeWithProgressCsv) {
   ASSERT_GT(actor_port, 0) << ReadFile(actor_err);
   int agreeing = 0;
   double actor_steps = 0;
-  // Scrape while the learner runs (WaitVantage reaps it later).
-  for (int i = 0; i < 600 && agreeing < 3 && kill(learner.pid, 0) == 0; ++i) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  // Scrape while the learner serves (an exited learner stays a zombie until
+  // WaitVantage reaps it, so its endpoint going away ends the loop). Two
+  // scrapes take about as long as an update here: 24 updates give several
+  // chances to land between two.
+  bool served = false;
+  for (int i = 0; i < 1200 && agreeing < 3; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
     absl::StatusOr<std::string> text = HttpGet(learner_port, "/metrics");
     absl::StatusOr<std::string> actor_text = HttpGet(actor_port, "/metrics");
     if (actor_text.ok()) {
       actor_steps = Sample(*actor_text, "vantage_actor_env_steps_total");
     }
+    if (!text.ok() && served) break;
     if (!text.ok()) continue;
+    served = true;
     const int version =
         static_cast<int>(Sample(*text, "vantage_learner_policy_version"));
     const std::vector<std::string> rows = DeterministicProgress(run);
