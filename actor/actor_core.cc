@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <mutex>
@@ -57,10 +58,9 @@ absl::StatusOr<std::unique_ptr<ActorCore>> ActorCore::Create(
   absl::StatusOr<std::unique_ptr<VectorEnv>> envs = VectorEnv::Create(
       config.env, config.num_envs, config.seed, config.env_options);
   if (!envs.ok()) return envs.status();
-  if (absl::StatusOr<Torso> torso =
-          ResolveTorso(config.network.torso, (*envs)->spec());
-      !torso.ok()) {
-    return torso.status();
+  if (absl::Status status = CheckNetworkConfig(config.network, (*envs)->spec());
+      !status.ok()) {
+    return status;
   }
   if (absl::Status status = (*envs)->Reset(); !status.ok()) return status;
   return std::unique_ptr<ActorCore>(new ActorCore(config, std::move(*envs)));
@@ -75,7 +75,8 @@ ActorCore::ActorCore(const ActorConfig& config, std::unique_ptr<VectorEnv> envs)
       generator_(at::make_generator<at::CPUGeneratorImpl>(
           config.seed * 0x9E3779B97F4A7C15ULL + config.actor_id + 1)),
       stream_actor_id_(config.actor_id),
-      next_sequence_(config.num_envs, 0) {}
+      next_sequence_(config.num_envs, 0),
+      core_states_(config.num_envs * config.network.core_state_size(), 0.0f) {}
 
 absl::Status ActorCore::SetWeights(const PolicyWeights& weights) {
   if (absl::Status status = ImportPolicyWeights(weights, *policy_, normalizer_);
@@ -106,11 +107,24 @@ void ActorCore::Act(const at::Tensor& observations_row, float* actions,
   const int64_t width = spec().discrete ? 1 : spec().action_size;
   if (kernel_) {
     kernel_outputs_.resize(m * kernel_->output_size());
-    kernel_->Forward(envs_->observations().data(), m, kernel_outputs_.data());
+    kernel_->Forward(envs_->observations().data(), m, kernel_outputs_.data(),
+                     core_states_.data());
     kernel_->Act(kernel_outputs_.data(), m, generator_, actions, log_probs);
   } else {
-    const at::Tensor output = policy_->forward(ObservationsForNetwork(
-        spec(), normalizer_, observations_row, config_.observation_clip));
+    const at::Tensor inputs = ObservationsForNetwork(
+        spec(), normalizer_, observations_row, config_.observation_clip);
+    at::Tensor output;
+    if (policy_->recurrent()) {
+      // The states stay in core_states_: LibTorch writes its next ones there.
+      at::Tensor states =
+          at::from_blob(core_states_.data(),
+                        {m, static_cast<int64_t>(core_states_.size()) / m});
+      output = policy_->Step(inputs, states);
+      std::copy_n(states.contiguous().data_ptr<float>(), core_states_.size(),
+                  core_states_.data());
+    } else {
+      output = policy_->forward(inputs);
+    }
     const at::Tensor action = policy_->Act(output, false, generator_);
     const at::Tensor log_prob = policy_->LogProb(output, action);
     std::copy_n(action.contiguous().data_ptr<float>(), m * width, actions);
@@ -151,6 +165,8 @@ struct ActorCore::Rollout {
   at::Tensor truncated;
   // Per slot: the observations its truncated episodes ended on.
   std::vector<std::vector<at::Tensor>> finals;
+  // A recurrent policy's state before step 0 [m, state size].
+  at::Tensor core_states;
   std::vector<Segment> segments;
 };
 
@@ -166,6 +182,13 @@ absl::Status ActorCore::CollectSegments(SegmentSink& sink) {
 
   at::NoGradGuard no_grad;
   StoreObservations(envs_->observations(), rollout.observations[0]);
+  if (!core_states_.empty()) {
+    rollout.core_states =
+        at::from_blob(
+            core_states_.data(),
+            {rollout.m, static_cast<int64_t>(core_states_.size()) / rollout.m})
+            .clone();
+  }
   for (int64_t t = 0; t < rollout.steps; ++t) {
     if (absl::Status status = CollectStep(t, rollout); !status.ok()) {
       return status;
@@ -199,10 +222,15 @@ void ActorCore::RecordStep(int64_t t, Rollout& rollout) {
   float* reward_row = rollout.rewards.data_ptr<float>() + t * m;
   bool* terminated_row = rollout.terminated.data_ptr<bool>() + t * m;
   bool* truncated_row = rollout.truncated.data_ptr<bool>() + t * m;
+  const size_t state_size = core_states_.size() / m;
   for (int64_t i = 0; i < m; ++i) {
     reward_row[i] = static_cast<float>(envs_->rewards()[i]);
     terminated_row[i] = envs_->terminated()[i] != 0;
     truncated_row[i] = envs_->truncated()[i] != 0;
+    // The environment reset: the next step starts an episode.
+    if (terminated_row[i] || truncated_row[i]) {
+      std::fill_n(core_states_.begin() + i * state_size, state_size, 0.0f);
+    }
   }
   for (const FinishedEpisode& episode : envs_->finished()) {
     Segment& segment = rollout.segments[episode.env_index];
@@ -237,6 +265,9 @@ absl::Status ActorCore::SendSegments(Rollout& rollout, SegmentSink& sink) {
         rollout.finals[i].empty()
             ? at::empty({0, rollout.obs}, rollout.observation_dtype)
             : at::stack(rollout.finals[i]);
+    if (rollout.core_states.defined()) {
+      segment.core_state = rollout.core_states[i].clone();
+    }
     if (absl::Status status = sink.Send(std::move(segment)); !status.ok()) {
       return status;
     }
@@ -255,6 +286,11 @@ absl::StatusOr<std::string> ActorCore::SaveState() const {
   writer.PutI64s(next_sequence_);
   writer.PutBytes(GeneratorState(generator_));
   writer.PutBytes(*envs);
+  // Only a recurrent policy's: a feed-forward actor's state is as before.
+  if (!core_states_.empty()) {
+    writer.PutDoubles(
+        std::vector<double>(core_states_.begin(), core_states_.end()));
+  }
   return std::move(writer).Finish();
 }
 
@@ -270,6 +306,14 @@ absl::Status ActorCore::RestoreState(absl::string_view state) {
       reader.GetI64s("next_sequence", next_sequence_.size());
   const absl::string_view generator = reader.GetBytes("sampling generator");
   const absl::string_view envs = reader.GetBytes("environments");
+  std::vector<double> core_states;
+  if (!core_states_.empty()) {
+    core_states =
+        reader.GetDoubles("the recurrent policy's states", core_states_.size());
+  }
+  reader.Check(std::all_of(core_states.begin(), core_states.end(),
+                           [](double v) { return std::isfinite(v); }),
+               "a non-finite recurrent state");
   reader.Check(env_steps >= 0, absl::StrCat("env_steps is ", env_steps));
   reader.Check(std::all_of(next_sequence.begin(), next_sequence.end(),
                            [](int64_t sequence) { return sequence >= 0; }),
@@ -309,6 +353,7 @@ absl::Status ActorCore::RestoreState(absl::string_view state) {
   }
   env_steps_ = env_steps;
   next_sequence_ = std::move(next_sequence);
+  std::copy(core_states.begin(), core_states.end(), core_states_.begin());
   return absl::OkStatus();
 }
 

@@ -58,7 +58,8 @@ class ActorCore {
 
   // Everything but the weights that decides the next segments: the
   // environments (VectorEnv::SaveState), the action-sampling generator,
-  // env_steps() and each slot's next sequence number, so that an actor
+  // env_steps(), each slot's next sequence number and a recurrent policy's
+  // state in each slot, so that an actor
   // restored from it continues bit for bit. The policy weights, normaliser
   // and policy_version() are not in it: after RestoreState the learner
   // sends its weights again with SetWeights (acting still needs them).
@@ -102,6 +103,9 @@ class ActorCore {
   int64_t env_steps_ = 0;
   std::vector<int64_t> next_sequence_;
   std::vector<double> actions_;
+  // A recurrent policy's state per slot [num_envs, state size], zero where
+  // an episode starts; empty for a feed-forward policy.
+  std::vector<float> core_states_;
 };
 
 }  // namespace vantage

@@ -39,7 +39,10 @@ const SettingsTable<NetworkConfig, pb::TrainingSettings>& NetworkTable() {
   static const auto* table =
       new SettingsTable<NetworkConfig, pb::TrainingSettings>(
           "training",
-          {{"hidden", &C::hidden}, {"shared_torso", &C::shared_torso}},
+          {{"hidden", &C::hidden},
+           {"shared_torso", &C::shared_torso},
+           {"core_size", &C::core_size, AtLeast(1)},
+           {"seq_len", &C::seq_len, AtLeast(0)}},
           SettingNames::kFlag);
   return *table;
 }
@@ -58,6 +61,10 @@ absl::Status ResolveNetwork(pb::TrainingSettings& training) {
                      absl::StrCat("'", training.torso(),
                                   "' is not one of auto, mlp, minatar, "
                                   "nature"));
+  }
+  if (training.has_core() && !ParseCore(training.core()).ok()) {
+    return FlagError("core", absl::StrCat("'", training.core(),
+                                          "' is not one of none, gru, lstm"));
   }
   return absl::OkStatus();
 }
@@ -91,6 +98,10 @@ absl::StatusOr<NetworkConfig> PolicyNetworkOf(const pb::RunConfig& run) {
       ParseTorso(training.has_torso() ? training.torso() : "mlp");
   if (!torso.ok()) return torso.status();
   network.torso = *torso;
+  absl::StatusOr<Core> core =
+      ParseCore(training.has_core() ? training.core() : "none");
+  if (!core.ok()) return core.status();
+  network.core = *core;
   return network;
 }
 

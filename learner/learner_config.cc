@@ -24,6 +24,19 @@ absl::Status LearnerConfig::ValidateSettings() const {
                      "networks with one optimiser; ",
                      algorithm.name, " fits its value network alone"));
   }
+  if (network.recurrent() && !AlgorithmStepsBothNetworksAtOnce(algorithm)) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "--core=", CoreName(network.core),
+        " needs ppo or a2c: the policy and the value network share the core "
+        "and step with one optimiser; ",
+        algorithm.name, " fits its value network alone"));
+  }
+  if (network.recurrent() &&
+      (network.seq_len < 1 || horizon % network.seq_len != 0)) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "--seq_len (", network.seq_len, ") must divide --horizon (", horizon,
+        ") for a recurrent --core"));
+  }
   if (horizon < 1 || rollouts_per_batch < 1 || total_env_steps < 1) {
     return absl::InvalidArgumentError(
         "learner horizon, rollouts_per_batch and total_env_steps must be "

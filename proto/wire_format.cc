@@ -227,6 +227,9 @@ void SegmentToProto(const Segment& segment, pb::Segment* proto) {
     TensorToProto(segment.behaviour_log_probs,
                   proto->mutable_behaviour_log_probs());
   }
+  if (segment.core_state.defined()) {
+    TensorToProto(segment.core_state, proto->mutable_core_state());
+  }
   proto->mutable_episode_returns()->Add(segment.episode_returns.begin(),
                                         segment.episode_returns.end());
   proto->mutable_episode_lengths()->Add(segment.episode_lengths.begin(),
@@ -274,6 +277,13 @@ absl::StatusOr<Segment> SegmentFromProto(const pb::Segment& proto,
     if (!tensor.ok()) return tensor.status();
     *field.out = *std::move(tensor);
   }
+  // Optional: only a recurrent policy's segments carry it.
+  if (proto.has_core_state()) {
+    absl::StatusOr<at::Tensor> state = DecodeField(
+        true, proto.core_state(), "segment.core_state", kFloat, max_bytes);
+    if (!state.ok()) return state.status();
+    segment.core_state = *std::move(state);
+  }
   segment.episode_returns.assign(proto.episode_returns().begin(),
                                  proto.episode_returns().end());
   segment.episode_lengths.assign(proto.episode_lengths().begin(),
@@ -281,7 +291,8 @@ absl::StatusOr<Segment> SegmentFromProto(const pb::Segment& proto,
   return segment;
 }
 
-int64_t MaxSegmentMessageBytes(const EnvSpec& spec, int64_t max_steps) {
+int64_t MaxSegmentMessageBytes(const EnvSpec& spec, int64_t max_steps,
+                               int64_t core_state_size) {
   const int64_t t = std::max<int64_t>(1, max_steps);
   const int64_t act = spec.discrete ? 1 : spec.action_size;
   // observations [T+1, obs] and at most T final observations, float32 or
@@ -290,7 +301,7 @@ int64_t MaxSegmentMessageBytes(const EnvSpec& spec, int64_t max_steps) {
   const int64_t observation_bytes = spec.byte_observations() ? 1 : 4;
   const int64_t payload =
       observation_bytes * spec.observation_size * (2 * t + 1) + 4 * act * t +
-      8 * t + 2 * t + 18 * t;
+      8 * t + 2 * t + 18 * t + 4 * core_state_size;
   // Tags, lengths, shapes and the four integers, generously.
   constexpr int64_t kFraming = 4096;
   return payload + kFraming;

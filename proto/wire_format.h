@@ -47,9 +47,11 @@ void SegmentToProto(const Segment& segment, pb::Segment* proto);
 absl::StatusOr<Segment> SegmentFromProto(const pb::Segment& proto,
                                          int64_t max_bytes);
 // An upper bound on the serialised size of any segment of at most
-// `max_steps` steps that ValidateSegment accepts for `spec`: what a learner
-// must be willing to read, and no more.
-int64_t MaxSegmentMessageBytes(const EnvSpec& spec, int64_t max_steps);
+// `max_steps` steps (and a recurrent state of `core_state_size` floats)
+// that ValidateSegment accepts for `spec`: what a learner must be willing to
+// read, and no more.
+int64_t MaxSegmentMessageBytes(const EnvSpec& spec, int64_t max_steps,
+                               int64_t core_state_size = 0);
 
 // Weight tensors must be float32 or float64 (ImportPolicyWeights converts
 // them to the policy's dtype). `max_bytes` bounds each tensor separately.

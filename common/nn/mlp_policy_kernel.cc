@@ -13,6 +13,7 @@
 #include "common/nn/distributions.h"
 #include "common/nn/float_copy.h"
 #include "common/nn/networks.h"
+#include "common/nn/recurrent_trunk.h"
 #include "common/nn/running_mean_std.h"
 #include "common/util/scratch_buffer.h"
 
@@ -46,25 +47,19 @@ absl::StatusOr<MlpPolicyKernel> MlpPolicyKernel::Create(
   kernel.clip_ = observation_clip;
   kernel.mean_ = DoubleVector(normalizer.mean());
   kernel.scale_ = DoubleVector(at::sqrt(normalizer.var() + 1e-8));
-  const torch::nn::ModuleList& layers = policy.body()->layers();
   int64_t width = spec.observation_size;
-  for (size_t i = 0; i < layers->size(); ++i) {
-    const auto& linear = layers->at<torch::nn::LinearImpl>(i);
-    Layer layer;
-    layer.outputs = linear.weight.size(0);
-    layer.inputs = linear.weight.size(1);
-    if (layer.inputs != width || !linear.bias.defined()) {
-      return absl::UnimplementedError(absl::StrCat(
-          "layer ", i, " of the policy is not a biased Linear layer on ", width,
-          " inputs"));
+  if (policy.recurrent()) {
+    if (absl::Status status = kernel.AddCore(policy, width); !status.ok()) {
+      return status;
     }
-    layer.weight = FloatVector(linear.weight);
-    layer.bias = FloatVector(linear.bias);
-    width = layer.outputs;
-    kernel.widest_ = std::max(kernel.widest_, width);
-    kernel.layers_.push_back(std::move(layer));
   }
-  if (kernel.layers_.empty() || width != spec.action_size) {
+  if (absl::Status status =
+          kernel.AddLayers(policy.body()->layers(), "policy", width);
+      !status.ok()) {
+    return status;
+  }
+  if (kernel.layers_.size() == kernel.encoder_layers_ ||
+      width != spec.action_size) {
     return absl::UnimplementedError(absl::StrCat("the policy's MLP ends in ",
                                                  width, " outputs, not ",
                                                  spec.action_size));
@@ -78,6 +73,64 @@ absl::StatusOr<MlpPolicyKernel> MlpPolicyKernel::Create(
     }
   }
   return kernel;
+}
+
+absl::Status MlpPolicyKernel::AddLayers(const torch::nn::ModuleList& mlp,
+                                        const char* name, int64_t& width) {
+  for (size_t i = 0; i < mlp->size(); ++i) {
+    const auto& linear = mlp->at<torch::nn::LinearImpl>(i);
+    Layer layer;
+    layer.outputs = linear.weight.size(0);
+    layer.inputs = linear.weight.size(1);
+    if (layer.inputs != width || !linear.bias.defined()) {
+      return absl::UnimplementedError(
+          absl::StrCat("layer ", i, " of the ", name,
+                       " is not a biased Linear layer on ", width, " inputs"));
+    }
+    layer.weight = FloatVector(linear.weight);
+    layer.bias = FloatVector(linear.bias);
+    width = layer.outputs;
+    widest_ = std::max(widest_, width);
+    layers_.push_back(std::move(layer));
+  }
+  return absl::OkStatus();
+}
+
+absl::Status MlpPolicyKernel::AddCore(PolicyNetworkImpl& policy,
+                                      int64_t& width) {
+  const RecurrentTrunk& trunk = policy.trunk();
+  if (!trunk->conv_torso().is_empty()) {
+    return absl::UnimplementedError(
+        "the policy's core follows a convolutional torso, which only "
+        "LibTorch runs");
+  }
+  if (!trunk->encoder().is_empty()) {
+    if (absl::Status status =
+            AddLayers(trunk->encoder()->layers(), "policy's encoder", width);
+        !status.ok()) {
+      return status;
+    }
+  }
+  encoder_layers_ = layers_.size();
+  absl::StatusOr<RecurrentCellKernel> cell =
+      trunk->core() == Core::kLstm
+          ? RecurrentCellKernel::Create(
+                RecurrentCellKernel::Kind::kLstm, trunk->lstm()->weight_ih,
+                trunk->lstm()->weight_hh, trunk->lstm()->bias_ih,
+                trunk->lstm()->bias_hh)
+          : RecurrentCellKernel::Create(
+                RecurrentCellKernel::Kind::kGru, trunk->gru()->weight_ih,
+                trunk->gru()->weight_hh, trunk->gru()->bias_ih,
+                trunk->gru()->bias_hh);
+  if (!cell.ok()) return cell.status();
+  if (cell->input_size() != width) {
+    return absl::UnimplementedError(absl::StrCat(
+        "the core takes ", cell->input_size(), " inputs, not ", width));
+  }
+  width = cell->hidden_size();
+  widest_ = std::max(widest_, cell->state_size());
+  cell_ = std::move(*cell);
+  return absl::OkStatus();
 }
 
 void MlpPolicyKernel::Inputs(const double* observations, int64_t rows,
@@ -108,31 +161,44 @@ void MlpPolicyKernel::Inputs(const double* observations, int64_t rows,
   }
 }
 
+void MlpPolicyKernel::Apply(const Layer& layer, const float* x, int64_t rows,
+                            bool squash, float* y) {
+  for (int64_t r = 0; r < rows; ++r) {
+    std::copy(layer.bias.begin(), layer.bias.end(), y + r * layer.outputs);
+  }
+  // y = x W^T + b: a matrix-vector product for one row.
+  if (rows == 1) {
+    cblas_sgemv(CblasRowMajor, CblasNoTrans, layer.outputs, layer.inputs, 1.0f,
+                layer.weight.data(), layer.inputs, x, 1, 1.0f, y, 1);
+  } else {
+    cblas_sgemm(CblasRowMajor, CblasNoTrans, CblasTrans, rows, layer.outputs,
+                layer.inputs, 1.0f, x, layer.inputs, layer.weight.data(),
+                layer.inputs, 1.0f, y, layer.outputs);
+  }
+  if (squash) {
+    for (int64_t i = 0; i < rows * layer.outputs; ++i) y[i] = std::tanh(y[i]);
+  }
+}
+
 void MlpPolicyKernel::Forward(const double* observations, int64_t rows,
-                              float* outputs) {
+                              float* outputs, float* states) {
   float* in = GrowScratch(buffer_a_, rows * widest_);
   float* out = GrowScratch(buffer_b_, rows * widest_);
   Inputs(observations, rows, in);
   for (size_t l = 0; l < layers_.size(); ++l) {
-    const Layer& layer = layers_[l];
+    if (cell_.has_value() && l == encoder_layers_) {
+      // The cell's next states, whose hidden parts feed the next layer.
+      cell_->Step(in, rows, states);
+      const int64_t stride = cell_->state_size();
+      const int64_t hidden = cell_->hidden_size();
+      for (int64_t r = 0; r < rows; ++r) {
+        std::copy(states + r * stride, states + r * stride + hidden,
+                  in + r * hidden);
+      }
+    }
     const bool last = l + 1 == layers_.size();
-    float* y = last ? outputs : out;
-    for (int64_t r = 0; r < rows; ++r) {
-      std::copy(layer.bias.begin(), layer.bias.end(), y + r * layer.outputs);
-    }
-    // y = x W^T + b: a matrix-vector product for one row.
-    if (rows == 1) {
-      cblas_sgemv(CblasRowMajor, CblasNoTrans, layer.outputs, layer.inputs,
-                  1.0f, layer.weight.data(), layer.inputs, in, 1, 1.0f, y, 1);
-    } else {
-      cblas_sgemm(CblasRowMajor, CblasNoTrans, CblasTrans, rows, layer.outputs,
-                  layer.inputs, 1.0f, in, layer.inputs, layer.weight.data(),
-                  layer.inputs, 1.0f, y, layer.outputs);
-    }
-    if (!last) {
-      for (int64_t i = 0; i < rows * layer.outputs; ++i) y[i] = std::tanh(y[i]);
-      std::swap(in, out);
-    }
+    Apply(layers_[l], in, rows, !last, last ? outputs : out);
+    if (!last) std::swap(in, out);
   }
 }
 

@@ -7,16 +7,24 @@
 // networks' inputs need it, each layer one BLAS call over all of an
 // actor's environments, and sampling and log-probabilities in one pass
 // that draws from the generator exactly as PolicyNetworkImpl::Act does.
-// Its outputs agree with PolicyNetworkImpl's forward, Act and LogProb up
-// to float rounding (tests/common/nn/mlp_policy_kernel_test.cc).
+// A recurrent core after the MLP (NetworkConfig::core) steps through
+// RecurrentCellKernel, its gates two BLAS calls over all environments.
+// Its outputs agree with PolicyNetworkImpl's forward (or Step), Act and
+// LogProb up to float rounding (tests/common/nn/mlp_policy_kernel_test.cc).
 
 #include <ATen/core/Generator.h>
 
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "absl/status/statusor.h"
 #include "common/env/environment.h"
+#include "common/nn/recurrent_cell_kernel.h"
+
+namespace torch::nn {
+class ModuleList;
+}  // namespace torch::nn
 
 namespace vantage {
 
@@ -37,11 +45,18 @@ class MlpPolicyKernel {
   // k action values per row, or 1 (the index, as a float) when discrete.
   int64_t action_width() const { return discrete_ ? 1 : output_size_; }
 
+  // Floats per row of a recurrent policy's state; 0 for a feed-forward one.
+  int64_t state_size() const {
+    return cell_.has_value() ? cell_->state_size() : 0;
+  }
+
   // The network's outputs [rows, output_size] for `rows` observations as
   // the environments wrote them (doubles, [rows, observation_size]): what
   // policy.forward(ObservationsForNetwork(...)) gives for them stored in
-  // the dtype segments hold.
-  void Forward(const double* observations, int64_t rows, float* outputs);
+  // the dtype segments hold. A recurrent policy reads and overwrites
+  // `states` [rows, state_size()] as PolicyNetworkImpl::Step does.
+  void Forward(const double* observations, int64_t rows, float* outputs,
+               float* states = nullptr);
   // From Forward's outputs: sampled actions [rows, action_width()] and
   // their log-probabilities [rows].
   void Act(const float* outputs, int64_t rows, at::Generator& generator,
@@ -56,7 +71,15 @@ class MlpPolicyKernel {
   };
 
   MlpPolicyKernel() = default;
+  // Copies the Linear layers of `mlp`, whose inputs must be `width` wide;
+  // `width` becomes their outputs.
+  absl::Status AddLayers(const torch::nn::ModuleList& mlp, const char* name,
+                         int64_t& width);
+  absl::Status AddCore(PolicyNetworkImpl& policy, int64_t& width);
   void Inputs(const double* observations, int64_t rows, float* inputs) const;
+  // y = x W^T + b for `rows` rows, tanh'd when `squash`.
+  static void Apply(const Layer& layer, const float* x, int64_t rows,
+                    bool squash, float* y);
 
   EnvSpec spec_;
   bool discrete_ = false;
@@ -65,6 +88,10 @@ class MlpPolicyKernel {
   std::vector<double> mean_;   // the normaliser's, [observation_size]
   std::vector<double> scale_;  // sqrt(var + 1e-8)
   std::vector<Layer> layers_;
+  // A recurrent policy's: its first encoder_layers_ layers (all tanh'd)
+  // feed the cell, the rest read its hidden state.
+  size_t encoder_layers_ = 0;
+  std::optional<RecurrentCellKernel> cell_;
   int64_t widest_ = 0;  // the widest of the inputs and every layer's outputs
   std::vector<float> log_std_;  // continuous only
   std::vector<float> std_;      // exp(log_std)

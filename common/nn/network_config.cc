@@ -56,6 +56,26 @@ std::string TorsoName(Torso torso) {
   return FindConvTorsoDesign(torso)->name;
 }
 
+absl::StatusOr<Core> ParseCore(absl::string_view name) {
+  if (name == "none") return Core::kNone;
+  if (name == "gru") return Core::kGru;
+  if (name == "lstm") return Core::kLstm;
+  return absl::InvalidArgumentError(
+      absl::StrCat("unknown core \"", name, "\"; valid: none, gru, lstm"));
+}
+
+std::string CoreName(Core core) {
+  switch (core) {
+    case Core::kGru:
+      return "gru";
+    case Core::kLstm:
+      return "lstm";
+    case Core::kNone:
+      break;
+  }
+  return "none";
+}
+
 absl::StatusOr<Torso> ResolveTorso(Torso torso, const EnvSpec& spec) {
   const std::vector<int64_t>& shape = spec.observation_shape;
   if (torso == Torso::kAuto) {
@@ -91,6 +111,14 @@ absl::Status CheckNetworkConfig(const NetworkConfig& config,
         "a shared torso needs a convolutional one, but '", spec.name,
         "' gets the mlp torso (--torso=", TorsoName(config.torso),
         "); share with --torso=minatar or nature on image observations"));
+  }
+  if (config.recurrent() && config.core_size < 1) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "--core_size must be >= 1 for --core=", CoreName(config.core)));
+  }
+  if (config.seq_len < 0) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "--seq_len must be >= 0 (0: whole segments), got ", config.seq_len));
   }
   return absl::OkStatus();
 }

@@ -57,17 +57,48 @@ const ConvTorsoDesign* FindConvTorsoDesign(Torso torso);
 // (< 1: the input is too small).
 int64_t ConvOutputSide(const ConvTorsoDesign& design, int64_t size);
 
+// A recurrent core after the torso: the policy then acts on what it has
+// seen in its episode so far, not only on the current observation.
+enum class Core {
+  kNone,
+  kGru,
+  kLstm,
+};
+
+// "none", "gru", "lstm"; an unknown name lists them.
+absl::StatusOr<Core> ParseCore(absl::string_view name);
+std::string CoreName(Core core);
+
 struct NetworkConfig {
   std::vector<int64_t> hidden = {64, 64};  // the MLP torso's layers
   Torso torso = Torso::kAuto;
+  // With a core, the torso (tanh after every --hidden layer, or the
+  // convolutions) feeds a GRU or LSTM of core_size units, and the policy's
+  // and the value's output layers both read its hidden state: one trunk for
+  // both, since the actor carries only the policy's state and a separate
+  // value core would start every rollout from a state nobody computed.
+  Core core = Core::kNone;
+  int64_t core_size = 64;
+  // Backpropagation through time over chunks of seq_len steps (0: whole
+  // segments); each chunk starts from the state the core had there.
+  int64_t seq_len = 0;
   // The value network uses the policy's convolutions instead of its own, so
   // that one trunk learns from both losses. Needs a convolutional torso,
   // and an algorithm that steps both networks with one optimiser.
   bool shared_torso = false;
+
+  bool recurrent() const { return core != Core::kNone; }
+  // Floats per environment of the core's state: the GRU's hidden state, or
+  // the LSTM's hidden and cell states one after the other; 0 without one.
+  int64_t core_state_size() const {
+    if (core == Core::kNone) return 0;
+    return core == Core::kLstm ? 2 * core_size : core_size;
+  }
 };
 
 // Why `config` cannot build networks for `spec`: a torso that does not fit
-// (ResolveTorso), or a shared torso that resolves to the MLP.
+// (ResolveTorso), a shared torso that resolves to the MLP, or a core of
+// fewer than one unit.
 absl::Status CheckNetworkConfig(const NetworkConfig& config,
                                 const EnvSpec& spec);
 

@@ -13,32 +13,6 @@
 
 namespace vantage {
 
-TanhMlpImpl::TanhMlpImpl(int64_t inputs, const std::vector<int64_t>& hidden,
-                         int64_t outputs, double output_gain) {
-  layers_ = register_module("layers", torch::nn::ModuleList());
-  int64_t width = inputs;
-  std::vector<int64_t> sizes = hidden;
-  sizes.push_back(outputs);
-  for (size_t i = 0; i < sizes.size(); ++i) {
-    torch::nn::Linear layer(width, sizes[i]);
-    const bool last = i + 1 == sizes.size();
-    torch::nn::init::orthogonal_(layer->weight,
-                                 last ? output_gain : std::sqrt(2.0));
-    torch::nn::init::zeros_(layer->bias);
-    layers_->push_back(layer);
-    width = sizes[i];
-  }
-}
-
-at::Tensor TanhMlpImpl::forward(const at::Tensor& x) {
-  at::Tensor h = x;
-  for (size_t i = 0; i < layers_->size(); ++i) {
-    h = layers_->ptr<torch::nn::LinearImpl>(i)->forward(h);
-    if (i + 1 < layers_->size()) h = at::tanh(h);
-  }
-  return h;
-}
-
 namespace {
 
 // The torso's convolutions (registered first, so that an MLP network's
@@ -103,15 +77,39 @@ at::Tensor ObservationsForNetwork(const EnvSpec& spec,
 PolicyNetworkImpl::PolicyNetworkImpl(const EnvSpec& spec,
                                      const NetworkConfig& config)
     : spec_(spec), discrete_(spec.discrete) {
-  body_ = MakeBody(*this, spec, config, spec.action_size,
-                   /*output_gain=*/0.01, conv_);
+  if (config.recurrent()) {
+    trunk_ = register_module("trunk", RecurrentTrunk(spec, config));
+    body_ = register_module("body",
+                            TanhMlp(trunk_->features(), std::vector<int64_t>{},
+                                    spec.action_size, /*output_gain=*/0.01));
+  } else {
+    body_ = MakeBody(*this, spec, config, spec.action_size,
+                     /*output_gain=*/0.01, conv_);
+  }
   if (!discrete_) {
     log_std_ = register_parameter("log_std", at::zeros({spec.action_size}));
   }
 }
 
 at::Tensor PolicyNetworkImpl::forward(const at::Tensor& observations) {
+  TORCH_CHECK(!recurrent(), "a recurrent policy acts with its state");
   return Forward(spec_, conv_, body_, observations);
+}
+
+at::Tensor PolicyNetworkImpl::Head(const at::Tensor& features) {
+  return body_->forward(features);
+}
+
+at::Tensor PolicyNetworkImpl::Step(const at::Tensor& observations,
+                                   at::Tensor& state) {
+  state = trunk_->Step(trunk_->Encode(observations), state);
+  return Head(trunk_->Hidden(state));
+}
+
+at::Tensor PolicyNetworkImpl::Unroll(const at::Tensor& observations,
+                                     const at::Tensor& starts,
+                                     const at::Tensor& state) {
+  return Head(trunk_->Unroll(observations, starts, state));
 }
 
 at::Tensor PolicyNetworkImpl::LogProb(const at::Tensor& output,
@@ -159,16 +157,30 @@ ValueNetworkImpl::ValueNetworkImpl(const EnvSpec& spec, ConvTorso shared)
                    std::move(shared));
 }
 
+ValueNetworkImpl::ValueNetworkImpl(const EnvSpec& spec, RecurrentTrunk shared)
+    : spec_(spec) {
+  trunk_ = register_module("trunk", std::move(shared));
+  body_ = register_module("body",
+                          TanhMlp(trunk_->features(), std::vector<int64_t>{}, 1,
+                                  /*output_gain=*/1.0));
+}
+
 ValueNetworkImpl::ValueNetworkImpl(int64_t observation_size,
                                    const NetworkConfig& config)
     : ValueNetworkImpl(FlatSpec(observation_size), config) {}
 
 at::Tensor ValueNetworkImpl::forward(const at::Tensor& observations) {
+  TORCH_CHECK(!recurrent(), "a recurrent value network needs its state");
   return Forward(spec_, conv_, body_, observations).squeeze(-1);
+}
+
+at::Tensor ValueNetworkImpl::Head(const at::Tensor& features) {
+  return body_->forward(features).squeeze(-1);
 }
 
 ValueNetwork MakeValueNetwork(const EnvSpec& spec, const NetworkConfig& config,
                               const PolicyNetworkImpl& policy) {
+  if (policy.recurrent()) return ValueNetwork(spec, policy.trunk());
   if (config.shared_torso) return ValueNetwork(spec, policy.conv_torso());
   return ValueNetwork(spec, config);
 }

@@ -14,8 +14,6 @@
 // nothing before the network holds a float copy of them.
 
 #include <torch/nn/module.h>
-#include <torch/nn/modules/container/modulelist.h>
-#include <torch/nn/modules/linear.h>
 
 #include <cstdint>
 #include <vector>
@@ -23,24 +21,12 @@
 #include "absl/status/status.h"
 #include "common/env/environment.h"
 #include "common/nn/network_config.h"
+#include "common/nn/recurrent_trunk.h"
 #include "common/nn/running_mean_std.h"
+#include "common/nn/tanh_mlp.h"
 #include "common/nn/torso.h"
 
 namespace vantage {
-
-// Linear layers with tanh between them (none after the last).
-class TanhMlpImpl : public torch::nn::Module {
- public:
-  TanhMlpImpl(int64_t inputs, const std::vector<int64_t>& hidden,
-              int64_t outputs, double output_gain);
-  at::Tensor forward(const at::Tensor& x);
-  // The Linear layers in order (for code that runs it without modules).
-  const torch::nn::ModuleList& layers() const { return layers_; }
-
- private:
-  torch::nn::ModuleList layers_;
-};
-TORCH_MODULE(TanhMlp);
 
 // The float inputs of the networks for `spec`: byte observations divided
 // by observation_high, float ones as they are.
@@ -64,8 +50,21 @@ class PolicyNetworkImpl : public torch::nn::Module {
  public:
   PolicyNetworkImpl(const EnvSpec& spec, const NetworkConfig& config);
 
-  // Means [B, k] (continuous) or logits [B, n] (discrete).
+  // Means [B, k] (continuous) or logits [B, n] (discrete). Feed-forward
+  // policies only: a recurrent one needs its state (Step, Unroll).
   at::Tensor forward(const at::Tensor& observations);
+
+  // Recurrent policies (NetworkConfig::core): the trunk they share with
+  // their value network, and the output layer on its features.
+  bool recurrent() const { return !trunk_.is_empty(); }
+  const RecurrentTrunk& trunk() const { return trunk_; }
+  at::Tensor Head(const at::Tensor& features);
+  // One step of `state.size(0)` environments whose episodes go on: the
+  // outputs, and `state` replaced by the next one.
+  at::Tensor Step(const at::Tensor& observations, at::Tensor& state);
+  // The outputs over a sequence (RecurrentTrunkImpl::Unroll's arguments).
+  at::Tensor Unroll(const at::Tensor& observations, const at::Tensor& starts,
+                    const at::Tensor& state);
 
   // From forward()'s output: per-sample log-probabilities and entropies
   // [B]. Discrete actions are indices stored as floats [B, 1] or [B].
@@ -83,15 +82,16 @@ class PolicyNetworkImpl : public torch::nn::Module {
   const EnvSpec& spec() const { return spec_; }
   // Undefined for discrete policies.
   const at::Tensor& log_std() const { return log_std_; }
-  // Empty for the MLP torso.
+  // Empty for the MLP torso and for recurrent policies (their trunk's).
   const ConvTorso& conv_torso() const { return conv_; }
-  // The MLP (for images, only the output layer after the torso).
+  // The MLP (for images or a recurrent trunk, only the output layer).
   const TanhMlp& body() const { return body_; }
 
  private:
   EnvSpec spec_;
   bool discrete_;
-  ConvTorso conv_{nullptr};  // images only
+  RecurrentTrunk trunk_{nullptr};  // recurrent only
+  ConvTorso conv_{nullptr};        // images only
   TanhMlp body_{nullptr};
   at::Tensor log_std_;
 };
@@ -103,10 +103,16 @@ class ValueNetworkImpl : public torch::nn::Module {
   // On `shared`, a convolutional torso of another network (its parameters
   // become this network's too), with only an output layer of its own.
   ValueNetworkImpl(const EnvSpec& spec, ConvTorso shared);
+  // On the trunk of a recurrent policy, with an output layer of its own.
+  ValueNetworkImpl(const EnvSpec& spec, RecurrentTrunk shared);
   // For float vectors of `observation_size`.
   ValueNetworkImpl(int64_t observation_size, const NetworkConfig& config);
-  // V(s) [B].
+  // V(s) [B]; feed-forward networks only.
   at::Tensor forward(const at::Tensor& observations);
+  // On a recurrent trunk: V from its features [B, features] -> [B].
+  bool recurrent() const { return !trunk_.is_empty(); }
+  const RecurrentTrunk& trunk() const { return trunk_; }
+  at::Tensor Head(const at::Tensor& features);
   // Empty for the MLP torso; a shared torso is the policy's.
   const ConvTorso& conv_torso() const { return conv_; }
   // The MLP (for images, only the output layer after the torso).
@@ -114,13 +120,15 @@ class ValueNetworkImpl : public torch::nn::Module {
 
  private:
   EnvSpec spec_;
+  RecurrentTrunk trunk_{nullptr};
   ConvTorso conv_{nullptr};
   TanhMlp body_{nullptr};
 };
 TORCH_MODULE(ValueNetwork);
 
-// The value network to train with `policy`: on the policy's torso when
-// `config.shared_torso`, else with its own.
+// The value network to train with `policy`: on the policy's recurrent
+// trunk if it has one, on its torso when `config.shared_torso`, else with
+// its own.
 ValueNetwork MakeValueNetwork(const EnvSpec& spec, const NetworkConfig& config,
                               const PolicyNetworkImpl& policy);
 

@@ -14,8 +14,9 @@ namespace {
 
 float Sigmoid(float x) { return 1.0f / (1.0f + std::exp(-x)); }
 
-// out[rows, n] = in[rows, k] x weight[n, k]^T + bias[n].
-void Project(const float* in, int64_t rows, int64_t k,
+// out[rows, n] = in[rows, k] x weight[n, k]^T + bias[n]; rows of `in` are
+// `stride` floats apart.
+void Project(const float* in, int64_t rows, int64_t k, int64_t stride,
              const std::vector<float>& weight, const std::vector<float>& bias,
              int64_t n, float* out) {
   for (int64_t r = 0; r < rows; ++r) {
@@ -23,8 +24,8 @@ void Project(const float* in, int64_t rows, int64_t k,
   }
   cblas_sgemm(CblasRowMajor, CblasNoTrans, CblasTrans, static_cast<int>(rows),
               static_cast<int>(n), static_cast<int>(k), 1.0f, in,
-              static_cast<int>(k), weight.data(), static_cast<int>(k), 1.0f,
-              out, static_cast<int>(n));
+              static_cast<int>(stride), weight.data(), static_cast<int>(k),
+              1.0f, out, static_cast<int>(n));
 }
 
 }  // namespace
@@ -55,8 +56,8 @@ absl::StatusOr<RecurrentCellKernel> RecurrentCellKernel::Create(
   return kernel;
 }
 
-void RecurrentCellKernel::Step(const float* inputs, int64_t rows, float* hidden,
-                               float* cell) {
+void RecurrentCellKernel::Step(const float* inputs, int64_t rows,
+                               float* states) {
   const size_t size = static_cast<size_t>(rows * gates_);
   if (from_input_.size() < size) {
     from_input_.resize(size);
@@ -64,15 +65,16 @@ void RecurrentCellKernel::Step(const float* inputs, int64_t rows, float* hidden,
   }
   // The two projections stay apart: a GRU's candidate takes r times the
   // hidden one alone.
-  Project(inputs, rows, inputs_, weight_ih_, bias_ih_, gates_,
+  const int64_t stride = state_size();
+  Project(inputs, rows, inputs_, inputs_, weight_ih_, bias_ih_, gates_,
           from_input_.data());
-  Project(hidden, rows, hidden_, weight_hh_, bias_hh_, gates_,
+  Project(states, rows, hidden_, stride, weight_hh_, bias_hh_, gates_,
           from_hidden_.data());
   const int64_t h = hidden_;
   for (int64_t r = 0; r < rows; ++r) {
     const float* x = from_input_.data() + r * gates_;
     const float* s = from_hidden_.data() + r * gates_;
-    float* state = hidden + r * h;
+    float* state = states + r * stride;
     if (kind_ == Kind::kGru) {
       for (int64_t j = 0; j < h; ++j) {
         const float reset = Sigmoid(x[j] + s[j]);
@@ -81,7 +83,7 @@ void RecurrentCellKernel::Step(const float* inputs, int64_t rows, float* hidden,
         state[j] = (1.0f - update) * candidate + update * state[j];
       }
     } else {
-      float* memory = cell + r * h;
+      float* memory = state + h;
       for (int64_t j = 0; j < h; ++j) {
         const float in = Sigmoid(x[j] + s[j]);
         const float forget = Sigmoid(x[h + j] + s[h + j]);

@@ -39,12 +39,16 @@ class RecurrentCellKernel {
   int64_t input_size() const { return inputs_; }
   int64_t hidden_size() const { return hidden_; }
 
+  // Floats per row of a state: the hidden state, then an LSTM's cell
+  // state (RecurrentTrunkImpl's layout).
+  int64_t state_size() const {
+    return kind_ == Kind::kLstm ? 2 * hidden_ : hidden_;
+  }
+
   // One step for `rows` environments: `inputs` [rows, input_size], the
-  // hidden state `hidden` [rows, hidden_size] (and, for an LSTM, the cell
-  // state `cell`, the same shape; null for a GRU) read and overwritten
-  // with the next. A row whose episode starts is zeroed by the caller
-  // before the step.
-  void Step(const float* inputs, int64_t rows, float* hidden, float* cell);
+  // states [rows, state_size()] read and overwritten with the next. A row
+  // whose episode starts is zeroed by the caller before the step.
+  void Step(const float* inputs, int64_t rows, float* states);
 
  private:
   RecurrentCellKernel() = default;

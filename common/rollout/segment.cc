@@ -143,10 +143,43 @@ absl::Status CheckEpisodes(const Segment& segment, const EnvSpec& spec,
   return absl::OkStatus();
 }
 
+// A recurrent policy's start state, of the run's size; none otherwise.
+// A recurrent run takes whole segments: then every rollout starts where a
+// segment does, with the state the segment carries.
+absl::Status CheckCoreState(const Segment& segment, int64_t size,
+                            int64_t max_steps, const ValueLimits& limits) {
+  if (size == 0) {
+    if (!segment.core_state.defined()) return absl::OkStatus();
+    return absl::InvalidArgumentError(
+        "segment field core_state is set, but this run's policy has no "
+        "recurrent core (--core=none)");
+  }
+  if (!segment.core_state.defined()) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "segment field core_state is missing: this run's policy is recurrent "
+        "(a state of ",
+        size,
+        " floats per segment; an actor too old to send it cannot "
+        "serve this run)"));
+  }
+  if (segment.steps() != max_steps) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("segment has ", segment.steps(),
+                     " steps; a recurrent run takes whole "
+                     "segments of ",
+                     max_steps,
+                     " (its core_state is the state at their "
+                     "start)"));
+  }
+  return Expect(segment.core_state, "core_state", {size}, at::kFloat,
+                limits.max_abs_observation);
+}
+
 }  // namespace
 
 absl::Status ValidateSegment(const Segment& segment, const EnvSpec& spec,
-                             int64_t max_steps, const ValueLimits& limits) {
+                             int64_t max_steps, const ValueLimits& limits,
+                             int64_t core_state_size) {
   const int64_t steps = segment.steps();
   if (steps < 1 || steps > max_steps) {
     return absl::InvalidArgumentError(
@@ -197,6 +230,11 @@ absl::Status ValidateSegment(const Segment& segment, const EnvSpec& spec,
   if (AnyBoth(segment.terminated, segment.truncated)) {
     return absl::InvalidArgumentError(
         "segment marks a step both terminated and truncated");
+  }
+  if (absl::Status status =
+          CheckCoreState(segment, core_state_size, max_steps, limits);
+      !status.ok()) {
+    return status;
   }
   return CheckEpisodes(segment, spec, limits);
 }

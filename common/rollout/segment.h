@@ -35,6 +35,9 @@ struct Segment {
   at::Tensor final_observations;
   // [T]: log pi_behaviour(a_t | s_t) of the policy version that acted.
   at::Tensor behaviour_log_probs;
+  // A recurrent policy's state before step 0 [state size] (zero if an
+  // episode starts there); undefined for a feed-forward policy.
+  at::Tensor core_state;
 
   // Episodes that ended inside this segment.
   std::vector<double> episode_returns;
@@ -55,9 +58,13 @@ struct Segment {
 // episode end (terminated or truncated step), each length >= 1, no longer
 // than the steps since the previous end in the segment (the first may have
 // begun in an earlier segment) nor than spec.max_episode_steps, each return
-// within max_abs_reward * length. The message names the field.
+// within max_abs_reward * length, and a core_state of exactly
+// `core_state_size` finite floats within max_abs_observation (none when 0;
+// with one, exactly max_steps steps).
+// The message names the field.
 absl::Status ValidateSegment(const Segment& segment, const EnvSpec& spec,
-                             int64_t max_steps, const ValueLimits& limits = {});
+                             int64_t max_steps, const ValueLimits& limits = {},
+                             int64_t core_state_size = 0);
 
 }  // namespace vantage
 

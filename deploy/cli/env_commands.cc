@@ -205,6 +205,10 @@ class RolloutActions {
         rng_(request.seed),
         action_(spec.discrete ? 1 : spec.action_size) {}
 
+  void StartEpisode() {
+    if (trained_.has_value()) trained_->StartEpisode();
+  }
+
   const std::vector<double>& Act(const std::vector<double>& observation) {
     if (trained_.has_value()) {
       action_ = trained_->Act(observation, deterministic_);
@@ -250,6 +254,7 @@ int PlayEpisode(Environment& env, int64_t episode, uint64_t seed,
     return Fail("rollout", status, kRuntimeError);
   }
   totals.digest.Add(observation);
+  actions.StartEpisode();
   // A frame after the reset and after every step.
   const bool recording = video.recording(episode);
   int video_code = kRuntimeError;

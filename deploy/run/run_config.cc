@@ -1,6 +1,7 @@
 #include "deploy/run/run_config.h"
 
 #include <algorithm>
+#include <numeric>
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_replace.h"
@@ -45,6 +46,43 @@ int64_t DefaultSegmentLength(int64_t horizon) {
   return 1;
 }
 
+// A recurrent core's chunks: whole segments by default (or the
+// algorithm's minibatch steps if those are fewer), dividing the segments
+// (whose start states the actors send), and the segments dividing the
+// horizon (so that every rollout starts with a segment's state).
+absl::Status ResolveSequences(const AlgorithmRunDefaults& run_defaults,
+                              pb::TrainingSettings& t) {
+  const bool recurrent = t.has_core() && t.core() != "none";
+  if (!recurrent) {
+    if (t.seq_len() != 0) {
+      return FlagError("seq_len", "needs a recurrent --core (gru or lstm)");
+    }
+    return absl::OkStatus();
+  }
+  if (t.horizon() % t.segment_length() != 0) {
+    return FlagError("segment_length",
+                     absl::StrCat("must divide --horizon (", t.horizon(),
+                                  ") with a recurrent --core: each rollout "
+                                  "starts with a segment's state"));
+  }
+  const int64_t slice = run_defaults.horizon_multiple;
+  if (t.seq_len() == 0) {
+    t.set_seq_len(std::gcd(t.segment_length(), slice > 1 ? slice : 0));
+  }
+  if (t.segment_length() % t.seq_len() != 0) {
+    return FlagError("seq_len",
+                     absl::StrCat("must divide --segment_length (",
+                                  t.segment_length(), "), got ", t.seq_len()));
+  }
+  if (slice > 1 && slice % t.seq_len() != 0) {
+    return FlagError("seq_len",
+                     absl::StrCat("must divide the algorithm's minibatch "
+                                  "steps (",
+                                  slice, "), got ", t.seq_len()));
+  }
+  return absl::OkStatus();
+}
+
 // The training section: the learner's settings, then the actor's (whose
 // segments default to a divisor of the horizon); --envs only checked here,
 // since the run's layout (distributed or local) decides it.
@@ -72,7 +110,7 @@ absl::Status ResolveTraining(const AlgorithmConfig& algorithm,
   if (t.segment_length() < 1 || t.segment_length() > t.horizon()) {
     return FlagError("segment_length", "must be in [1, --horizon]");
   }
-  return absl::OkStatus();
+  return ResolveSequences(run_defaults, t);
 }
 
 // A local run: one strictly on-policy process.

@@ -22,6 +22,7 @@ struct TrainedPolicy::Networks {
   RunningMeanStd normalizer{1};
   double observation_clip = 10.0;
   at::Generator generator = at::detail::createCPUGenerator(0);
+  at::Tensor state;  // a recurrent policy's, [1, state size]
 };
 
 namespace {
@@ -63,6 +64,7 @@ absl::StatusOr<TrainedPolicy> LoadCheckpointFile(const std::string& path) {
       !status.ok()) {
     return status;
   }
+  trained.StartEpisode();
   return trained;
 }
 
@@ -72,18 +74,23 @@ void TrainedPolicy::Seed(uint64_t seed) {
   networks->generator = at::detail::createCPUGenerator(seed);
 }
 
+void TrainedPolicy::StartEpisode() {
+  Networks& n = *networks;
+  if (n.policy->recurrent()) n.state = n.policy->trunk()->InitialState(1);
+}
+
 std::vector<double> TrainedPolicy::Act(absl::Span<const double> observation,
                                        bool deterministic) {
   at::NoGradGuard no_grad;
   Networks& n = *networks;
-  const at::Tensor x = ObservationTensor(spec, observation.data(), 1);
-  const at::Tensor action =
-      n.policy
-          ->Act(n.policy->forward(ObservationsForNetwork(spec, n.normalizer, x,
-                                                         n.observation_clip)),
-                deterministic, n.generator)
-          .to(at::kDouble)
-          .contiguous();
+  const at::Tensor x = ObservationsForNetwork(
+      spec, n.normalizer, ObservationTensor(spec, observation.data(), 1),
+      n.observation_clip);
+  const at::Tensor output =
+      n.policy->recurrent() ? n.policy->Step(x, n.state) : n.policy->forward(x);
+  const at::Tensor action = n.policy->Act(output, deterministic, n.generator)
+                                .to(at::kDouble)
+                                .contiguous();
   const double* data = action.data_ptr<double>();
   return std::vector<double>(data, data + action.numel());
 }

@@ -24,6 +24,9 @@ struct TrainedPolicy {
 
   // Its sampling starts from `seed`'s random generator.
   void Seed(uint64_t seed);
+  // A recurrent policy forgets what it has seen (call where an episode
+  // starts); nothing for a feed-forward one.
+  void StartEpisode();
   // The action for one observation: the mean (continuous) or the most
   // likely action (discrete) when `deterministic`, else a sample.
   std::vector<double> Act(absl::Span<const double> observation,

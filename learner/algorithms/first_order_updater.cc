@@ -50,6 +50,17 @@ FirstOrderUpdater::FlatRows FirstOrderUpdater::StartFlatUpdate(
       FloatRows(batch.advantages, size), FloatRows(batch.returns, size)};
 }
 
+ChunkOutputs FirstOrderUpdater::Evaluate(const UpdateBatch& batch,
+                                         const ChunkMinibatch& minibatch) {
+  if (minibatch.chunks.defined()) {
+    return RunChunks(*policy_, *value_, batch, minibatch);
+  }
+  const at::Tensor observations =
+      batch.observations.index_select(0, minibatch.rows);
+  return ChunkOutputs{policy_->forward(observations),
+                      value_->forward(observations)};
+}
+
 float* FirstOrderUpdater::d_log_probs(int64_t rows) {
   d_log_probs_.resize(rows);
   return d_log_probs_.data();

@@ -9,6 +9,7 @@
 
 #include "absl/status/status.h"
 #include "common/nn/networks.h"
+#include "learner/algorithms/chunk_minibatches.h"
 #include "learner/algorithms/flat_actor_critic.h"
 #include "learner/algorithms/flat_optimizer.h"
 #include "learner/algorithms/policy_updater.h"
@@ -95,6 +96,12 @@ class FirstOrderUpdater : public PolicyUpdater {
   AlgorithmStats AutogradStep(const at::Tensor& policy_loss,
                               const at::Tensor& value_loss,
                               const at::Tensor& entropy);
+
+  // The policy's outputs and the critic's values on a minibatch's rows of
+  // `batch`: a recurrent policy's through its trunk over the minibatch's
+  // chunks, a feed-forward one's (`chunks` undefined) row by row.
+  ChunkOutputs Evaluate(const UpdateBatch& batch,
+                        const ChunkMinibatch& minibatch);
 
   // d(loss)/d(value) for a row whose value misses its target by `error`,
   // in a minibatch of `rows` rows.

@@ -24,6 +24,10 @@ absl::StatusOr<FlatActorCritic> FlatActorCritic::Create(
     return absl::UnimplementedError(
         "the networks have a convolutional torso, which only autograd trains");
   }
+  if (policy.recurrent()) {
+    return absl::UnimplementedError(
+        "the networks have a recurrent core, which only autograd trains");
+  }
   FlatActorCritic flat;
   flat.spec_ = policy.spec();
   flat.discrete_ = policy.discrete();

@@ -22,6 +22,14 @@ struct UpdateBatch {
   // Some steps were acted by an older version than the one updating (an
   // asynchronous run's lag).
   bool lagged = false;
+  // Recurrent policies train on chunks of seq_len steps of one stream
+  // (seq_len divides T; 0: a feed-forward policy): `starts` [T*N] bool
+  // marks where episodes start (the core's state is zeroed before the
+  // step), `chunk_states` [T/seq_len * N, state] is the state before each
+  // chunk (chunk c of stream n at row c * N + n).
+  int64_t seq_len = 0;
+  at::Tensor starts;
+  at::Tensor chunk_states;
 };
 
 }  // namespace vantage

@@ -8,6 +8,7 @@
 
 #include "common/nn/networks.h"
 #include "common/nn/running_mean_std.h"
+#include "learner/batch/recurrent_critic.h"
 #include "learner/batch/reward_scaler.h"
 #include "learner/exploration/ex2_bonus.h"
 #include "learner/parallel/replica_group.h"
@@ -34,9 +35,37 @@ at::Tensor BatchPreparer::Normalised(const at::Tensor& observations) const {
                                 config_.observation_clip);
 }
 
-at::Tensor BatchPreparer::Values(const at::Tensor& observations) const {
+at::Tensor BatchPreparer::Values(const std::vector<Rollout>& rollouts) const {
+  std::vector<at::Tensor> observations, finals;
+  for (const Rollout& rollout : rollouts) {
+    observations.push_back(rollout.observations);
+    finals.push_back(rollout.final_observations);
+  }
   at::NoGradGuard no_grad;
-  return value_.forward(Normalised(observations));
+  // One critic pass: every rollout's T + 1 observations, then the finals.
+  return value_.forward(
+      Normalised(at::cat({at::cat(observations), at::cat(finals)})));
+}
+
+absl::StatusOr<TrainingBatch> BatchPreparer::Assemble(
+    const std::vector<Rollout>& rollouts) const {
+  if (!value_.recurrent()) {
+    return AssembleBatch(
+        rollouts, [&](const std::vector<Rollout>& r) { return Values(r); });
+  }
+  RecurrentCriticPass pass;
+  absl::StatusOr<TrainingBatch> batch =
+      AssembleBatch(rollouts, [&](const std::vector<Rollout>& r) {
+        pass = RunRecurrentCritic(
+            value_, r, [&](const at::Tensor& raw) { return Normalised(raw); });
+        return pass.values;
+      });
+  if (!batch.ok()) return batch;
+  batch->seq_len = config_.network.seq_len;
+  batch->starts = EpisodeStarts(batch->advantage_inputs.terminated,
+                                batch->advantage_inputs.truncated);
+  batch->chunk_states = ChunkStartStates(pass, batch->seq_len);
+  return batch;
 }
 
 absl::StatusOr<PreparedBatch> BatchPreparer::Prepare(
@@ -45,8 +74,7 @@ absl::StatusOr<PreparedBatch> BatchPreparer::Prepare(
   if (exploration_ != nullptr) {
     prepared.exploration = exploration_->ShapeRewards(rollouts);
   }
-  absl::StatusOr<TrainingBatch> batch = AssembleBatch(
-      rollouts, [&](const at::Tensor& raw) { return Values(raw); });
+  absl::StatusOr<TrainingBatch> batch = Assemble(rollouts);
   if (!batch.ok()) return batch.status();
   prepared.batch = *std::move(batch);
   AdvantageInputs& inputs = prepared.batch.advantage_inputs;

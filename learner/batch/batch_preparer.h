@@ -55,8 +55,12 @@ class BatchPreparer {
                                         int64_t version, std::mt19937_64& rng);
 
  private:
-  // V(s) of raw observations with the current critic.
-  at::Tensor Values(const at::Tensor& observations) const;
+  // The critic's values in AssembleBatch's order (a feed-forward one).
+  at::Tensor Values(const std::vector<Rollout>& rollouts) const;
+  // The batch, its values from the current critic; a recurrent one's also
+  // marks episode starts and the states its chunks start from.
+  absl::StatusOr<TrainingBatch> Assemble(
+      const std::vector<Rollout>& rollouts) const;
   // Raw observations as the networks take them.
   at::Tensor Normalised(const at::Tensor& observations) const;
 

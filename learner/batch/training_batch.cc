@@ -6,29 +6,28 @@
 
 namespace vantage {
 
+at::Tensor EpisodeStarts(const at::Tensor& terminated,
+                         const at::Tensor& truncated) {
+  const at::Tensor ended = at::logical_or(terminated, truncated);
+  return at::cat({at::zeros({1, ended.size(1)}, at::kBool),
+                  ended.slice(0, 0, ended.size(0) - 1)});
+}
+
 absl::StatusOr<TrainingBatch> AssembleBatch(
-    const std::vector<Rollout>& rollouts,
-    absl::FunctionRef<at::Tensor(const at::Tensor&)> values_of) {
+    const std::vector<Rollout>& rollouts, CriticValuesOf values_of) {
   if (rollouts.empty()) {
     return absl::InvalidArgumentError("a batch needs at least one rollout");
   }
   const int64_t steps = rollouts[0].rewards.size(0);
   const int64_t n = static_cast<int64_t>(rollouts.size());
-  std::vector<at::Tensor> observations, finals;
   for (const Rollout& rollout : rollouts) {
     if (rollout.rewards.size(0) != steps) {
       return absl::InvalidArgumentError(
           absl::StrCat("rollouts of ", rollout.rewards.size(0), " and ", steps,
                        " steps cannot share a batch"));
     }
-    observations.push_back(rollout.observations);
-    finals.push_back(rollout.final_observations);
   }
-  // One critic pass: every rollout's T + 1 observations, then the finals.
-  const at::Tensor all_observations = at::cat(observations);
-  const at::Tensor all_finals = at::cat(finals);
-  const at::Tensor values =
-      values_of(at::cat({all_observations, all_finals})).to(at::kFloat);
+  const at::Tensor values = values_of(rollouts).to(at::kFloat);
   const at::Tensor stream_values =
       values.slice(0, 0, n * (steps + 1)).reshape({n, steps + 1}).t();
   const at::Tensor final_values = values.slice(0, n * (steps + 1));
@@ -79,6 +78,11 @@ UpdateBatch MakeUpdateBatch(
   update.behaviour_log_probs = batch.behaviour_log_probs.reshape({samples});
   update.advantages = advantages.mixed.reshape({samples});
   update.returns = advantages.returns.reshape({samples});
+  if (batch.seq_len > 0) {
+    update.starts = batch.starts.reshape({samples});
+    update.chunk_states = batch.chunk_states;
+    update.seq_len = batch.seq_len;
+  }
   return update;
 }
 

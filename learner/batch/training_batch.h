@@ -21,16 +21,32 @@ struct TrainingBatch {
   at::Tensor actions;                // [T, N, act]
   at::Tensor behaviour_log_probs;    // [T, N]
   at::Tensor policy_versions;        // [T, N] int64
+  // Recurrent policies: where episodes start ([T, N] bool: the core's state
+  // is zeroed before the step) and the core's state before each chunk of
+  // seq_len steps ([T / seq_len * N, state], chunk c of stream n at row
+  // c * N + n), from the learner's own pass over the rollouts.
+  at::Tensor starts;
+  at::Tensor chunk_states;
+  int64_t seq_len = 0;
 };
+
+// The critic's values of every observation the estimators need, in this
+// order: each rollout's T + 1 observations, rollout after rollout, then
+// each rollout's final observations (of its truncated steps), in order.
+using CriticValuesOf =
+    absl::FunctionRef<at::Tensor(const std::vector<Rollout>&)>;
 
 // Evaluates the learner's critic once over every observation the
 // estimators need: V(s_t), V(s_T) after each rollout's last step, and V of
 // the final observation at each truncated step (the others are 0 and never
-// read). `values_of` maps raw observations [M, obs] to values [M]. All
-// rollouts must have the same length.
+// read). All rollouts must have the same length.
 absl::StatusOr<TrainingBatch> AssembleBatch(
-    const std::vector<Rollout>& rollouts,
-    absl::FunctionRef<at::Tensor(const at::Tensor&)> values_of);
+    const std::vector<Rollout>& rollouts, CriticValuesOf values_of);
+
+// Where episodes start in a batch's [T, N] step flags: after every step
+// that ended one (never at step 0, whose state the rollout carries).
+at::Tensor EpisodeStarts(const at::Tensor& terminated,
+                         const at::Tensor& truncated);
 
 // What the algorithm trains on, flattened time-major: the policy gets the
 // rho-mixed advantages, the critic ALWAYS the normal targets V + GAE

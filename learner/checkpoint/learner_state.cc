@@ -21,8 +21,34 @@ at::Tensor SpecShape(const EnvSpec& spec) {
                     at::kLong);
 }
 
+// A recurrent core as a checkpoint names it: "gru:64".
+std::string CoreDescription(const NetworkConfig& network) {
+  return absl::StrCat(CoreName(network.core), ":", network.core_size);
+}
+
+// Feed-forward networks' checkpoints hold no "core" entry (those written
+// before cores existed neither).
+absl::Status CheckCore(torch::serialize::InputArchive& archive,
+                       const NetworkConfig& network) {
+  std::string saved = "none";
+  at::Tensor entry;
+  if (archive.try_read("core", entry)) {
+    absl::StatusOr<std::string> core = ReadBytes(archive, "core");
+    if (!core.ok()) return core.status();
+    saved = *core;
+  }
+  const std::string wanted =
+      network.recurrent() ? CoreDescription(network) : "none";
+  if (saved == wanted) return absl::OkStatus();
+  return absl::InvalidArgumentError(
+      absl::StrCat("checkpoint's policy has core ", saved,
+                   ", but the run config says ", wanted,
+                   " (--core, --core_size): a checkpoint's networks are not "
+                   "reinitialised to fit"));
+}
+
 // Whether `archive` was written for the run `config` describes: its
-// environment, algorithm and torso sharing.
+// environment, algorithm, torso sharing and recurrent core.
 absl::Status CheckCheckpointFits(const LearnerConfig& config,
                                  torch::serialize::InputArchive& archive) {
   absl::StatusOr<std::string> name = ReadBytes(archive, "spec.name");
@@ -64,12 +90,15 @@ absl::Status CheckCheckpointFits(const LearnerConfig& config,
         " their torso, but the run config says the opposite "
         "(--shared_torso)"));
   }
-  return absl::OkStatus();
+  return CheckCore(archive, config.network);
 }
 
 }  // namespace
 
 void LearnerCore::Save(torch::serialize::OutputArchive& archive) const {
+  if (config_.network.recurrent()) {
+    WriteBytes(archive, "core", CoreDescription(config_.network));
+  }
   WriteBytes(archive, "spec.name", config_.spec.name);
   archive.write("spec.shape", SpecShape(config_.spec));
   WriteBytes(archive, "algorithm", config_.algorithm.name);

@@ -51,6 +51,8 @@ Rollout RolloutStitcher::Cut(int64_t actor_id, int64_t env_slot,
       finals, log_probs, versions;
   int64_t needed = horizon_;
   at::Tensor next_observation;  // s_T: the observation after the last step
+  // Recurrent runs take whole segments, so a rollout starts where one does.
+  const at::Tensor core_state = stream.pieces.front().segment->core_state;
   while (needed > 0) {
     Piece& piece = stream.pieces.front();
     const Segment& s = *piece.segment;
@@ -88,6 +90,7 @@ Rollout RolloutStitcher::Cut(int64_t actor_id, int64_t env_slot,
   rollout.final_observations = at::cat(finals);
   rollout.behaviour_log_probs = at::cat(log_probs);
   rollout.policy_versions = at::cat(versions);
+  rollout.core_state = core_state;
   return rollout;
 }
 

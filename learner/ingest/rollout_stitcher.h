@@ -28,6 +28,9 @@ struct Rollout {
   at::Tensor final_observations;   // [K, obs] for the K truncated steps
   at::Tensor behaviour_log_probs;  // [T]
   at::Tensor policy_versions;      // [T] int64: the version that acted
+  // A recurrent policy's state before step 0 [state size] (its first
+  // segment's); undefined for a feed-forward policy.
+  at::Tensor core_state;
 };
 
 struct StitcherStats {

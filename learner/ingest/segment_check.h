@@ -20,8 +20,11 @@ class SegmentCheck {
  public:
   // `max_policy_lag`: versions a segment may be behind the newest one
   // (0: only the newest, the sync mode; -1: any).
+  // `core_state_size`: the floats of a recurrent policy's state each
+  // segment carries (0: none).
   SegmentCheck(EnvSpec spec, int64_t max_segment_steps,
-               ValueLimits value_limits, int64_t max_policy_lag);
+               ValueLimits value_limits, int64_t max_policy_lag,
+               int64_t core_state_size = 0);
 
   // ValidateSegment against the run's spec and limits (the message names
   // the field).
@@ -42,6 +45,7 @@ class SegmentCheck {
   int64_t max_segment_steps_;
   ValueLimits value_limits_;
   int64_t max_policy_lag_;
+  int64_t core_state_size_;
 };
 
 }  // namespace vantage

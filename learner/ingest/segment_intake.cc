@@ -17,7 +17,7 @@ constexpr size_t kRecentReturns = 100;
 
 SegmentIntake::SegmentIntake(const LearnerConfig& config)
     : check_(config.spec, config.max_segment_steps, config.value_limits,
-             config.max_policy_lag),
+             config.max_policy_lag, config.network.core_state_size()),
       horizon_(config.horizon),
       rollouts_per_batch_(config.rollouts_per_batch),
       // 0 means room for 8 batches.

@@ -265,6 +265,7 @@ GatewayConfig LearnerProcess::GatewayConfigFor(int64_t segment_length) const {
   gateway.max_policy_lag = layout.max_policy_lag();
   gateway.first_actor_id = first_actor_id_;
   gateway.spec = config_.spec;
+  gateway.core_state_size = config_.learner.network.core_state_size();
   gateway.limits = config_.limits;
   gateway.batch_rollouts = own_streams_;
   // An actor paces whole horizons of whole segments.
@@ -303,8 +304,8 @@ absl::Status LearnerProcess::Serve() {
   run_->learner().SetBatchPlan(plan_.get());
   // Nothing larger than the run's largest valid segment is ever read.
   ServiceLimits service_limits = config_.service_limits;
-  service_limits.max_segment_message_bytes =
-      MaxSegmentMessageBytes(config_.spec, segment_length);
+  service_limits.max_segment_message_bytes = MaxSegmentMessageBytes(
+      config_.spec, segment_length, config_.learner.network.core_state_size());
   service_ = std::make_unique<LearnerService>(*gateway_, service_limits);
   ServerOptions options;
   options.listen = config_.listen;

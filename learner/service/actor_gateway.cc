@@ -60,7 +60,7 @@ absl::Status GatewayLimits::Validate() const {
 ActorGateway::ActorGateway(GatewayConfig config, SegmentSink& sink)
     : config_(std::move(config)),
       check_(config_.spec, config_.max_segment_steps, config_.limits.values,
-             config_.max_policy_lag),
+             config_.max_policy_lag, config_.core_state_size),
       sink_(sink),
       next_actor_id_(config_.first_actor_id) {}
 

@@ -74,6 +74,9 @@ struct GatewayConfig {
   // The run's environment, pinned by the learner's own configuration (or
   // its checkpoint); registrations must match it exactly.
   EnvSpec spec;
+  // Floats of a recurrent policy's state that every segment carries (0: a
+  // feed-forward policy, whose segments carry none).
+  int64_t core_state_size = 0;
   int64_t max_segment_steps = 4096;
   // Segments older than the newest version minus this are dropped and
   // counted (not an error for the actor); -1: any age.

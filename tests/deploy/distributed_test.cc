@@ -81,6 +81,13 @@ TEST(DistributedTest, SyncWithOneActorReproducesLocalModeWithStackedFrames) {
   ExpectSyncWithOneActorReproducesLocalMode("stacked", " --frame_stack=3");
 }
 
+// A recurrent policy's state travels with each segment and its chunks
+// start from the learner's own pass: the same numbers either way.
+TEST(DistributedTest, SyncWithOneActorReproducesLocalModeWithAGruCore) {
+  ExpectSyncWithOneActorReproducesLocalMode(
+      "gru", " --core=gru --core_size=16 --seq_len=16");
+}
+
 TEST(DistributedTest, SyncWithOneActorReproducesLocalModeWithEx2) {
   ExpectSyncWithOneActorReproducesLocalMode(
       "ex2",

@@ -32,10 +32,18 @@ std::string FreshDirectory(const std::string& name) {
   return path;
 }
 
-RunPlan SmallRun(const std::string& algorithm, uint64_t seed,
+// `name`: an algorithm, or "ex2", optionally with a recurrent core
+// ("ppo_gru": PPO with a GRU of 16 units).
+RunPlan SmallRun(const std::string& name, uint64_t seed,
                  const std::string& run_dir) {
+  const std::vector<std::string> parts = absl::StrSplit(name, '_');
+  const std::string& algorithm = parts[0];
   pb::RunConfig run;
   pb::TrainingSettings& training = *run.mutable_training();
+  if (parts.size() > 1) {
+    training.set_core(parts[1]);
+    training.set_core_size(16);
+  }
   training.set_env("Hopper");
   training.set_envs(kEnvs);
   // A2C's rollouts are 5n steps (n = 4 here).
@@ -171,7 +179,8 @@ TEST_P(ResumeTest, ResumedRunEqualsUninterruptedRun) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Algorithms, ResumeTest,
-                         ::testing::Values("ppo", "a2c", "trpo", "ex2"));
+                         ::testing::Values("ppo", "a2c", "trpo", "ex2",
+                                           "ppo_gru", "a2c_lstm"));
 
 // The rows without the three exploration columns (the last ones before the
 // wall clock, which DeterministicProgress drops).

@@ -98,17 +98,24 @@ AlgorithmStats A2cUpdater::AutogradUpdate(const UpdateBatch& batch,
   const int64_t rows = MinibatchRows(batch);
   MeanStats stats;
   for (int64_t begin = 0; begin + rows <= size; begin += rows) {
-    const at::Tensor obs = batch.observations.slice(0, begin, begin + rows);
-    const at::Tensor adv = batch.advantages.slice(0, begin, begin + rows);
+    // A time slice of every stream: for a recurrent policy, its chunks.
+    const ChunkMinibatch minibatch =
+        policy_->recurrent()
+            ? ChunksOfSteps(batch, begin / batch.streams,
+                            config_.steps_per_minibatch)
+            : ChunkMinibatch{at::arange(begin, begin + rows, at::kLong),
+                             at::Tensor()};
+    const at::Tensor& index = minibatch.rows;
+    const at::Tensor adv = batch.advantages.index_select(0, index);
     const at::Tensor old_log_prob =
-        batch.behaviour_log_probs.slice(0, begin, begin + rows);
-    const at::Tensor output = policy_->forward(obs);
+        batch.behaviour_log_probs.index_select(0, index);
+    const ChunkOutputs out = Evaluate(batch, minibatch);
     const at::Tensor log_prob =
-        policy_->LogProb(output, batch.actions.slice(0, begin, begin + rows));
-    AlgorithmStats step = AutogradStep(
-        -(log_prob * adv).mean(),
-        ValueLoss(*value_, obs, batch.returns.slice(0, begin, begin + rows)),
-        policy_->Entropy(output).mean());
+        policy_->LogProb(out.policy, batch.actions.index_select(0, index));
+    const at::Tensor error = out.values - batch.returns.index_select(0, index);
+    AlgorithmStats step =
+        AutogradStep(-(log_prob * adv).mean(), 0.5 * (error * error).mean(),
+                     policy_->Entropy(out.policy).mean());
     // Later minibatches act on an already-updated policy; this is how far
     // it has moved from the behaviour policy (the same estimator as PPO's).
     const at::Tensor log_ratio = log_prob.detach() - old_log_prob;

@@ -74,8 +74,19 @@ PpoUpdater::Decoupled PpoUpdater::Decouple(const UpdateBatch& batch) {
   Decoupled out{batch, at::Tensor()};
   if (!batch.lagged) return out;
   at::NoGradGuard no_grad;
-  const at::Tensor proximal =
-      policy_->LogProb(policy_->forward(batch.observations), batch.actions);
+  at::Tensor proximal;
+  if (policy_->recurrent()) {
+    // Every chunk, its rows back in the batch's order.
+    const ChunkMinibatch all = ChunksOfSteps(batch, 0, batch.horizon);
+    proximal = at::empty({batch.observations.size(0)}, at::kFloat)
+                   .index_copy_(0, all.rows,
+                                policy_->LogProb(
+                                    Evaluate(batch, all).policy,
+                                    batch.actions.index_select(0, all.rows)));
+  } else {
+    proximal =
+        policy_->LogProb(policy_->forward(batch.observations), batch.actions);
+  }
   out.weights =
       at::exp(proximal - batch.behaviour_log_probs.to(proximal.dtype()));
   out.batch.behaviour_log_probs = proximal;
@@ -168,6 +179,20 @@ AlgorithmStats PpoUpdater::FlatMinibatch(
   return FlatStep(minibatch, sums, static_cast<double>(clipped) / count);
 }
 
+std::vector<ChunkMinibatch> PpoUpdater::EpochMinibatches(
+    const UpdateBatch& batch, std::vector<int64_t>& order, int64_t minibatch,
+    std::mt19937_64& rng) {
+  if (policy_->recurrent()) {
+    return ShuffledChunkMinibatches(batch, config_.minibatches, rng);
+  }
+  ShuffleRows(order, rng);
+  std::vector<ChunkMinibatch> minibatches;
+  for (const at::Tensor& rows : MinibatchIndices(order, minibatch)) {
+    minibatches.push_back(ChunkMinibatch{rows, at::Tensor()});
+  }
+  return minibatches;
+}
+
 AlgorithmStats PpoUpdater::AutogradUpdate(const UpdateBatch& lagged,
                                           std::mt19937_64& rng) {
   const Decoupled decoupled = Decouple(lagged);
@@ -177,8 +202,10 @@ AlgorithmStats PpoUpdater::AutogradUpdate(const UpdateBatch& lagged,
   std::vector<int64_t> order(size);
   MeanStats stats;
   for (int epoch = 0; epoch < config_.epochs; ++epoch) {
-    ShuffleRows(order, rng);
-    const std::vector<at::Tensor> indices = MinibatchIndices(order, minibatch);
+    const std::vector<ChunkMinibatch> minibatches =
+        EpochMinibatches(batch, order, minibatch, rng);
+    std::vector<at::Tensor> indices;
+    for (const ChunkMinibatch& m : minibatches) indices.push_back(m.rows);
     // Each minibatch's advantage statistics over every replica's part of
     // it, all of the epoch's in one collective.
     std::optional<PartsNormalizer> normalizer;
@@ -187,22 +214,22 @@ AlgorithmStats PpoUpdater::AutogradUpdate(const UpdateBatch& lagged,
     }
     for (size_t part = 0; part < indices.size(); ++part) {
       const at::Tensor& index = indices[part];
-      const at::Tensor obs = batch.observations.index_select(0, index);
       at::Tensor adv = batch.advantages.index_select(0, index);
       if (normalizer.has_value()) adv = normalizer->Normalize(part, adv);
       if (decoupled.weights.defined()) {
         adv = adv * decoupled.weights.index_select(0, index);
       }
-      const at::Tensor output = policy_->forward(obs);
+      const ChunkOutputs out = Evaluate(batch, minibatches[part]);
       const at::Tensor log_prob =
-          policy_->LogProb(output, batch.actions.index_select(0, index));
+          policy_->LogProb(out.policy, batch.actions.index_select(0, index));
       const PpoPolicyLoss policy_loss = PpoClippedPolicyLoss(
           log_prob, batch.behaviour_log_probs.index_select(0, index), adv,
           config_.clip);
-      AlgorithmStats step = AutogradStep(
-          policy_loss.loss,
-          ValueLoss(*value_, obs, batch.returns.index_select(0, index)),
-          policy_->Entropy(output).mean());
+      const at::Tensor error =
+          out.values - batch.returns.index_select(0, index);
+      AlgorithmStats step =
+          AutogradStep(policy_loss.loss, 0.5 * (error * error).mean(),
+                       policy_->Entropy(out.policy).mean());
       step.approx_kl = policy_loss.approx_kl.item<double>();
       step.clip_fraction = policy_loss.clip_fraction.item<double>();
       stats.Add(step);

@@ -39,6 +39,12 @@ class PpoUpdater : public FirstOrderUpdater {
     at::Tensor weights;  // [T*N], undefined when not lagged
   };
   Decoupled Decouple(const UpdateBatch& batch);
+  // An epoch's minibatches: shuffled rows (`order` is scratch of the
+  // batch's size), or for a recurrent policy shuffled whole chunks.
+  std::vector<ChunkMinibatch> EpochMinibatches(const UpdateBatch& batch,
+                                               std::vector<int64_t>& order,
+                                               int64_t minibatch,
+                                               std::mt19937_64& rng);
   AlgorithmStats AutogradUpdate(const UpdateBatch& batch,
                                 std::mt19937_64& rng) override;
   AlgorithmStats FlatUpdate(const UpdateBatch& batch,

@@ -37,7 +37,10 @@ void ExpectAgreement(RecurrentCellKernel::Kind kind, Cell& cell, int64_t rows) {
   const bool lstm = kind == RecurrentCellKernel::Kind::kLstm;
   at::Tensor h = at::randn({rows, kHidden}) * 0.5;
   at::Tensor c = at::randn({rows, kHidden}) * 0.5;
-  std::vector<float> hidden = Floats(h), memory = Floats(c);
+  // The kernel's rows: the hidden state, then an LSTM's cell state.
+  const int64_t width = kernel->state_size();
+  ASSERT_EQ(width, lstm ? 2 * kHidden : kHidden);
+  std::vector<float> states = Floats(lstm ? at::cat({h, c}, 1) : h);
   torch::NoGradGuard no_grad;
   for (int step = 0; step < kSteps; ++step) {
     const at::Tensor x = at::randn({rows, kInputs}) * 2.0;
@@ -47,26 +50,26 @@ void ExpectAgreement(RecurrentCellKernel::Kind kind, Cell& cell, int64_t rows) {
       const int64_t row = step % rows;
       h[row].zero_();
       c[row].zero_();
-      std::memset(hidden.data() + row * kHidden, 0, kHidden * sizeof(float));
-      std::memset(memory.data() + row * kHidden, 0, kHidden * sizeof(float));
+      std::memset(states.data() + row * width, 0, width * sizeof(float));
     }
     if constexpr (std::is_same_v<Cell, torch::nn::LSTMCell>) {
       std::tie(h, c) = cell->forward(x, std::make_tuple(h, c));
     } else {
       h = cell->forward(x, h);
     }
-    kernel->Step(Floats(x).data(), rows, hidden.data(),
-                 lstm ? memory.data() : nullptr);
+    kernel->Step(Floats(x).data(), rows, states.data());
     const std::vector<float> expected = Floats(h);
-    for (size_t i = 0; i < expected.size(); ++i) {
-      ASSERT_NEAR(hidden[i], expected[i], 2e-5)
-          << "step " << step << " rows " << rows << " at " << i;
-    }
-    if (lstm) {
-      const std::vector<float> expected_cell = Floats(c);
-      for (size_t i = 0; i < expected_cell.size(); ++i) {
-        ASSERT_NEAR(memory[i], expected_cell[i], 5e-5)
-            << "cell, step " << step << " rows " << rows << " at " << i;
+    const std::vector<float> expected_cell = Floats(c);
+    for (int64_t r = 0; r < rows; ++r) {
+      for (int64_t j = 0; j < kHidden; ++j) {
+        ASSERT_NEAR(states[r * width + j], expected[r * kHidden + j], 2e-5)
+            << "step " << step << " rows " << rows << " at " << r << "," << j;
+        if (lstm) {
+          ASSERT_NEAR(states[r * width + kHidden + j],
+                      expected_cell[r * kHidden + j], 5e-5)
+              << "cell, step " << step << " rows " << rows << " at " << r << ","
+              << j;
+        }
       }
     }
   }

@@ -16,6 +16,17 @@ at::Tensor FakeValues(const at::Tensor& observations) {
   return observations.select(1, 0) + 10.0 * observations.select(1, 1);
 }
 
+// The critic as AssembleBatch asks for it: each rollout's T + 1
+// observations, then every rollout's final observations.
+at::Tensor FakeCritic(const std::vector<Rollout>& rollouts) {
+  std::vector<at::Tensor> observations, finals;
+  for (const Rollout& r : rollouts) {
+    observations.push_back(r.observations);
+    finals.push_back(r.final_observations);
+  }
+  return FakeValues(at::cat({at::cat(observations), at::cat(finals)}));
+}
+
 Rollout MakeRollout(int64_t steps, int64_t seed) {
   Rollout r;
   r.observations = at::randn({steps + 1, 2});
@@ -38,9 +49,9 @@ TEST(TrainingBatchTest, EveryValueComesFromTheRightObservation) {
                                          MakeRollout(6, 3)};
   int calls = 0;
   const absl::StatusOr<TrainingBatch> batch =
-      AssembleBatch(rollouts, [&](const at::Tensor& observations) {
+      AssembleBatch(rollouts, [&](const std::vector<Rollout>& given) {
         ++calls;
-        return FakeValues(observations);
+        return FakeCritic(given);
       });
   ASSERT_TRUE(batch.ok()) << batch.status();
   EXPECT_EQ(calls, 1);
@@ -72,8 +83,8 @@ TEST(TrainingBatchTest, EveryValueComesFromTheRightObservation) {
 }
 
 TEST(TrainingBatchTest, RefusesMixedLengthsAndEmptyBatches) {
-  EXPECT_FALSE(AssembleBatch({}, FakeValues).ok());
-  EXPECT_THAT(AssembleBatch({MakeRollout(6, 0), MakeRollout(5, 0)}, FakeValues)
+  EXPECT_FALSE(AssembleBatch({}, FakeCritic).ok());
+  EXPECT_THAT(AssembleBatch({MakeRollout(6, 0), MakeRollout(5, 0)}, FakeCritic)
                   .status()
                   .message(),
               ::testing::HasSubstr("cannot share a batch"));
