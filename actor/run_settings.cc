@@ -1,5 +1,7 @@
 #include "actor/run_settings.h"
 
+#include <utility>
+
 #include "absl/strings/str_cat.h"
 #include "common/env/frame_stack.h"
 #include "proto/settings_table.h"
@@ -39,12 +41,26 @@ const SettingsTable<NetworkConfig, pb::TrainingSettings>& NetworkTable() {
   static const auto* table =
       new SettingsTable<NetworkConfig, pb::TrainingSettings>(
           "training",
-          {{"hidden", &C::hidden},
-           {"shared_torso", &C::shared_torso},
-           {"core_size", &C::core_size, AtLeast(1)},
+          {{"hidden", &C::hidden}, {"shared_torso", &C::shared_torso}},
+          SettingNames::kFlag);
+  return *table;
+}
+
+// A recurrent core's settings: in a run's config only when it has one, so
+// that a feed-forward run's config is what it was before cores existed.
+const SettingsTable<NetworkConfig, pb::TrainingSettings>& CoreTable() {
+  using C = NetworkConfig;
+  static const auto* table =
+      new SettingsTable<NetworkConfig, pb::TrainingSettings>(
+          "training",
+          {{"core_size", &C::core_size, AtLeast(1)},
            {"seq_len", &C::seq_len, AtLeast(0)}},
           SettingNames::kFlag);
   return *table;
+}
+
+bool NamesACore(const pb::TrainingSettings& training) {
+  return training.has_core() && training.core() != "none";
 }
 
 // The torso by name; the hidden sizes positive.
@@ -65,6 +81,14 @@ absl::Status ResolveNetwork(pb::TrainingSettings& training) {
   if (training.has_core() && !ParseCore(training.core()).ok()) {
     return FlagError("core", absl::StrCat("'", training.core(),
                                           "' is not one of none, gru, lstm"));
+  }
+  if (NamesACore(training)) {
+    return CoreTable().Resolve(NetworkConfig(), training).status();
+  }
+  for (const auto& [given, name] :
+       {std::pair{training.has_core_size(), "core_size"},
+        std::pair{training.has_seq_len(), "seq_len"}}) {
+    if (given) return FlagError(name, "needs a recurrent --core (gru or lstm)");
   }
   return absl::OkStatus();
 }
@@ -94,6 +118,7 @@ absl::StatusOr<NetworkConfig> PolicyNetworkOf(const pb::RunConfig& run) {
   const pb::TrainingSettings& training = run.training();
   NetworkConfig network;
   NetworkTable().Read(training, network);
+  CoreTable().Read(training, network);
   absl::StatusOr<Torso> torso =
       ParseTorso(training.has_torso() ? training.torso() : "mlp");
   if (!torso.ok()) return torso.status();

@@ -52,13 +52,8 @@ int64_t DefaultSegmentLength(int64_t horizon) {
 // horizon (so that every rollout starts with a segment's state).
 absl::Status ResolveSequences(const AlgorithmRunDefaults& run_defaults,
                               pb::TrainingSettings& t) {
-  const bool recurrent = t.has_core() && t.core() != "none";
-  if (!recurrent) {
-    if (t.seq_len() != 0) {
-      return FlagError("seq_len", "needs a recurrent --core (gru or lstm)");
-    }
-    return absl::OkStatus();
-  }
+  // Without a core, --core_size and --seq_len were refused already.
+  if (!t.has_core() || t.core() == "none") return absl::OkStatus();
   if (t.horizon() % t.segment_length() != 0) {
     return FlagError("segment_length",
                      absl::StrCat("must divide --horizon (", t.horizon(),

@@ -155,6 +155,56 @@ TEST(RunConfigTest, ASharedTorsoNeedsOneOptimiserOverBothNetworks) {
       "optimiser; trpo fits its value network alone");
 }
 
+// A recurrent core: its settings appear in the config only with a core;
+// its chunks default to whole segments (a2c: its minibatches' steps); each
+// rule names its flag.
+TEST(RunConfigTest, ARecurrentCoreResolvesItsChunksAndNamesEveryRule) {
+  absl::StatusOr<pb::RunConfig> plain = Resolve(R"({"training": {}})");
+  ASSERT_TRUE(plain.ok()) << plain.status();
+  EXPECT_FALSE(plain->training().has_core_size());
+  EXPECT_FALSE(plain->training().has_seq_len());
+  absl::StatusOr<pb::RunConfig> gru =
+      Resolve(R"({"training": {"env": "CueRecall", "core": "gru"}})");
+  ASSERT_TRUE(gru.ok()) << gru.status();
+  EXPECT_EQ(gru->training().core_size(), 64);
+  EXPECT_EQ(gru->training().seq_len(), 128);
+  absl::StatusOr<RunPlan> plan = PlanRun(*gru);
+  ASSERT_TRUE(plan.ok()) << plan.status();
+  EXPECT_EQ(plan->learner.network.core, Core::kGru);
+  EXPECT_EQ(plan->learner.network.seq_len, 128);
+  EXPECT_EQ(plan->actor.network.core_state_size(), 64);
+  absl::StatusOr<pb::RunConfig> a2c =
+      Resolve(R"({"training": {"core": "lstm"}, "a2c": {}})");
+  ASSERT_TRUE(a2c.ok()) << a2c.status();
+  EXPECT_EQ(a2c->training().seq_len(), 5);
+  const auto error = [](const std::string& json) {
+    return std::string(Resolve(json).status().message());
+  };
+  EXPECT_THAT(error(R"({"training": {"core": "rnn"}})"),
+              HasSubstr("'rnn' is not one of none, gru, lstm"));
+  EXPECT_THAT(error(R"({"training": {"seq_len": 16}})"),
+              HasSubstr("--seq_len needs a recurrent --core (gru or lstm)"));
+  EXPECT_THAT(error(R"({"training": {"core_size": 16}})"),
+              HasSubstr("--core_size needs a recurrent --core"));
+  EXPECT_THAT(error(R"({"training": {"core": "gru", "core_size": 0}})"),
+              HasSubstr("core_size"));
+  EXPECT_THAT(
+      error(R"({"training": {"core": "gru", "seq_len": 48}})"),
+      HasSubstr("--seq_len must divide --segment_length (128), got 48"));
+  EXPECT_THAT(error(R"({"training": {"core": "gru", "horizon": 300,
+                             "segment_length": 128}})"),
+              HasSubstr("--segment_length must divide --horizon (300) with a "
+                        "recurrent --core"));
+  EXPECT_THAT(
+      error(R"({"training": {"core": "gru", "seq_len": 2},
+                         "a2c": {}})"),
+      HasSubstr(
+          "--seq_len must divide the algorithm's minibatch steps (5), got 2"));
+  EXPECT_THAT(error(R"({"training": {"core": "gru"}, "trpo": {}})"),
+              HasSubstr("--core=gru needs ppo or a2c: the policy and the value "
+                        "network share the core"));
+}
+
 // One resolved config, one plan: what the actor and the learner both need
 // is read once and agrees.
 TEST(RunConfigTest, ThePlanGivesActorAndLearnerTheSameRun) {

@@ -2,15 +2,27 @@
 
 #include <ATen/ATen.h>
 
+#include "absl/strings/match.h"
 #include "gtest/gtest.h"
 #include "learner/algorithms/ppo/ppo_config.h"
 
 namespace vantage {
 
-LearnerConfig TestLearnerConfig(const EnvSpec& spec,
-                                const std::string& algorithm) {
+NetworkConfig TestNetwork(const std::string& algorithm) {
+  NetworkConfig network;
+  if (absl::EndsWith(algorithm, "_gru")) {
+    network.core = Core::kGru;
+    network.core_size = 16;
+    network.seq_len = 16;
+  }
+  return network;
+}
+
+LearnerConfig TestLearnerConfig(const EnvSpec& spec, const std::string& name) {
+  const std::string algorithm = name.substr(0, name.find('_'));
   LearnerConfig config;
   config.spec = spec;
+  config.network = TestNetwork(name);
   // A2C's rollouts are 5n steps.
   config.horizon = algorithm == "a2c" ? 60 : kTestHorizon;
   config.rollouts_per_batch = kTestEnvs;
@@ -27,8 +39,10 @@ LearnerConfig TestLearnerConfig(const EnvSpec& spec,
 }
 
 std::unique_ptr<ActorCore> MakeTestActor(int64_t segment_length,
-                                         const std::string& env) {
+                                         const std::string& env,
+                                         const NetworkConfig& network) {
   ActorConfig config;
+  config.network = network;
   config.env = env;
   config.num_envs = kTestEnvs;
   config.segment_length = segment_length;

@@ -19,11 +19,16 @@ inline constexpr int kTestEnvs = 2;
 
 // PPO (4 minibatches, 2 epochs), A2C or TRPO with maxabs at rho 0.5 and
 // reward scaling, kTestEnvs rollouts of kTestHorizon steps (A2C: 60).
+// "ppo_gru": PPO with TestNetwork's core.
 LearnerConfig TestLearnerConfig(const EnvSpec& spec,
                                 const std::string& algorithm);
+// The networks of TestLearnerConfig(spec, algorithm): "..._gru" has a GRU
+// of 16 units trained in chunks of 16 steps.
+NetworkConfig TestNetwork(const std::string& algorithm);
 
-std::unique_ptr<ActorCore> MakeTestActor(int64_t segment_length = kTestHorizon,
-                                         const std::string& env = "Hopper");
+std::unique_ptr<ActorCore> MakeTestActor(
+    int64_t segment_length = kTestHorizon, const std::string& env = "Hopper",
+    const NetworkConfig& network = NetworkConfig());
 
 // One batch of segments acted by `learner`'s current weights.
 std::vector<Segment> ActOneBatch(ActorCore& actor, LearnerCore& learner);

@@ -306,6 +306,25 @@ TEST(SegmentWireTest, RoundTripsBitExact) {
   EXPECT_TRUE(ValidateSegment(*back, ContinuousSpec(), 2048).ok());
 }
 
+// A recurrent policy's start state travels bit for bit; a segment of a
+// feed-forward policy (or an actor from before states) has none, and a
+// state of the wrong dtype is refused by name.
+TEST(SegmentWireTest, ACoreStateRoundTripsAndIsOptional) {
+  Segment segment = RealisticSegment();
+  absl::StatusOr<Segment> back = SegmentOverWire(segment);
+  ASSERT_TRUE(back.ok()) << back.status();
+  EXPECT_FALSE(back->core_state.defined());
+  segment.core_state = at::randn({48});
+  back = SegmentOverWire(segment);
+  ASSERT_TRUE(back.ok()) << back.status();
+  EXPECT_TRUE(BitEqual(segment.core_state, back->core_state));
+  segment.core_state = at::randn({48}, at::kDouble);
+  EXPECT_THAT(SegmentOverWire(segment).status().message(),
+              ::testing::HasSubstr("segment.core_state"));
+  EXPECT_GE(MaxSegmentMessageBytes(ContinuousSpec(), 16, 48),
+            MaxSegmentMessageBytes(ContinuousSpec(), 16) + 4 * 48);
+}
+
 TEST(SegmentWireTest, EmptyFinalObservationsKeepTheirShape) {
   Segment segment = RealisticSegment();
   segment.truncated.zero_();

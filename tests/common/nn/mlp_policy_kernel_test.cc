@@ -118,6 +118,71 @@ void CompareWithLibTorch(const Case& c) {
       << "the generators drew different amounts";
 }
 
+// A recurrent policy over 50 steps at each of several batch sizes: the
+// states the kernel carries stay with LibTorch's (PolicyNetworkImpl::Step),
+// rows zeroed on both sides where an episode starts, and the outputs,
+// actions and log-probabilities agree.
+void CompareRecurrentWithLibTorch(Core core, const Case& c) {
+  const EnvSpec spec = VectorSpec(c.discrete, 7, c.actions);
+  NetworkConfig config;
+  config.hidden = c.hidden;
+  config.core = core;
+  config.core_size = 24;
+  PolicyNetwork policy(spec, config);
+  RunningMeanStd normalizer(spec.observation_size);
+  Randomise(*policy, normalizer, spec);
+  absl::StatusOr<MlpPolicyKernel> kernel =
+      MlpPolicyKernel::Create(spec, *policy, normalizer, kClip);
+  ASSERT_TRUE(kernel.ok()) << kernel.status();
+  ASSERT_EQ(kernel->state_size(), config.core_state_size());
+  at::Generator reference = at::make_generator<at::CPUGeneratorImpl>(11);
+  at::Generator fast = at::make_generator<at::CPUGeneratorImpl>(11);
+  at::NoGradGuard no_grad;
+  for (int64_t rows : {1, 3, 16}) {
+    at::Tensor state = at::randn({rows, kernel->state_size()}) * 0.5;
+    std::vector<float> states(state.data_ptr<float>(),
+                              state.data_ptr<float>() + state.numel());
+    for (int step = 0; step < 50; ++step) {
+      const std::string what =
+          "rows " + std::to_string(rows) + " step " + std::to_string(step);
+      if (step % 7 == 3) {
+        const int64_t row = step % rows;
+        state[row].zero_();
+        std::fill_n(states.begin() + row * kernel->state_size(),
+                    kernel->state_size(), 0.0f);
+      }
+      const std::vector<double> observations = Observations(spec, rows);
+      const at::Tensor output = policy->Step(
+          ObservationsForNetwork(
+              spec, normalizer,
+              ObservationTensor(spec, observations.data(), rows), kClip),
+          state);
+      std::vector<float> outputs(rows * c.actions);
+      kernel->Forward(observations.data(), rows, outputs.data(), states.data());
+      ExpectClose(outputs, output, what + " outputs");
+      ExpectClose(states, state, what + " states");
+      const at::Tensor action = policy->Act(output, false, reference);
+      std::vector<float> actions(rows * kernel->action_width());
+      std::vector<float> log_probs(rows);
+      kernel->Act(outputs.data(), rows, fast, actions.data(), log_probs.data());
+      ExpectClose(actions, action, what + " actions");
+      ExpectClose(log_probs, policy->LogProb(output, action),
+                  what + " log-probs");
+      if (::testing::Test::HasFailure()) return;
+    }
+  }
+}
+
+TEST(MlpPolicyKernelTest, AGruPolicyAgreesWithLibTorch) {
+  CompareRecurrentWithLibTorch(Core::kGru, {false, 0, {32, 16}, 3});
+  CompareRecurrentWithLibTorch(Core::kGru, {true, 0, {}, 4});
+}
+
+TEST(MlpPolicyKernelTest, AnLstmPolicyAgreesWithLibTorch) {
+  CompareRecurrentWithLibTorch(Core::kLstm, {false, 0, {16}, 2});
+  CompareRecurrentWithLibTorch(Core::kLstm, {true, 0, {32, 32}, 5});
+}
+
 TEST(MlpPolicyKernelTest, GaussianTwoHiddenLayersAgreesWithLibTorch) {
   CompareWithLibTorch({false, 0, {64, 64}, 6});
 }

@@ -2,6 +2,7 @@
 
 #include <ATen/ATen.h>
 
+#include <cmath>
 #include <functional>
 #include <string>
 #include <thread>
@@ -205,6 +206,34 @@ TEST(SegmentTest, ScalarRewardsAreRefusedNotThrown) {
   EXPECT_EQ(s.steps(), 0);
   EXPECT_THAT(ValidateSegment(s, Spec(), 128).message(),
               HasSubstr("0 steps, expected 1..128"));
+}
+
+// A recurrent run's segments carry the core's start state: of the run's
+// size, finite, in whole segments; a feed-forward run's carry none.
+TEST(SegmentTest, ACoreStateIsCheckedAgainstTheRun) {
+  const ValueLimits limits;
+  Segment s = ValidSegment();
+  EXPECT_THAT(ValidateSegment(s, Spec(), 4, limits, 6).message(),
+              HasSubstr("core_state is missing: this run's policy is "
+                        "recurrent (a state of 6 floats"));
+  s.core_state = at::zeros({6});
+  EXPECT_TRUE(ValidateSegment(s, Spec(), 4, limits, 6).ok());
+  EXPECT_THAT(ValidateSegment(s, Spec(), 4).message(),
+              HasSubstr("core_state is set, but this run's policy has no "
+                        "recurrent core"));
+  EXPECT_THAT(ValidateSegment(s, Spec(), 8, limits, 6).message(),
+              HasSubstr("segment has 4 steps; a recurrent run takes whole "
+                        "segments of 8"));
+  s.core_state = at::zeros({5});
+  EXPECT_THAT(ValidateSegment(s, Spec(), 4, limits, 6).message(),
+              HasSubstr("core_state has shape [5], expected [6]"));
+  s.core_state = at::zeros({6});
+  s.core_state[2] = std::nanf("");
+  EXPECT_THAT(ValidateSegment(s, Spec(), 4, limits, 6).message(),
+              HasSubstr("core_state holds non-finite values"));
+  s.core_state = at::zeros({6}, at::kDouble);
+  EXPECT_THAT(ValidateSegment(s, Spec(), 4, limits, 6).message(),
+              HasSubstr("core_state has dtype Double, expected Float"));
 }
 
 TEST(SegmentQueueTest, BoundedFifoThatCloses) {

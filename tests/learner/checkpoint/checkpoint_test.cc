@@ -58,7 +58,8 @@ class CheckpointTest : public ::testing::TestWithParam<std::string> {};
 // segments, the same next update (which needs the optimiser's moments, the
 // reward scaler and the minibatch generator to have come back too).
 TEST_P(CheckpointTest, RoundTripRestoresTheWholeLearner) {
-  auto actor = MakeTestActor(GetParam() == "a2c" ? 60 : kHorizon);
+  auto actor = MakeTestActor(GetParam() == "a2c" ? 60 : kHorizon, "Hopper",
+                             TestNetwork(GetParam()));
   const LearnerConfig config = Config(actor->spec(), GetParam());
   auto learner = *LearnerCore::Create(config);
   for (int i = 0; i < 2; ++i)
@@ -90,7 +91,7 @@ TEST_P(CheckpointTest, RoundTripRestoresTheWholeLearner) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Algorithms, CheckpointTest,
-                         ::testing::Values("ppo", "a2c", "trpo"));
+                         ::testing::Values("ppo", "a2c", "trpo", "ppo_gru"));
 
 class CheckpointErrorTest : public ::testing::Test {
  protected:
@@ -136,6 +137,29 @@ TEST_F(CheckpointErrorTest, OtherNetworkSizesAreRefused) {
   const absl::Status status = ReadCheckpoint(path_, other).status();
   EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument);
   EXPECT_THAT(std::string(status.message()), HasSubstr("networks"));
+}
+
+// Networks are never reinitialised to fit a config: a feed-forward
+// policy's checkpoint does not take a core, nor a GRU's another one.
+TEST_F(CheckpointErrorTest, AnotherCoreIsRefusedByName) {
+  LearnerConfig gru = config_;
+  gru.network = TestNetwork("ppo_gru");
+  absl::Status status = ReadCheckpoint(path_, gru).status();
+  EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(std::string(status.message()),
+              HasSubstr("checkpoint's policy has core none, but the run "
+                        "config says gru:16 (--core, --core_size)"));
+  const std::string gru_path = TempFile("gru.pt");
+  ASSERT_TRUE(WriteCheckpoint(gru_path, **LearnerCore::Create(gru), {}).ok());
+  EXPECT_TRUE(ReadCheckpoint(gru_path, gru).ok());
+  status = ReadCheckpoint(gru_path, config_).status();
+  EXPECT_THAT(std::string(status.message()),
+              HasSubstr("has core gru:16, but the run config says none"));
+  LearnerConfig lstm = gru;
+  lstm.network.core = Core::kLstm;
+  status = ReadCheckpoint(gru_path, lstm).status();
+  EXPECT_THAT(std::string(status.message()),
+              HasSubstr("has core gru:16, but the run config says lstm:16"));
 }
 
 TEST_F(CheckpointErrorTest, AnEx2RunDoesNotContinueARunWithoutIt) {
