@@ -52,7 +52,7 @@ const std::map<std::string, Factory>& Factories() {
         {"FirstPersonMaze", Plain(MakeFirstPersonMaze)},
         {"Humanoid", Plain(MakeHumanoid)},
         {"InvertedDoublePendulum", Plain(MakeInvertedDoublePendulum)},
-        {"InvertedPendulum", Plain(MakeInvertedPendulum)},
+        {"InvertedPendulum", MakeInvertedPendulum},
         {"MinAtarAsterix", Plain(MakeMinAtarAsterix)},
         {"MinAtarBreakout", Plain(MakeMinAtarBreakout)},
         {"MinAtarFreeway", Plain(MakeMinAtarFreeway)},
@@ -110,6 +110,7 @@ absl::StatusOr<std::unique_ptr<Environment>> MakeEnvironment(
 
 std::vector<EnvOptionInfo> EnvironmentOptions(const std::string& name) {
   if (name == "CueRecall") return CueRecallOptions();
+  if (name == "InvertedPendulum") return InvertedPendulumOptions();
   return GymTaskOptions(name);
 }
 

@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
 #include <utility>
+#include <vector>
 
 #include "actor/envs/mujoco/models.h"
 #include "actor/envs/mujoco/mujoco_env.h"
@@ -10,11 +12,24 @@
 namespace vantage {
 namespace {
 
+struct InvertedPendulumTask {
+  bool hide_velocities = false;
+};
+
+std::vector<EnvOption> Options(InvertedPendulumTask& task) {
+  return {{"hide_velocities",
+           "observe the cart's and the pole's positions only (partially "
+           "observable: velocities must be inferred over time)",
+           &task.hide_velocities}};
+}
+
 class InvertedPendulum : public MujocoEnv {
  public:
-  InvertedPendulum(EnvSpec spec, MjModelPtr model, MjDataPtr data)
+  InvertedPendulum(EnvSpec spec, MjModelPtr model, MjDataPtr data,
+                   bool hide_velocities)
       : MujocoEnv(std::move(spec), std::move(model), std::move(data),
-                  /*frame_skip=*/2) {}
+                  /*frame_skip=*/2),
+        hide_velocities_(hide_velocities) {}
 
  protected:
   void ResetState(std::mt19937_64& rng) override {
@@ -34,8 +49,13 @@ class InvertedPendulum : public MujocoEnv {
   }
   void Observe(double* observation) const override {
     std::copy(data()->qpos, data()->qpos + 2, observation);
-    std::copy(data()->qvel, data()->qvel + 2, observation + 2);
+    if (!hide_velocities_) {
+      std::copy(data()->qvel, data()->qvel + 2, observation + 2);
+    }
   }
+
+ private:
+  const bool hide_velocities_;
 };
 
 class InvertedDoublePendulum : public MujocoEnv {
@@ -96,8 +116,23 @@ absl::StatusOr<std::unique_ptr<Environment>> Build(const char* name,
 
 }  // namespace
 
-absl::StatusOr<std::unique_ptr<Environment>> MakeInvertedPendulum() {
-  return Build<InvertedPendulum>("InvertedPendulum", kInvertedPendulumXml, 4);
+absl::StatusOr<std::unique_ptr<Environment>> MakeInvertedPendulum(
+    const EnvName& name) {
+  InvertedPendulumTask task;
+  if (absl::Status status =
+          ApplyEnvOptions(name.task, Options(task), name.options);
+      !status.ok()) {
+    return status;
+  }
+  const std::string canonical = name.Canonical();
+  return Build<InvertedPendulum>(canonical.c_str(), kInvertedPendulumXml,
+                                 task.hide_velocities ? 2 : 4,
+                                 task.hide_velocities);
+}
+
+std::vector<EnvOptionInfo> InvertedPendulumOptions() {
+  InvertedPendulumTask task;
+  return Describe(Options(task));
 }
 
 absl::StatusOr<std::unique_ptr<Environment>> MakeInvertedDoublePendulum() {

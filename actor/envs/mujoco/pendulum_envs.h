@@ -4,13 +4,18 @@
 #include <memory>
 
 #include "absl/status/statusor.h"
+#include "actor/envs/env_options.h"
 #include "common/env/environment.h"
 
 namespace vantage {
 
 // Gymnasium v4 InvertedPendulum: obs (qpos, qvel) = 4, reward 1 per step,
 // terminated once |pole angle| > 0.2 rad; frame skip 2 (dt 0.04 s).
-absl::StatusOr<std::unique_ptr<Environment>> MakeInvertedPendulum();
+// Option hide_velocities (`InvertedPendulum:hide_velocities=true`): obs
+// qpos only (2), a standard partially observable variant.
+absl::StatusOr<std::unique_ptr<Environment>> MakeInvertedPendulum(
+    const EnvName& name);
+std::vector<EnvOptionInfo> InvertedPendulumOptions();
 
 // Gymnasium v4 InvertedDoublePendulum: obs 11 = (cart x, sin and cos of
 // both hinges, clip(qvel, +-10), clip(qfrc_constraint, +-10)), reward
