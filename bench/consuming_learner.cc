@@ -3,6 +3,8 @@
 #include <chrono>
 #include <utility>
 
+#include "actor/run_settings.h"
+
 namespace vantage {
 namespace {
 
@@ -11,6 +13,10 @@ GatewayConfig MakeGatewayConfig(const pb::RunConfig& run_config,
   GatewayConfig config;
   config.run_config = run_config;
   config.spec = spec;
+  if (absl::StatusOr<NetworkConfig> network = PolicyNetworkOf(run_config);
+      network.ok()) {
+    config.core_state_size = network->core_state_size();
+  }
   config.run_config.mutable_distributed()->set_sync(false);
   config.max_segment_steps = run_config.training().segment_length();
   config.max_policy_lag = -1;  // nothing is too stale to be ingested

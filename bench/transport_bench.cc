@@ -51,7 +51,8 @@ int Fail(const char* bench, const absl::Status& status) {
   return 1;
 }
 
-pb::RunConfig BenchRunConfig(const std::string& env) {
+pb::RunConfig BenchRunConfig(const std::string& env,
+                             const NetworkConfig& network = NetworkConfig()) {
   pb::RunConfig run;
   pb::TrainingSettings& training = *run.mutable_training();
   training.set_env(env);
@@ -59,14 +60,21 @@ pb::RunConfig BenchRunConfig(const std::string& env) {
   training.set_segment_length(kSegmentLength);
   training.add_hidden(64);
   training.add_hidden(64);
+  if (network.recurrent()) {
+    training.set_core(CoreName(network.core));
+    training.set_core_size(network.core_size);
+    training.set_seq_len(kSegmentLength);
+  }
   run.mutable_distributed()->set_sync(false);
   run.mutable_distributed()->set_max_policy_lag(4);
   return run;
 }
 
-// Version 0 of a fresh 64x64 policy for `spec`.
-PolicyWeights FreshWeights(const EnvSpec& spec) {
-  NetworkConfig network;
+// Version 0 of a fresh 64x64 policy for `spec` (with `core`'s recurrent
+// core, if any).
+PolicyWeights FreshWeights(const EnvSpec& spec,
+                           const NetworkConfig& core = NetworkConfig()) {
+  NetworkConfig network = core;
   network.hidden = {64, 64};
   PolicyNetwork policy(spec, network);
   RunningMeanStd normalizer(spec.observation_size);
@@ -381,7 +389,8 @@ int RunConnectionsBenchmark(int max_actors) {
   return 0;
 }
 
-int RunActorBenchmark(const std::string& env_name, int envs, double seconds) {
+int RunActorBenchmark(const std::string& env_name, int envs, double seconds,
+                      const NetworkConfig& network) {
   SetComputeThreads(1);
   absl::StatusOr<std::unique_ptr<Environment>> probe =
       MakeEnvironment(env_name);
@@ -403,10 +412,10 @@ int RunActorBenchmark(const std::string& env_name, int envs, double seconds) {
   // The `vantage actor` loop itself, paced by a learner that publishes a
   // version per batch of its data and otherwise only ingests.
   const EnvSpec spec = (*probe)->spec();
-  const pb::RunConfig run = BenchRunConfig(env_name);
+  const pb::RunConfig run = BenchRunConfig(env_name, network);
   absl::StatusOr<std::unique_ptr<ConsumingLearner>> learner =
       ConsumingLearner::Start(
-          run, spec, FreshWeights(spec),
+          run, spec, FreshWeights(spec, network),
           /*steps_per_version=*/run.training().horizon() * envs);
   if (!learner.ok()) return Fail("actor", learner.status());
   RemoteActorConfig config;
@@ -430,9 +439,13 @@ int RunActorBenchmark(const std::string& env_name, int envs, double seconds) {
       "learner that only ingests, against bare physics stepping\n",
       envs, env_name.c_str(), static_cast<long>(kSegmentLength));
   std::printf(
-      "RESULT actor env=%s envs=%d raw_steps_per_s=%.0f "
+      "RESULT actor env=%s envs=%d core=%s raw_steps_per_s=%.0f "
       "actor_steps_per_s=%.0f ratio=%.3f\n",
-      env_name.c_str(), envs, raw, streamed, streamed / raw);
+      env_name.c_str(), envs,
+      network.recurrent()
+          ? absl::StrCat(CoreName(network.core), ":", network.core_size).c_str()
+          : "none",
+      raw, streamed, streamed / raw);
   return 0;
 }
 

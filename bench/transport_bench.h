@@ -6,6 +6,8 @@
 
 #include <string>
 
+#include "common/nn/network_config.h"
+
 namespace vantage {
 
 // `vantage bench ingest`: K clients stream HalfCheetah-sized segments (128
@@ -24,9 +26,12 @@ int RunIngestBenchmark(int clients, double seconds);
 // and publishes a version per horizon of its data), over `seconds` split
 // into windows, the fastest kept, against the bare physics of the env's
 // model on one core (`bench env`'s raw figure, measured in the same run).
-// Ends with `RESULT actor env=NAME envs=M raw_steps_per_s=<x>
-// actor_steps_per_s=<y> ratio=<y/x>`. Returns the exit code.
-int RunActorBenchmark(const std::string& env_name, int envs, double seconds);
+// The policy is `network` (64x64 tanh layers, and its recurrent core if
+// any, whose state the actor carries and sends). Ends with `RESULT actor
+// env=NAME envs=M core=C raw_steps_per_s=<x> actor_steps_per_s=<y>
+// ratio=<y/x>`. Returns the exit code.
+int RunActorBenchmark(const std::string& env_name, int envs, double seconds,
+                      const NetworkConfig& network);
 
 // `vantage bench connections`: what connected actors cost a learner. A
 // `vantage learner` process (InvertedPendulum, a batch that never

@@ -22,6 +22,13 @@ void Project(const float* in, int64_t rows, int64_t k, int64_t stride,
   for (int64_t r = 0; r < rows; ++r) {
     std::copy(bias.begin(), bias.end(), out + r * n);
   }
+  // One environment: a matrix-vector product, which BLAS does faster.
+  if (rows == 1) {
+    cblas_sgemv(CblasRowMajor, CblasNoTrans, static_cast<int>(n),
+                static_cast<int>(k), 1.0f, weight.data(), static_cast<int>(k),
+                in, 1, 1.0f, out, 1);
+    return;
+  }
   cblas_sgemm(CblasRowMajor, CblasNoTrans, CblasTrans, static_cast<int>(rows),
               static_cast<int>(n), static_cast<int>(k), 1.0f, in,
               static_cast<int>(stride), weight.data(), static_cast<int>(k),

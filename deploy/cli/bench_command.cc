@@ -199,7 +199,19 @@ int RunActorBench() {
   if (envs < 1 || !(seconds > 0)) {
     return Usage("actor: --envs must be >= 1 and --bench_seconds > 0");
   }
-  return RunActorBenchmark(env, envs, seconds);
+  // The policy: 64x64 tanh layers, and a recurrent core if one is given.
+  absl::StatusOr<RunRequest> request = RunRequestFromFlags();
+  if (!request.ok()) {
+    return Usage(std::string(request.status().message()).c_str());
+  }
+  const pb::TrainingSettings& given = request->flags.training();
+  absl::StatusOr<Core> core =
+      ParseCore(given.has_core() ? given.core() : "none");
+  if (!core.ok()) return Usage(std::string(core.status().message()).c_str());
+  NetworkConfig network;
+  network.core = *core;
+  if (given.has_core_size()) network.core_size = given.core_size();
+  return RunActorBenchmark(env, envs, seconds, network);
 }
 
 int RunEnvBench() {
