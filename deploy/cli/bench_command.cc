@@ -20,6 +20,7 @@
 #include "bench/advantage_bench.h"
 #include "bench/env_bench.h"
 #include "bench/learner_bench.h"
+#include "bench/recurrent_learner_bench.h"
 #include "bench/train_bench.h"
 #include "bench/transport_bench.h"
 #include "deploy/cli/command_line.h"
@@ -190,6 +191,20 @@ int RunAdvantagesBench() {
   return RunAdvantageBenchmark(steps, streams);
 }
 
+// The recurrent core the run flags give (--core, --core_size), if any.
+absl::StatusOr<NetworkConfig> CoreFromFlags() {
+  absl::StatusOr<RunRequest> request = RunRequestFromFlags();
+  if (!request.ok()) return request.status();
+  const pb::TrainingSettings& given = request->flags.training();
+  absl::StatusOr<Core> core =
+      ParseCore(given.has_core() ? given.core() : "none");
+  if (!core.ok()) return core.status();
+  NetworkConfig network;
+  network.core = *core;
+  if (given.has_core_size()) network.core_size = given.core_size();
+  return network;
+}
+
 int RunActorBench() {
   const std::string env =
       FlagGiven("env") ? absl::GetFlag(FLAGS_env) : kActorBenchEnv;
@@ -199,19 +214,11 @@ int RunActorBench() {
   if (envs < 1 || !(seconds > 0)) {
     return Usage("actor: --envs must be >= 1 and --bench_seconds > 0");
   }
-  // The policy: 64x64 tanh layers, and a recurrent core if one is given.
-  absl::StatusOr<RunRequest> request = RunRequestFromFlags();
-  if (!request.ok()) {
-    return Usage(std::string(request.status().message()).c_str());
+  absl::StatusOr<NetworkConfig> network = CoreFromFlags();
+  if (!network.ok()) {
+    return Usage(std::string(network.status().message()).c_str());
   }
-  const pb::TrainingSettings& given = request->flags.training();
-  absl::StatusOr<Core> core =
-      ParseCore(given.has_core() ? given.core() : "none");
-  if (!core.ok()) return Usage(std::string(core.status().message()).c_str());
-  NetworkConfig network;
-  network.core = *core;
-  if (given.has_core_size()) network.core_size = given.core_size();
-  return RunActorBenchmark(env, envs, seconds, network);
+  return RunActorBenchmark(env, envs, seconds, *network);
 }
 
 int RunEnvBench() {
@@ -241,6 +248,11 @@ int RunConnectionsBench() {
 
 int RunLearnerBench() {
   const std::string replica_of = absl::GetFlag(FLAGS_bench_replica_of);
+  absl::StatusOr<NetworkConfig> network = CoreFromFlags();
+  if (!network.ok()) {
+    return Usage(std::string(network.status().message()).c_str());
+  }
+  if (network->recurrent()) return RunRecurrentLearnerBenchmark(*network);
   return replica_of.empty()
              ? RunLearnerBenchmark()
              : RunLearnerBenchmarkReplica(
