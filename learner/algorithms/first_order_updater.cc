@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <utility>
 
+#include "common/util/scratch_buffer.h"
 #include "learner/algorithms/gradient_step.h"
 
 namespace vantage {
@@ -44,10 +45,43 @@ FirstOrderUpdater::FlatRows FirstOrderUpdater::StartFlatUpdate(
     const UpdateBatch& batch) {
   flat_->Pull();
   const int64_t size = batch.observations.size(0);
-  return FlatRows{
+  FlatRows rows{
       flat_->Inputs(batch.observations), FloatRows(batch.actions, size),
       FloatRows(batch.behaviour_log_probs, size),
       FloatRows(batch.advantages, size), FloatRows(batch.returns, size)};
+  if (batch.seq_len > 0) {
+    rows.starts = batch.starts.to(at::kByte).contiguous();
+    rows.states = FloatRows(batch.chunk_states, batch.chunk_states.size(0));
+    rows.seq_len = batch.seq_len;
+  }
+  return rows;
+}
+
+FirstOrderUpdater::Gathered FirstOrderUpdater::GatherAndForward(
+    const FlatRows& rows, const ChunkMinibatch& minibatch) {
+  const int64_t count = minibatch.rows.size(0);
+  const int64_t* index = minibatch.rows.data_ptr<int64_t>();
+  GatherRows(rows.inputs.data_ptr<float>(), rows.inputs.size(1), index, count,
+             inputs_);
+  GatherRows(rows.actions.data_ptr<float>(), rows.actions.size(1), index, count,
+             actions_);
+  GatherRows(rows.behaviour.data_ptr<float>(), 1, index, count, behaviour_);
+  GatherRows(rows.advantages.data_ptr<float>(), 1, index, count, advantages_);
+  GatherRows(rows.returns.data_ptr<float>(), 1, index, count, returns_);
+  if (minibatch.chunks.defined()) {
+    const int64_t chunks = minibatch.chunks.size(0);
+    const uint8_t* starts = rows.starts.data_ptr<uint8_t>();
+    uint8_t* gathered = GrowScratch(starts_, count);
+    for (int64_t r = 0; r < count; ++r) gathered[r] = starts[index[r]];
+    GatherRows(rows.states.data_ptr<float>(), rows.states.size(1),
+               minibatch.chunks.data_ptr<int64_t>(), chunks, states_);
+    flat_->ForwardSequences(inputs_.data(), actions_.data(), gathered,
+                            states_.data(), rows.seq_len, chunks);
+  } else {
+    flat_->Forward(inputs_.data(), actions_.data(), count);
+  }
+  return Gathered{count, behaviour_.data(), advantages_.data(),
+                  returns_.data()};
 }
 
 ChunkOutputs FirstOrderUpdater::Evaluate(const UpdateBatch& batch,

@@ -70,13 +70,29 @@ class FirstOrderUpdater : public PolicyUpdater {
   virtual AlgorithmStats AutogradUpdate(const UpdateBatch& batch,
                                         std::mt19937_64& rng) = 0;
 
-  // The batch's columns as contiguous float rows, for the flat networks.
+  // The batch's columns as contiguous float rows, for the flat networks;
+  // a recurrent policy's also the episode starts (uint8 per row) and the
+  // chunks' start states.
   struct FlatRows {
     at::Tensor inputs, actions, behaviour, advantages, returns;
+    at::Tensor starts, states;
+    int64_t seq_len = 0;
   };
   // Pulls the modules' parameters into the flat networks (they may have
   // been rolled back or loaded since the last update) and lays out `batch`.
   FlatRows StartFlatUpdate(const UpdateBatch& batch);
+
+  // The rows of `minibatch` (in its order) gathered from `rows`, and the
+  // flat networks' forward pass on them: over its chunks for a recurrent
+  // policy. Valid until the next call.
+  struct Gathered {
+    int64_t rows = 0;
+    const float* behaviour = nullptr;
+    float* advantages = nullptr;  // the caller's to normalise or weight
+    const float* returns = nullptr;
+  };
+  Gathered GatherAndForward(const FlatRows& rows,
+                            const ChunkMinibatch& minibatch);
 
   // A flat minibatch's loss sums over its rows.
   struct LossSums {
@@ -123,6 +139,10 @@ class FirstOrderUpdater : public PolicyUpdater {
   std::optional<FlatActorCritic> flat_;
   std::unique_ptr<FlatOptimizer> flat_optimizer_;
   std::vector<float> d_log_probs_, d_values_;
+  // Scratch of GatherAndForward: one minibatch's rows.
+  std::vector<float> inputs_, actions_, behaviour_, advantages_, returns_,
+      states_;
+  std::vector<uint8_t> starts_;
 };
 
 }  // namespace vantage

@@ -24,9 +24,10 @@ absl::StatusOr<FlatActorCritic> FlatActorCritic::Create(
     return absl::UnimplementedError(
         "the networks have a convolutional torso, which only autograd trains");
   }
-  if (policy.recurrent()) {
+  if (policy.recurrent() && !policy.trunk()->conv_torso().is_empty()) {
     return absl::UnimplementedError(
-        "the networks have a recurrent core, which only autograd trains");
+        "the networks' core follows a convolutional torso, which only "
+        "autograd trains");
   }
   FlatActorCritic flat;
   flat.spec_ = policy.spec();
@@ -60,12 +61,19 @@ absl::StatusOr<int64_t> FlatActorCritic::TakeParameters(
 absl::Status FlatActorCritic::LayOutNetworks(PolicyNetworkImpl& policy,
                                              ValueNetworkImpl& value) {
   std::vector<bool> claimed(tensors_.size(), false);
+  if (policy.recurrent()) {
+    if (absl::Status status = LayOutRecurrent(policy, value, claimed);
+        !status.ok()) {
+      return status;
+    }
+  }
+  const int64_t inputs = core_ ? core_->hidden() : spec_.observation_size;
   if (absl::Status status =
-          LayOutMlp(policy.body(), spec_.action_size, claimed, policy_);
+          LayOutMlp(policy.body(), inputs, spec_.action_size, claimed, policy_);
       !status.ok()) {
     return status;
   }
-  if (absl::Status status = LayOutMlp(value.body(), 1, claimed, value_);
+  if (absl::Status status = LayOutMlp(value.body(), inputs, 1, claimed, value_);
       !status.ok()) {
     return status;
   }
@@ -82,10 +90,52 @@ absl::Status FlatActorCritic::LayOutNetworks(PolicyNetworkImpl& policy,
   return absl::OkStatus();
 }
 
-absl::Status FlatActorCritic::LayOutMlp(const TanhMlp& body, int64_t outputs,
+absl::Status FlatActorCritic::LayOutRecurrent(PolicyNetworkImpl& policy,
+                                              ValueNetworkImpl& value,
+                                              std::vector<bool>& claimed) {
+  if (!value.recurrent()) {
+    return absl::UnimplementedError("the value network has no recurrent trunk");
+  }
+  const RecurrentTrunk& trunk = policy.trunk();
+  int64_t width = spec_.observation_size;
+  if (!trunk->encoder().is_empty()) {
+    const auto& last = trunk->encoder()->layers()->at<torch::nn::LinearImpl>(
+        trunk->encoder()->layers()->size() - 1);
+    width = last.weight.size(0);
+    if (absl::Status status = LayOutMlp(
+            trunk->encoder(), spec_.observation_size, width, claimed, encoder_);
+        !status.ok()) {
+      return status;
+    }
+    encoder_.squash_last = true;
+  }
+  const bool lstm = trunk->core() == Core::kLstm;
+  const at::Tensor& weight_ih =
+      lstm ? trunk->lstm()->weight_ih : trunk->gru()->weight_ih;
+  const at::Tensor& weight_hh =
+      lstm ? trunk->lstm()->weight_hh : trunk->gru()->weight_hh;
+  FlatRecurrentCore::Offsets offsets;
+  offsets.weight_ih = ClaimOffset(weight_ih, claimed);
+  offsets.weight_hh = ClaimOffset(weight_hh, claimed);
+  offsets.bias_ih = ClaimOffset(
+      lstm ? trunk->lstm()->bias_ih : trunk->gru()->bias_ih, claimed);
+  offsets.bias_hh = ClaimOffset(
+      lstm ? trunk->lstm()->bias_hh : trunk->gru()->bias_hh, claimed);
+  if (offsets.weight_ih < 0 || offsets.weight_hh < 0 || offsets.bias_ih < 0 ||
+      offsets.bias_hh < 0 || weight_ih.size(1) != width) {
+    return absl::UnimplementedError(
+        absl::StrCat("the core is not a biased cell on ", width,
+                     " inputs whose parameters are the given ones"));
+  }
+  core_.emplace(trunk->core(), width, trunk->features(), offsets);
+  return absl::OkStatus();
+}
+
+absl::Status FlatActorCritic::LayOutMlp(const TanhMlp& body, int64_t inputs,
+                                        int64_t outputs,
                                         std::vector<bool>& claimed, Mlp& mlp) {
   const torch::nn::ModuleList& layers = body->layers();
-  int64_t width = spec_.observation_size;
+  int64_t width = inputs;
   for (size_t i = 0; i < layers->size(); ++i) {
     const auto& linear = layers->at<torch::nn::LinearImpl>(i);
     Layer layer;
@@ -155,7 +205,7 @@ void FlatActorCritic::MlpForward(Mlp& mlp, const float* inputs, int64_t rows) {
                 layer.inputs, 1.0f, x, layer.inputs,
                 parameters_.data() + layer.weight, layer.inputs, 1.0f, y,
                 layer.outputs);
-    if (l + 1 < mlp.layers.size()) {
+    if (l + 1 < mlp.layers.size() || mlp.squash_last) {
       // LibTorch's vectorised tanh, the one the modules use: libm's scalar
       // tanhf would take most of the step.
       at::from_blob(y, {rows * layer.outputs}).tanh_();
@@ -165,7 +215,8 @@ void FlatActorCritic::MlpForward(Mlp& mlp, const float* inputs, int64_t rows) {
 }
 
 void FlatActorCritic::MlpBackward(Mlp& mlp, const float* inputs, int64_t rows,
-                                  std::vector<float>& gradient) {
+                                  std::vector<float>& gradient,
+                                  float* d_inputs) {
   for (size_t l = mlp.layers.size(); l-- > 0;) {
     const Layer& layer = mlp.layers[l];
     const float* x = l == 0 ? inputs : mlp.outputs[l - 1].data();
@@ -180,12 +231,13 @@ void FlatActorCritic::MlpBackward(Mlp& mlp, const float* inputs, int64_t rows,
         db[j] += dy[r * layer.outputs + j];
       }
     }
-    if (l == 0) break;
-    float* dx = GrowScratch(scratch_, rows * layer.inputs);
+    if (l == 0 && d_inputs == nullptr) break;
+    float* dx = l == 0 ? d_inputs : GrowScratch(scratch_, rows * layer.inputs);
     cblas_sgemm(CblasRowMajor, CblasNoTrans, CblasNoTrans, rows, layer.inputs,
                 layer.outputs, 1.0f, dy, layer.outputs,
                 parameters_.data() + layer.weight, layer.inputs, 0.0f, dx,
                 layer.inputs);
+    if (l == 0) break;
     // Through the tanh whose outputs x are.
     for (int64_t i = 0; i < rows * layer.inputs; ++i) {
       dx[i] *= 1.0f - x[i] * x[i];
@@ -201,6 +253,30 @@ void FlatActorCritic::Forward(const float* inputs, const float* actions,
   actions_ = actions;
   MlpForward(policy_, inputs, rows);
   MlpForward(value_, inputs, rows);
+  Heads(actions, rows);
+}
+
+void FlatActorCritic::ForwardSequences(const float* inputs,
+                                       const float* actions,
+                                       const uint8_t* starts,
+                                       const float* states, int64_t steps,
+                                       int64_t chunks) {
+  const int64_t rows = steps * chunks;
+  rows_ = rows;
+  inputs_ = inputs;
+  actions_ = actions;
+  const float* encoded = inputs;
+  if (!encoder_.layers.empty()) {
+    MlpForward(encoder_, inputs, rows);
+    encoded = encoder_.outputs.back().data();
+  }
+  core_->Forward(parameters_.data(), encoded, starts, states, steps, chunks);
+  MlpForward(policy_, core_->features(), rows);
+  MlpForward(value_, core_->features(), rows);
+  Heads(actions, rows);
+}
+
+void FlatActorCritic::Heads(const float* actions, int64_t rows) {
   GrowScratch(values_, rows);
   std::memcpy(values_.data(), value_.outputs.back().data(),
               sizeof(float) * rows);
@@ -300,10 +376,34 @@ void FlatActorCritic::Backward(const float* d_log_probs, double entropy_weight,
       d_log_std[j] += sum;
     }
   }
-  MlpBackward(policy_, inputs_, rows, policy_gradient_);
   float* d_value = GrowScratch(value_gradient_, rows);
   std::memcpy(d_value, d_values, sizeof(float) * rows);
+  if (core_) {
+    TrunkBackward(rows);
+    return;
+  }
+  MlpBackward(policy_, inputs_, rows, policy_gradient_);
   MlpBackward(value_, inputs_, rows, value_gradient_);
+}
+
+void FlatActorCritic::TrunkBackward(int64_t rows) {
+  const int64_t h = core_->hidden();
+  const float* features = core_->features();
+  float* d_features = GrowScratch(d_features_, rows * h);
+  float* d_value_features = GrowScratch(d_value_features_, rows * h);
+  MlpBackward(policy_, features, rows, policy_gradient_, d_features);
+  MlpBackward(value_, features, rows, value_gradient_, d_value_features);
+  for (int64_t i = 0; i < rows * h; ++i) d_features[i] += d_value_features[i];
+  const int64_t width = core_->inputs();
+  float* d_encoded = GrowScratch(d_encoded_, rows * width);
+  core_->Backward(parameters_.data(), d_features, gradients_.data(), d_encoded);
+  if (encoder_.layers.empty()) return;
+  // Through the encoder's last tanh, then its layers.
+  const float* encoded = encoder_.outputs.back().data();
+  for (int64_t i = 0; i < rows * width; ++i) {
+    d_encoded[i] *= 1.0f - encoded[i] * encoded[i];
+  }
+  MlpBackward(encoder_, inputs_, rows, d_encoded_);
 }
 
 }  // namespace vantage

@@ -14,10 +14,12 @@
 #include <ATen/core/Tensor.h>
 
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "absl/status/statusor.h"
 #include "common/env/environment.h"
+#include "learner/algorithms/flat_recurrent_core.h"
 
 namespace vantage {
 
@@ -54,8 +56,19 @@ class FlatActorCritic {
 
   // Both networks on `rows` inputs, and the policy's log-probabilities of
   // `actions` ([rows, action_width()]; indices as floats when discrete).
-  // Both arrays must stay unchanged until Backward.
+  // Both arrays must stay unchanged until Backward. Feed-forward networks.
   void Forward(const float* inputs, const float* actions, int64_t rows);
+
+  // Networks with a recurrent core (FlatRecurrentCore): the same over
+  // `steps` steps of `chunks` sequences, rows time-major (step t of chunk j
+  // at t * chunks + j), `starts` [rows] marking episode starts, `states`
+  // [chunks, state_size()] the chunks' start states. Every array must stay
+  // unchanged until Backward.
+  bool recurrent() const { return core_.has_value(); }
+  int64_t state_size() const { return core_ ? core_->state_size() : 0; }
+  void ForwardSequences(const float* inputs, const float* actions,
+                        const uint8_t* starts, const float* states,
+                        int64_t steps, int64_t chunks);
   const float* log_probs() const { return log_probs_.data(); }  // [rows]
   const float* values() const { return values_.data(); }        // [rows]
   // The mean over the rows of the policy's entropy.
@@ -77,6 +90,7 @@ class FlatActorCritic {
   };
   struct Mlp {
     std::vector<Layer> layers;
+    bool squash_last = false;  // tanh after the last layer too (an encoder)
     // Each layer's output of the last Forward (after tanh but the last).
     std::vector<std::vector<float>> outputs;
   };
@@ -88,17 +102,27 @@ class FlatActorCritic {
   absl::StatusOr<int64_t> TakeParameters(std::vector<at::Tensor> parameters);
   absl::Status LayOutNetworks(PolicyNetworkImpl& policy,
                               ValueNetworkImpl& value);
-  absl::Status LayOutMlp(const TanhMlp& body, int64_t outputs,
+  absl::Status LayOutMlp(const TanhMlp& body, int64_t inputs, int64_t outputs,
                          std::vector<bool>& claimed, Mlp& mlp);
+  // A recurrent trunk: its encoder, its cell; then both heads on its
+  // features.
+  absl::Status LayOutRecurrent(PolicyNetworkImpl& policy,
+                               ValueNetworkImpl& value,
+                               std::vector<bool>& claimed);
   // -1 for a tensor that is not a given parameter or whose parameter is
   // already claimed (shared by two layers).
   int64_t ClaimOffset(const at::Tensor& tensor,
                       std::vector<bool>& claimed) const;
   void MlpForward(Mlp& mlp, const float* inputs, int64_t rows);
   // From d loss / d (the last layer's output) in `gradient` [rows, last
-  // outputs] (used as scratch).
+  // outputs] (used as scratch); d loss / d inputs into `d_inputs` unless
+  // null.
   void MlpBackward(Mlp& mlp, const float* inputs, int64_t rows,
-                   std::vector<float>& gradient);
+                   std::vector<float>& gradient, float* d_inputs = nullptr);
+  // The values and log-probabilities after both networks' forward passes.
+  void Heads(const float* actions, int64_t rows);
+  // Backward's path through a recurrent trunk from both heads' gradients.
+  void TrunkBackward(int64_t rows);
   void GaussianHead(const float* actions, int64_t rows);
   void CategoricalHead(const float* actions, int64_t rows);
 
@@ -110,6 +134,10 @@ class FlatActorCritic {
   std::vector<float> gradients_;
   Mlp policy_;
   Mlp value_;
+  // A recurrent trunk's (the heads above then read its features).
+  Mlp encoder_;
+  std::optional<FlatRecurrentCore> core_;
+  std::vector<float> d_features_, d_value_features_, d_encoded_;
   int64_t log_std_ = -1;  // offset; continuous only
 
   // The last Forward's rows and what Backward needs of them.

@@ -7,12 +7,14 @@
 #include <torch/optim/rmsprop.h>
 #include <torch/serialize/archive.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <sstream>
 #include <utility>
 
 #include "absl/strings/str_cat.h"
+#include "common/util/scratch_buffer.h"
 #include "learner/checkpoint/archive_io.h"
 #include "learner/parallel/replica_reductions.h"
 
@@ -76,6 +78,15 @@ std::optional<FlatActorCritic> MakeFlatActorCritic(
 
 at::Tensor FloatRows(const at::Tensor& values, int64_t rows) {
   return values.detach().to(at::kFloat).contiguous().reshape({rows, -1});
+}
+
+void GatherRows(const float* source, int64_t width, const int64_t* index,
+                int64_t rows, std::vector<float>& out) {
+  float* target = GrowScratch(out, rows * width);
+  for (int64_t r = 0; r < rows; ++r) {
+    std::copy(source + index[r] * width, source + (index[r] + 1) * width,
+              target + r * width);
+  }
 }
 
 void SetLearningRate(torch::optim::Optimizer& optimizer, double learning_rate) {

@@ -56,6 +56,10 @@ std::optional<FlatActorCritic> MakeFlatActorCritic(
 // `values` as a contiguous float tensor of `rows` rows.
 at::Tensor FloatRows(const at::Tensor& values, int64_t rows);
 
+// `rows` rows of `width` floats of `source` picked by `index` into `out`.
+void GatherRows(const float* source, int64_t width, const int64_t* index,
+                int64_t rows, std::vector<float>& out);
+
 // Sets every parameter group's learning rate.
 void SetLearningRate(torch::optim::Optimizer& optimizer, double learning_rate);
 

@@ -18,6 +18,7 @@
 
 #include "absl/status/status.h"
 #include "common/nn/networks.h"
+#include "learner/algorithms/chunk_minibatches.h"
 #include "learner/algorithms/policy_updater.h"
 
 namespace vantage {
@@ -32,9 +33,9 @@ struct Networks {
 
 // The default networks of `spec`, their weights drawn after seeding
 // LibTorch's generator with `seed`.
-inline Networks MakeNetworks(const EnvSpec& spec, uint64_t seed) {
+inline Networks MakeNetworks(const EnvSpec& spec, uint64_t seed,
+                             const NetworkConfig& config = NetworkConfig()) {
   at::manual_seed(seed);
-  NetworkConfig config;
   Networks n;
   n.policy = PolicyNetwork(spec, config);
   n.value = MakeValueNetwork(spec, config, *n.policy);
@@ -53,6 +54,35 @@ inline UpdateBatch ActedBatch(const EnvSpec& spec, Networks& n, int64_t horizon,
   batch.streams = streams;
   batch.observations = at::randn({samples, spec.observation_size});
   const at::Tensor output = n.policy->forward(batch.observations);
+  batch.actions = n.policy->Act(output, false, at::Generator());
+  batch.behaviour_log_probs =
+      n.policy->LogProb(output, batch.actions) + 0.2 * at::randn({samples});
+  batch.advantages = at::randn({samples});
+  batch.returns = at::randn({samples});
+  return batch;
+}
+
+// The same for a recurrent policy (`n` has a core): `streams` rollouts of
+// `horizon` steps in chunks of `seq_len`, episodes starting at random
+// steps, random chunk start states.
+inline UpdateBatch RecurrentActedBatch(const EnvSpec& spec, Networks& n,
+                                       int64_t horizon, int64_t streams,
+                                       int64_t seq_len) {
+  at::NoGradGuard no_grad;
+  const int64_t samples = horizon * streams;
+  UpdateBatch batch;
+  batch.horizon = horizon;
+  batch.streams = streams;
+  batch.seq_len = seq_len;
+  batch.observations = at::randn({samples, spec.observation_size});
+  batch.starts = at::rand({samples}) < 0.05;
+  batch.chunk_states = at::randn({horizon / seq_len * streams,
+                                  n.policy->trunk()->state_size()}) *
+                       0.3;
+  const ChunkMinibatch all = ChunksOfSteps(batch, 0, horizon);
+  const at::Tensor chunked = RunChunks(*n.policy, *n.value, batch, all).policy;
+  const at::Tensor output =
+      at::empty_like(chunked).index_copy_(0, all.rows, chunked);
   batch.actions = n.policy->Act(output, false, at::Generator());
   batch.behaviour_log_probs =
       n.policy->LogProb(output, batch.actions) + 0.2 * at::randn({samples});

@@ -63,15 +63,26 @@ AlgorithmStats A2cUpdater::FlatUpdate(const UpdateBatch& batch,
   const int64_t rows = MinibatchRows(batch);
   const double count = static_cast<double>(rows);
   MeanStats stats;
-  // The minibatches are consecutive rows: no gathering.
+  // The minibatches are consecutive rows: no gathering, but for a
+  // recurrent policy, whose time slice is gathered chunk by chunk.
   for (int64_t begin = 0; begin + rows <= size; begin += rows) {
     const float* adv = flat_rows.advantages.data_ptr<float>() + begin;
     const float* old_log_prob = flat_rows.behaviour.data_ptr<float>() + begin;
     const float* target = flat_rows.returns.data_ptr<float>() + begin;
-    net.Forward(
-        flat_rows.inputs.data_ptr<float>() + begin * flat_rows.inputs.size(1),
-        flat_rows.actions.data_ptr<float>() + begin * flat_rows.actions.size(1),
-        rows);
+    if (net.recurrent()) {
+      const Gathered gathered = GatherAndForward(
+          flat_rows, ChunksOfSteps(batch, begin / batch.streams,
+                                   config_.steps_per_minibatch));
+      adv = gathered.advantages;
+      old_log_prob = gathered.behaviour;
+      target = gathered.returns;
+    } else {
+      net.Forward(
+          flat_rows.inputs.data_ptr<float>() + begin * flat_rows.inputs.size(1),
+          flat_rows.actions.data_ptr<float>() +
+              begin * flat_rows.actions.size(1),
+          rows);
+    }
     const float* log_probs = net.log_probs();
     const float* values = net.values();
     float* d_log_prob = d_log_probs(rows);

@@ -37,16 +37,6 @@ std::vector<at::Tensor> MinibatchIndices(const std::vector<int64_t>& order,
   return indices;
 }
 
-// `rows` rows of `width` floats of `source` picked by `index` into `out`.
-void GatherRows(const float* source, int64_t width, const int64_t* index,
-                int64_t rows, std::vector<float>& out) {
-  float* target = GrowScratch(out, rows * width);
-  for (int64_t r = 0; r < rows; ++r) {
-    std::copy(source + index[r] * width, source + (index[r] + 1) * width,
-              target + r * width);
-  }
-}
-
 }  // namespace
 
 PpoUpdater::PpoUpdater(PolicyNetwork policy, ValueNetwork value,
@@ -106,18 +96,18 @@ AlgorithmStats PpoUpdater::FlatUpdate(const UpdateBatch& lagged,
   std::vector<int64_t> order(size);
   MeanStats stats;
   for (int epoch = 0; epoch < config_.epochs; ++epoch) {
-    ShuffleRows(order, rng);
+    const std::vector<ChunkMinibatch> minibatches =
+        EpochMinibatches(batch, order, minibatch, rng);
     std::optional<PartsNormalizer> normalizer;
     if (config_.normalize_advantages) {
-      normalizer.emplace(*replicas_, batch.advantages,
-                         replicas_->world_size() > 1
-                             ? MinibatchIndices(order, minibatch)
-                             : std::vector<at::Tensor>{});
+      std::vector<at::Tensor> parts;
+      if (replicas_->world_size() > 1) {
+        for (const ChunkMinibatch& m : minibatches) parts.push_back(m.rows);
+      }
+      normalizer.emplace(*replicas_, batch.advantages, parts);
     }
-    size_t part = 0;
-    for (int64_t begin = 0; begin + minibatch <= size;
-         begin += minibatch, ++part) {
-      stats.Add(FlatMinibatch(rows, weights, order.data() + begin, minibatch,
+    for (size_t part = 0; part < minibatches.size(); ++part) {
+      stats.Add(FlatMinibatch(rows, weights, minibatches[part],
                               normalizer.has_value() ? &*normalizer : nullptr,
                               part));
     }
@@ -126,26 +116,23 @@ AlgorithmStats PpoUpdater::FlatUpdate(const UpdateBatch& lagged,
   return stats.Mean();
 }
 
-AlgorithmStats PpoUpdater::FlatMinibatch(
-    const FlatRows& rows, const at::Tensor& weights, const int64_t* index,
-    int64_t minibatch, PartsNormalizer* normalizer, size_t part) {
-  GatherRows(rows.inputs.data_ptr<float>(), rows.inputs.size(1), index,
-             minibatch, inputs_);
-  GatherRows(rows.actions.data_ptr<float>(), rows.actions.size(1), index,
-             minibatch, actions_);
-  GatherRows(rows.behaviour.data_ptr<float>(), 1, index, minibatch, behaviour_);
-  GatherRows(rows.advantages.data_ptr<float>(), 1, index, minibatch,
-             advantages_);
-  GatherRows(rows.returns.data_ptr<float>(), 1, index, minibatch, returns_);
+AlgorithmStats PpoUpdater::FlatMinibatch(const FlatRows& rows,
+                                         const at::Tensor& weights,
+                                         const ChunkMinibatch& chunk_minibatch,
+                                         PartsNormalizer* normalizer,
+                                         size_t part) {
+  const Gathered gathered = GatherAndForward(rows, chunk_minibatch);
+  const int64_t minibatch = gathered.rows;
+  float* advantages = gathered.advantages;
   if (normalizer != nullptr) {
-    normalizer->NormalizeInPlace(part, advantages_.data(), minibatch);
+    normalizer->NormalizeInPlace(part, advantages, minibatch);
   }
   if (weights.defined()) {
-    GatherRows(weights.data_ptr<float>(), 1, index, minibatch, weights_);
-    for (int64_t i = 0; i < minibatch; ++i) advantages_[i] *= weights_[i];
+    GatherRows(weights.data_ptr<float>(), 1,
+               chunk_minibatch.rows.data_ptr<int64_t>(), minibatch, weights_);
+    for (int64_t i = 0; i < minibatch; ++i) advantages[i] *= weights_[i];
   }
   FlatActorCritic& net = flat_networks();
-  net.Forward(inputs_.data(), actions_.data(), minibatch);
   const float* log_probs = net.log_probs();
   const float* values = net.values();
   float* d_log_prob = d_log_probs(minibatch);
@@ -158,9 +145,9 @@ AlgorithmStats PpoUpdater::FlatMinibatch(
   LossSums sums;
   int64_t clipped = 0;
   for (int64_t i = 0; i < minibatch; ++i) {
-    const float log_ratio = log_probs[i] - behaviour_[i];
+    const float log_ratio = log_probs[i] - gathered.behaviour[i];
     const float ratio = std::exp(log_ratio);
-    const float advantage = advantages_[i];
+    const float advantage = advantages[i];
     const float unclipped = ratio * advantage;
     const float bounded = std::min(std::max(ratio, low), high) * advantage;
     // The surrogate's gradient flows through the unclipped term when it is
@@ -170,7 +157,7 @@ AlgorithmStats PpoUpdater::FlatMinibatch(
     d_log_prob[i] = unclipped <= bounded
                         ? static_cast<float>(-advantage * ratio / count)
                         : 0.0f;
-    const float error = values[i] - returns_[i];
+    const float error = values[i] - gathered.returns[i];
     sums.value_loss += 0.5 * error * error;
     d_value[i] = ValueGradient(error, count);
     sums.approx_kl += (ratio - 1.0f) - log_ratio;

@@ -49,16 +49,15 @@ class PpoUpdater : public FirstOrderUpdater {
                                 std::mt19937_64& rng) override;
   AlgorithmStats FlatUpdate(const UpdateBatch& batch,
                             std::mt19937_64& rng) override;
-  // One flat minibatch of the rows `index` points at (`part` of the epoch's
-  // advantage normaliser, if any).
+  // One flat minibatch (`part` of the epoch's advantage normaliser, if
+  // any).
   AlgorithmStats FlatMinibatch(const FlatRows& rows, const at::Tensor& weights,
-                               const int64_t* index, int64_t minibatch,
+                               const ChunkMinibatch& minibatch,
                                PartsNormalizer* normalizer, size_t part);
 
   PpoConfig config_;
-  // Scratch of FlatUpdate: one minibatch's rows.
-  std::vector<float> inputs_, actions_, behaviour_, advantages_, returns_,
-      weights_;
+  // Scratch of FlatUpdate: one minibatch's importance weights.
+  std::vector<float> weights_;
 };
 
 }  // namespace vantage

@@ -108,6 +108,83 @@ INSTANTIATE_TEST_SUITE_P(Heads, FlatActorCriticTest,
                                            Case{false, 3, 1, {}, false},
                                            Case{true, 9, 4, {16, 8}, true}));
 
+struct RecurrentCase {
+  Core core;
+  bool discrete;
+  std::vector<int64_t> hidden;
+};
+
+class FlatRecurrentTest : public ::testing::TestWithParam<RecurrentCase> {};
+
+// A recurrent trunk over chunks: 7 steps of 5 chunks from random start
+// states, episodes starting inside some: the log-probabilities, values and
+// entropy, and every parameter's gradient through time, against autograd
+// through RecurrentTrunkImpl::Unroll.
+TEST_P(FlatRecurrentTest, SequencesAndGradientsThroughTimeAreAutograds) {
+  const RecurrentCase& c = GetParam();
+  at::manual_seed(5);
+  const EnvSpec spec = VectorSpec(c.discrete, 6, 3);
+  NetworkConfig config;
+  config.hidden = c.hidden;
+  config.core = c.core;
+  config.core_size = 12;
+  PolicyNetwork policy(spec, config);
+  ValueNetwork value = MakeValueNetwork(spec, config, *policy);
+  const std::vector<at::Tensor> parameters = NetworkParameters(*policy, *value);
+  Randomise(parameters);
+  absl::StatusOr<FlatActorCritic> flat =
+      FlatActorCritic::Create(*policy, *value, parameters);
+  ASSERT_TRUE(flat.ok()) << flat.status();
+  ASSERT_TRUE(flat->recurrent());
+  ASSERT_EQ(flat->state_size(), config.core_state_size());
+
+  constexpr int64_t kSteps = 7;
+  constexpr int64_t kChunks = 5;
+  constexpr int64_t kRows = kSteps * kChunks;
+  const at::Tensor observations = at::randn({kRows, 6}) * 2.0;
+  const at::Tensor actions = c.discrete
+                                 ? at::randint(0, 3, {kRows, 1}).to(at::kFloat)
+                                 : at::randn({kRows, 3});
+  const at::Tensor starts = at::rand({kSteps, kChunks}) < 0.2;
+  const at::Tensor states = at::randn({kChunks, flat->state_size()}) * 0.5;
+  const at::Tensor start_bytes = starts.to(at::kByte).reshape({-1});
+  const at::Tensor d_log_probs = at::randn({kRows});
+  const at::Tensor d_values = at::randn({kRows});
+  const double entropy_weight = -0.37;
+
+  const at::Tensor inputs = flat->Inputs(observations);
+  flat->ForwardSequences(inputs.data_ptr<float>(), actions.data_ptr<float>(),
+                         start_bytes.data_ptr<uint8_t>(),
+                         states.data_ptr<float>(), kSteps, kChunks);
+  flat->Backward(d_log_probs.data_ptr<float>(), entropy_weight,
+                 d_values.data_ptr<float>());
+
+  RecurrentTrunk trunk = policy->trunk();
+  const at::Tensor features = trunk->Unroll(observations, starts, states);
+  const at::Tensor output = policy->Head(features);
+  const at::Tensor log_probs = policy->LogProb(output, actions);
+  const at::Tensor entropy = policy->Entropy(output).mean();
+  const at::Tensor values = value->Head(features);
+  ExpectClose(flat->log_probs(), log_probs, 1e-6, "log-probabilities");
+  ExpectClose(flat->values(), values, 1e-6, "values");
+  EXPECT_NEAR(flat->mean_entropy(), entropy.item<double>(),
+              1e-6 * std::max(1.0, std::abs(entropy.item<double>())));
+  ((log_probs * d_log_probs).sum() + entropy_weight * entropy +
+   (values * d_values).sum())
+      .backward();
+  for (size_t i = 0; i < parameters.size(); ++i) {
+    ExpectClose(flat->gradients() + flat->offsets()[i], parameters[i].grad(),
+                1e-5, "the gradient of parameter " + std::to_string(i));
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Cores, FlatRecurrentTest,
+    ::testing::Values(RecurrentCase{Core::kGru, false, {16, 8}},
+                      RecurrentCase{Core::kGru, true, {}},
+                      RecurrentCase{Core::kLstm, false, {16}},
+                      RecurrentCase{Core::kLstm, true, {8, 8}}));
+
 TEST(FlatActorCriticTest, PushWritesTheModulesAndPullReadsThem) {
   at::manual_seed(4);
   const EnvSpec spec = VectorSpec(false, 5, 2);
