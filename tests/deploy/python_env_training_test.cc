@@ -1,5 +1,6 @@
 // A Python environment trains as every task does, with the same commands:
-// PPO learns the test tree's CartPole locally and distributed, a run
+// PPO learns the test tree's CartPole locally and distributed (and with a
+// recurrent core, a memory task the test tree writes in Python), a run
 // resumes (exactly with get_state, restarting episodes without), and a
 // factory that cannot be imported is a usage error before anything starts.
 // PYTHONPATH holds tests/python_envs.
@@ -107,6 +108,27 @@ TEST(PythonEnvTrainingTest, PpoLearnsCartPoleDistributed) {
 // watchdog names the call and exits after --actor_stall_timeout_s, the
 // launcher restarts it with environment seeds of its new life (so the same
 // hang does not come back at the same step), and the run finishes.
+// A user's partially observable environment, one frame at a time
+// (tests/python_envs/cue_recall.py: a cue, 10 blank frames, then the frame
+// that asks for it): a GRU core remembers the cue, the feed-forward policy
+// stays at chance (0.25). Seed 1, 80k steps: 1.0 and 0.2 at the end
+// (2026-12-06).
+TEST(PythonEnvTrainingTest, AGruCoreRemembersWhatAPythonEnvShowedOnce) {
+  double best[2] = {0.0, 0.0};
+  for (int recurrent : {0, 1}) {
+    const std::string run =
+        FreshDirectory(absl::StrCat("python_cue_recall_", recurrent));
+    const Outcome outcome = RunVantage(absl::StrCat(
+        "train --mode=local --env=python:cue_recall:make --envs=8 "
+        "--horizon=128 --ppo_minibatches=16 --steps=80000 --seed=1 ",
+        recurrent ? "--core=gru --seq_len=16 " : "", "--run_dir=", run));
+    ASSERT_EQ(outcome.exit_code, 0) << outcome.err;
+    best[recurrent] = BestMeanReturn(run);
+  }
+  EXPECT_GE(best[1], 0.9);
+  EXPECT_LE(best[0], 0.5);
+}
+
 TEST(PythonEnvTrainingTest, AHungEnvironmentIsReplacedAndTheRunFinishes) {
   const std::string run = FreshDirectory("python_hangs");
   const Outcome outcome = RunVantage(
