@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <numeric>
 #include <optional>
 #include <random>
 #include <string>
@@ -97,8 +98,20 @@ UpdateBatch RunBatch(const TrainBenchConfig& config, int64_t horizon,
           ? at::randint(0, spec.observation_high + 1,
                         {rows, spec.observation_size}, at::kByte)
           : at::randn({rows, spec.observation_size});
-  {
-    at::NoGradGuard no_grad;
+  at::NoGradGuard no_grad;
+  if (policy.recurrent()) {
+    // Chunks of the run's length (whole in the horizon), from zero states,
+    // no episode starts.
+    batch.seq_len = std::gcd(config.network.seq_len, horizon);
+    batch.starts = at::zeros({rows}, at::kBool);
+    batch.chunk_states =
+        policy.trunk()->InitialState(horizon / batch.seq_len * config.streams);
+    const at::Tensor output = policy.Unroll(
+        batch.observations, batch.starts.reshape({horizon, config.streams}),
+        policy.trunk()->InitialState(config.streams));
+    batch.actions =
+        policy.Act(output, /*deterministic=*/false, at::Generator());
+  } else {
     batch.actions = policy.Act(policy.forward(batch.observations),
                                /*deterministic=*/false, at::Generator());
   }
