@@ -10,6 +10,7 @@
 #include "absl/strings/str_format.h"
 #include "absl/strings/str_join.h"
 #include "absl/strings/str_split.h"
+#include "common/nn/network_config.h"
 #include "deploy/cli/command_line.h"
 #include "deploy/run/run_config.h"
 #include "learner/algorithms/algorithm_config.h"
@@ -316,6 +317,11 @@ std::map<std::string, std::string> RunFlagDefaults(bool with_mode) {
     }
     defaults[flag.name] = text;
   }
+  // A feed-forward run's config holds no core settings: what a core takes.
+  const NetworkConfig network;
+  defaults["core"] = CoreName(network.core);
+  defaults["core_size"] = absl::StrCat(network.core_size);
+  defaults["seq_len"] = absl::StrCat(network.seq_len);
   return defaults;
 }
 
