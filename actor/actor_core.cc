@@ -50,6 +50,18 @@ void StoreObservations(absl::Span<const double> values, at::Tensor row) {
   }
 }
 
+// A recurrent policy's `count` state floats (none for a feed-forward one,
+// whose states hold none), all finite.
+std::vector<double> ReadCoreStates(StateReader& reader, size_t count) {
+  if (count == 0) return {};
+  std::vector<double> states =
+      reader.GetDoubles("the recurrent policy's states", count);
+  reader.Check(std::all_of(states.begin(), states.end(),
+                           [](double v) { return std::isfinite(v); }),
+               "a non-finite recurrent state");
+  return states;
+}
+
 }  // namespace
 
 absl::StatusOr<std::unique_ptr<ActorCore>> ActorCore::Create(
@@ -306,14 +318,8 @@ absl::Status ActorCore::RestoreState(absl::string_view state) {
       reader.GetI64s("next_sequence", next_sequence_.size());
   const absl::string_view generator = reader.GetBytes("sampling generator");
   const absl::string_view envs = reader.GetBytes("environments");
-  std::vector<double> core_states;
-  if (!core_states_.empty()) {
-    core_states =
-        reader.GetDoubles("the recurrent policy's states", core_states_.size());
-  }
-  reader.Check(std::all_of(core_states.begin(), core_states.end(),
-                           [](double v) { return std::isfinite(v); }),
-               "a non-finite recurrent state");
+  const std::vector<double> core_states =
+      ReadCoreStates(reader, core_states_.size());
   reader.Check(env_steps >= 0, absl::StrCat("env_steps is ", env_steps));
   reader.Check(std::all_of(next_sequence.begin(), next_sequence.end(),
                            [](int64_t sequence) { return sequence >= 0; }),

@@ -63,6 +63,16 @@ void BarePpo::Update(const UpdateBatch& batch) {
   }
 }
 
+EnvSpec BenchSpec(const BarePpoShape& shape) {
+  EnvSpec spec;
+  spec.name = "HalfCheetah";
+  spec.observation_size = shape.observations;
+  spec.action_size = shape.actions;
+  spec.action_low.assign(shape.actions, -1.0);
+  spec.action_high.assign(shape.actions, 1.0);
+  return spec;
+}
+
 UpdateBatch SyntheticBatch(const BarePpoShape& shape, int64_t samples) {
   UpdateBatch batch;
   batch.horizon = samples;

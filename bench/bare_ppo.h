@@ -40,6 +40,10 @@ class BarePpo {
   std::unique_ptr<torch::optim::Adam> optimizer_;
 };
 
+// The spec of a task of `shape`'s sizes (HalfCheetah's by default), its
+// actions bounded by +-1.
+EnvSpec BenchSpec(const BarePpoShape& shape);
+
 // A batch of `samples` random rows of `shape`'s sizes.
 UpdateBatch SyntheticBatch(const BarePpoShape& shape, int64_t samples);
 

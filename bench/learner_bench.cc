@@ -37,16 +37,6 @@ constexpr int kMinibatches = 32;
 constexpr int kEpochs = 10;
 constexpr int kRepetitions = 10;
 
-EnvSpec HalfCheetahSpec() {
-  EnvSpec spec;
-  spec.name = "HalfCheetah";
-  spec.observation_size = kObservations;
-  spec.action_size = kActions;
-  spec.action_low.assign(kActions, -1.0);
-  spec.action_high.assign(kActions, 1.0);
-  return spec;
-}
-
 BarePpoShape BenchShape() {
   BarePpoShape shape;
   shape.observations = kObservations;
@@ -55,6 +45,8 @@ BarePpoShape BenchShape() {
   shape.epochs = kEpochs;
   return shape;
 }
+
+EnvSpec HalfCheetahSpec() { return BenchSpec(BenchShape()); }
 
 UpdateBatch SyntheticBatch() { return SyntheticBatch(BenchShape(), kBatch); }
 

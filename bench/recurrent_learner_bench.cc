@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "absl/strings/str_cat.h"
+#include "bench/bare_ppo.h"
 #include "bench/fastest.h"
 #include "common/nn/compute_threads.h"
 #include "common/nn/networks.h"
@@ -36,13 +37,10 @@ constexpr int kEpochs = 10;
 constexpr int kRepetitions = 5;
 
 EnvSpec HalfCheetahSpec() {
-  EnvSpec spec;
-  spec.name = "HalfCheetah";
-  spec.observation_size = kObservations;
-  spec.action_size = kActions;
-  spec.action_low.assign(kActions, -1.0);
-  spec.action_high.assign(kActions, 1.0);
-  return spec;
+  BarePpoShape shape;
+  shape.observations = kObservations;
+  shape.actions = kActions;
+  return BenchSpec(shape);
 }
 
 // Random rows, no episode starts, small random chunk states.

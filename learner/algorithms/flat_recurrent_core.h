@@ -54,6 +54,15 @@ class FlatRecurrentCore {
 
  private:
   int64_t gates() const { return (lstm_ ? 4 : 3) * hidden_; }
+  // Forward's steps: the states step t reads (zeroed at episode starts)
+  // with the hidden projection's bias; one row's gates from its hidden
+  // projection `p`.
+  void ReadStates(int64_t t, const float* states, const float* bias_hh);
+  void Activate(int64_t row, const float* p);
+  // Backward's steps: one row's gate gradients; one step's hidden weights'
+  // gradient and the state gradient carried back.
+  void RowGradients(int64_t row, int64_t j, const float* d_features);
+  void StepBackward(int64_t t, const float* parameters, float* gradients);
 
   const bool lstm_;
   const int64_t inputs_;

@@ -42,6 +42,18 @@ inline Networks MakeNetworks(const EnvSpec& spec, uint64_t seed,
   return n;
 }
 
+// Actions drawn from the policy's `output` for the batch's rows, behaviour
+// log-probabilities of a slightly different policy, random advantages and
+// returns.
+inline void ActOn(Networks& n, const at::Tensor& output, UpdateBatch& batch) {
+  const int64_t samples = output.size(0);
+  batch.actions = n.policy->Act(output, false, at::Generator());
+  batch.behaviour_log_probs =
+      n.policy->LogProb(output, batch.actions) + 0.2 * at::randn({samples});
+  batch.advantages = at::randn({samples});
+  batch.returns = at::randn({samples});
+}
+
 // `horizon` x `streams` steps acted by `n`'s policy (actions drawn from
 // it) whose behaviour log-probabilities are those of a slightly different
 // policy, so that ratios start near 1 and some leave a clipping range.
@@ -53,12 +65,7 @@ inline UpdateBatch ActedBatch(const EnvSpec& spec, Networks& n, int64_t horizon,
   batch.horizon = horizon;
   batch.streams = streams;
   batch.observations = at::randn({samples, spec.observation_size});
-  const at::Tensor output = n.policy->forward(batch.observations);
-  batch.actions = n.policy->Act(output, false, at::Generator());
-  batch.behaviour_log_probs =
-      n.policy->LogProb(output, batch.actions) + 0.2 * at::randn({samples});
-  batch.advantages = at::randn({samples});
-  batch.returns = at::randn({samples});
+  ActOn(n, n.policy->forward(batch.observations), batch);
   return batch;
 }
 
@@ -83,11 +90,7 @@ inline UpdateBatch RecurrentActedBatch(const EnvSpec& spec, Networks& n,
   const at::Tensor chunked = RunChunks(*n.policy, *n.value, batch, all).policy;
   const at::Tensor output =
       at::empty_like(chunked).index_copy_(0, all.rows, chunked);
-  batch.actions = n.policy->Act(output, false, at::Generator());
-  batch.behaviour_log_probs =
-      n.policy->LogProb(output, batch.actions) + 0.2 * at::randn({samples});
-  batch.advantages = at::randn({samples});
-  batch.returns = at::randn({samples});
+  ActOn(n, output, batch);
   return batch;
 }
 

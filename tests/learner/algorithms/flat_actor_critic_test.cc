@@ -40,6 +40,32 @@ void ExpectClose(const float* fast, const at::Tensor& reference,
   EXPECT_LE(worst / scale, tolerance) << what;
 }
 
+// After the flat networks' Forward and Backward: their log-probabilities,
+// values and entropy are autograd's from the policy's `output` and the
+// critic's `values`, and so is every parameter's gradient of
+// sum(d_log_probs log_probs) + entropy_weight * entropy + sum(d_values
+// values).
+void ExpectAutogradsResults(const FlatActorCritic& flat,
+                            PolicyNetworkImpl& policy, const at::Tensor& output,
+                            const at::Tensor& actions, const at::Tensor& values,
+                            const at::Tensor& d_log_probs,
+                            double entropy_weight, const at::Tensor& d_values,
+                            const std::vector<at::Tensor>& parameters) {
+  const at::Tensor log_probs = policy.LogProb(output, actions);
+  const at::Tensor entropy = policy.Entropy(output).mean();
+  ExpectClose(flat.log_probs(), log_probs, 1e-6, "log-probabilities");
+  ExpectClose(flat.values(), values, 1e-6, "values");
+  EXPECT_NEAR(flat.mean_entropy(), entropy.item<double>(),
+              1e-6 * std::max(1.0, std::abs(entropy.item<double>())));
+  ((log_probs * d_log_probs).sum() + entropy_weight * entropy +
+   (values * d_values).sum())
+      .backward();
+  for (size_t i = 0; i < parameters.size(); ++i) {
+    ExpectClose(flat.gradients() + flat.offsets()[i], parameters[i].grad(),
+                1e-5, "the gradient of parameter " + std::to_string(i));
+  }
+}
+
 struct Case {
   bool discrete;
   int64_t observations;
@@ -85,21 +111,9 @@ TEST_P(FlatActorCriticTest, ForwardAndGradientsAreAutograds) {
                  d_values.data_ptr<float>());
 
   const at::Tensor output = policy->forward(observations);
-  const at::Tensor log_probs = policy->LogProb(output, actions);
-  const at::Tensor entropy = policy->Entropy(output).mean();
-  const at::Tensor values = value->forward(observations);
-  ExpectClose(flat->log_probs(), log_probs, 1e-6, "log-probabilities");
-  ExpectClose(flat->values(), values, 1e-6, "values");
-  EXPECT_NEAR(flat->mean_entropy(), entropy.item<double>(),
-              1e-6 * std::max(1.0, std::abs(entropy.item<double>())));
-
-  ((log_probs * d_log_probs).sum() + entropy_weight * entropy +
-   (values * d_values).sum())
-      .backward();
-  for (size_t i = 0; i < parameters.size(); ++i) {
-    ExpectClose(flat->gradients() + flat->offsets()[i], parameters[i].grad(),
-                1e-5, "the gradient of parameter " + std::to_string(i));
-  }
+  ExpectAutogradsResults(*flat, *policy, output, actions,
+                         value->forward(observations), d_log_probs,
+                         entropy_weight, d_values, parameters);
 }
 
 INSTANTIATE_TEST_SUITE_P(Heads, FlatActorCriticTest,
@@ -161,21 +175,9 @@ TEST_P(FlatRecurrentTest, SequencesAndGradientsThroughTimeAreAutograds) {
 
   RecurrentTrunk trunk = policy->trunk();
   const at::Tensor features = trunk->Unroll(observations, starts, states);
-  const at::Tensor output = policy->Head(features);
-  const at::Tensor log_probs = policy->LogProb(output, actions);
-  const at::Tensor entropy = policy->Entropy(output).mean();
-  const at::Tensor values = value->Head(features);
-  ExpectClose(flat->log_probs(), log_probs, 1e-6, "log-probabilities");
-  ExpectClose(flat->values(), values, 1e-6, "values");
-  EXPECT_NEAR(flat->mean_entropy(), entropy.item<double>(),
-              1e-6 * std::max(1.0, std::abs(entropy.item<double>())));
-  ((log_probs * d_log_probs).sum() + entropy_weight * entropy +
-   (values * d_values).sum())
-      .backward();
-  for (size_t i = 0; i < parameters.size(); ++i) {
-    ExpectClose(flat->gradients() + flat->offsets()[i], parameters[i].grad(),
-                1e-5, "the gradient of parameter " + std::to_string(i));
-  }
+  ExpectAutogradsResults(*flat, *policy, policy->Head(features), actions,
+                         value->Head(features), d_log_probs, entropy_weight,
+                         d_values, parameters);
 }
 
 INSTANTIATE_TEST_SUITE_P(

@@ -34,12 +34,15 @@ void ExpectSameNetworks(Networks& a, Networks& b, double tolerance) {
   ExpectSameParameters(a.parameters(), b.parameters(), tolerance);
 }
 
-class PpoUpdaterTest : public ::testing::TestWithParam<bool> {};
-
-TEST_P(PpoUpdaterTest, TheFlatUpdateIsTheAutogradUpdate) {
-  const EnvSpec spec = Spec(GetParam());
-  Networks flat_nets = MakeNetworks(spec, 9);
-  Networks autograd_nets = MakeNetworks(spec, 9);
+// Three updates of one batch from the same networks, on the flat path and
+// through autograd: the second starts from Adam's state of the first; the
+// third takes the batch as one acted by an older version. A recurrent
+// policy's batch is chunks of 16 steps from their start states, episodes
+// starting inside some.
+void ExpectTheFlatUpdateIsTheAutogradUpdate(const EnvSpec& spec,
+                                            const NetworkConfig& config) {
+  Networks flat_nets = MakeNetworks(spec, 9, config);
+  Networks autograd_nets = MakeNetworks(spec, 9, config);
   PpoUpdater flat(flat_nets.policy, flat_nets.value, SmallConfig());
   PpoUpdater autograd(autograd_nets.policy, autograd_nets.value, SmallConfig(),
                       SoloReplicaGroup(),
@@ -47,9 +50,10 @@ TEST_P(PpoUpdaterTest, TheFlatUpdateIsTheAutogradUpdate) {
   ASSERT_TRUE(flat.flat());
   ASSERT_FALSE(autograd.flat());
   at::manual_seed(10);
-  UpdateBatch batch = ActedBatch(spec, flat_nets, 512, 1);
-  // Two updates: the second starts from Adam's state of the first; the
-  // third takes the batch as one acted by an older version.
+  UpdateBatch batch =
+      config.recurrent()
+          ? RecurrentActedBatch(spec, flat_nets, 64, 4, config.seq_len)
+          : ActedBatch(spec, flat_nets, 512, 1);
   for (int update = 0; update < 3; ++update) {
     batch.lagged = update == 2;
     std::mt19937_64 rng_a(update), rng_b(update);
@@ -71,47 +75,24 @@ TEST_P(PpoUpdaterTest, TheFlatUpdateIsTheAutogradUpdate) {
   }
 }
 
+class PpoUpdaterTest : public ::testing::TestWithParam<bool> {};
+
+TEST_P(PpoUpdaterTest, TheFlatUpdateIsTheAutogradUpdate) {
+  ExpectTheFlatUpdateIsTheAutogradUpdate(Spec(GetParam()), NetworkConfig());
+}
+
 INSTANTIATE_TEST_SUITE_P(Heads, PpoUpdaterTest, ::testing::Bool());
 
 class RecurrentPpoUpdaterTest : public ::testing::TestWithParam<Core> {};
 
 // A recurrent policy's update through FlatRecurrentCore is the one autograd
-// computes through RecurrentTrunkImpl: chunks of 16 steps from their start
-// states, episodes starting inside some, Adam's state carried over, and a
-// lagged batch's proximal policy.
+// computes through RecurrentTrunkImpl.
 TEST_P(RecurrentPpoUpdaterTest, TheFlatUpdateIsTheAutogradUpdate) {
-  const EnvSpec spec = Spec(false);
   NetworkConfig config;
   config.core = GetParam();
   config.core_size = 16;
   config.seq_len = 16;
-  Networks flat_nets = MakeNetworks(spec, 9, config);
-  Networks autograd_nets = MakeNetworks(spec, 9, config);
-  PpoUpdater flat(flat_nets.policy, flat_nets.value, SmallConfig());
-  PpoUpdater autograd(autograd_nets.policy, autograd_nets.value, SmallConfig(),
-                      SoloReplicaGroup(),
-                      /*autograd_only=*/true);
-  ASSERT_TRUE(flat.flat());
-  ASSERT_FALSE(autograd.flat());
-  at::manual_seed(10);
-  UpdateBatch batch = RecurrentActedBatch(spec, flat_nets, 64, 4, 16);
-  for (int update = 0; update < 3; ++update) {
-    batch.lagged = update == 2;
-    std::mt19937_64 rng_a(update), rng_b(update);
-    const AlgorithmStats a = flat.Update(batch, 0.25 * update, rng_a);
-    const AlgorithmStats b = autograd.Update(batch, 0.25 * update, rng_b);
-    ExpectSameNetworks(flat_nets, autograd_nets, 1e-5);
-    for (auto [x, y, what] :
-         {std::tuple{a.policy_loss, b.policy_loss, "pi"},
-          {a.value_loss, b.value_loss, "value"},
-          {a.entropy, b.entropy, "entropy"},
-          {a.approx_kl, b.approx_kl, "kl"},
-          {a.clip_fraction, b.clip_fraction, "clip"},
-          {a.max_gradient_norm, b.max_gradient_norm, "norm"}}) {
-      EXPECT_NEAR(x, y, 1e-5 * std::max(1.0, std::abs(y))) << what;
-    }
-    if (!batch.lagged) EXPECT_GT(a.clip_fraction, 0.0);
-  }
+  ExpectTheFlatUpdateIsTheAutogradUpdate(Spec(false), config);
 }
 
 INSTANTIATE_TEST_SUITE_P(Cores, RecurrentPpoUpdaterTest,
