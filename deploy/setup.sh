@@ -53,6 +53,8 @@ done
 # Bullet characters with Cairo (libcairo2-dev) and encodes with FFmpeg's
 # libraries (libav*-dev, libswscale-dev). libbenchmark-dev: the container
 # image's build stage, which installs this list, builds `vantage bench`.
+# `vantage export` writes ONNX models with libonnx-dev (ONNX's protobuf
+# messages and its checker).
 # ccache keeps compiled objects for the next build of any clone, the fuzz
 # build and the container image's (CMakeLists.txt). clang-14 compiles: it
 # parses LibTorch's headers faster than g++ and loads them precompiled in a
@@ -72,6 +74,7 @@ packages=(
   python3-dev pybind11-dev python3-numpy
   libosmesa6-dev libcairo2-dev
   libavcodec-dev libavformat-dev libswscale-dev libavutil-dev
+  libonnx-dev
 )
 
 # Only the tests need these (kept apart from packages=(...), which the
@@ -82,9 +85,11 @@ packages=(
 # (tests/deploy/docker/); python3-yaml to read the rendered Kubernetes
 # manifests (tests/deploy/k8s/), kubectl to render them and Node.js with npm
 # to validate them. A machine that has kubectl or npm from elsewhere keeps
-# them (Debian's packages would conflict).
+# them (Debian's packages would conflict). OpenCV's DNN module
+# (libopencv-dnn-dev) runs exported ONNX policies as an independent runtime.
 test_packages=(libgtest-dev libgmock-dev clang-format ffmpeg
-  slurm-wlm munge buildah debootstrap python3-yaml iproute2 util-linux)
+  slurm-wlm munge buildah debootstrap python3-yaml iproute2 util-linux
+  libopencv-dnn-dev)
 command -v kubectl >/dev/null || test_packages+=(kubernetes-client)
 command -v npm >/dev/null || test_packages+=(nodejs npm)
 

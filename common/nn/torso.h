@@ -25,6 +25,8 @@ class ConvTorsoImpl : public torch::nn::Module {
   ConvTorsoImpl(Torso torso, const std::vector<int64_t>& shape);
   at::Tensor forward(const at::Tensor& flat);
   int64_t features() const { return features_; }
+  // Its layers in order (for code that writes them elsewhere).
+  const torch::nn::Sequential& layers() const { return layers_; }
 
  private:
   std::vector<int64_t> shape_;

@@ -7,6 +7,7 @@
 #include "deploy/cli/bench_command.h"
 #include "deploy/cli/env_commands.h"
 #include "deploy/cli/experiment_command.h"
+#include "deploy/cli/export_command.h"
 #include "deploy/cli/health_command.h"
 #include "deploy/cli/learner_command.h"
 #include "deploy/cli/plot_command.h"
@@ -18,9 +19,9 @@ const std::vector<Command>& AllCommands() {
   static const auto* commands = [] {
     auto* all = new std::vector<Command>{
         ActorCommand(),   AdvantagesCommand(), BenchCommand(),
-        EnvsCommand(),    ExperimentCommand(), HealthCommand(),
-        LearnerCommand(), PlotCommand(),       RolloutCommand(),
-        TrainCommand(),
+        EnvsCommand(),    ExperimentCommand(), ExportCommand(),
+        HealthCommand(),  LearnerCommand(),    PlotCommand(),
+        RolloutCommand(), TrainCommand(),
     };
     std::sort(all->begin(), all->end(), [](const Command& a, const Command& b) {
       return a.name < b.name;

@@ -20,9 +20,6 @@
 #include "deploy/run/trained_policy.h"
 
 ABSL_FLAG(int64_t, episodes, 10, "number of episodes");
-ABSL_FLAG(std::string, checkpoint, "",
-          "a run directory or checkpoint file whose policy acts (default: a "
-          "uniform-random policy)");
 ABSL_FLAG(bool, stochastic, false,
           "with --checkpoint: sample actions instead of the mean / mode");
 ABSL_FLAG(std::string, video, "",

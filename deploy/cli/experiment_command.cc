@@ -15,14 +15,12 @@
 #include "deploy/cli/command_line.h"
 #include "deploy/cli/python_script.h"
 #include "deploy/cli/run_flags.h"
+#include "deploy/cli/shared_flags.h"
 #include "deploy/cli/stop_signal.h"
 #include "deploy/experiment/experiment_backend.h"
 #include "deploy/experiment/experiment_grid.h"
 #include "deploy/experiment/experiment_runner.h"
 
-ABSL_FLAG(std::string, out, "",
-          "run: the experiment directory (created; an existing one is "
-          "continued)");
 ABSL_FLAG(int, jobs, 0,
           "run: cells at a time (0: as many as the cores allow, a core per "
           "process of a cell)");

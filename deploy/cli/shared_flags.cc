@@ -16,5 +16,12 @@ ABSL_FLAG(std::string, metrics, "",
           "0: a free one, printed on stderr); with train, the learner there "
           "and the actors on the next ports, listed in "
           "RUN_DIR/prometheus_targets.json (docs/metrics.md); empty: none");
+ABSL_FLAG(std::string, checkpoint, "",
+          "a run directory (its newest checkpoint that loads) or checkpoint "
+          "file whose policy acts (rollout's default: a uniform-random "
+          "policy)");
+ABSL_FLAG(std::string, out, "",
+          "experiment run: the experiment directory (created; an existing "
+          "one is continued); export: the ONNX file to write");
 ABSL_FLAG(std::string, metrics_port_file, "",
           "with --metrics, write the metrics port to this file once serving");

@@ -11,6 +11,7 @@
 #include "common/nn/networks.h"
 #include "common/nn/policy_weights.h"
 #include "common/nn/running_mean_std.h"
+#include "deploy/export/policy_onnx.h"
 #include "deploy/run/run_config.h"
 #include "deploy/run/run_plan.h"
 #include "learner/checkpoint/checkpoint.h"
@@ -93,6 +94,14 @@ std::vector<double> TrainedPolicy::Act(absl::Span<const double> observation,
                                 .contiguous();
   const double* data = action.data_ptr<double>();
   return std::vector<double>(data, data + action.numel());
+}
+
+absl::StatusOr<std::string> TrainedPolicy::OnnxModel(bool distribution) const {
+  OnnxExportOptions options;
+  options.distribution = distribution;
+  options.producer_version = absl::StrCat("policy version ", version);
+  return PolicyToOnnx(spec, *networks->policy, networks->normalizer,
+                      networks->observation_clip, options);
 }
 
 absl::StatusOr<TrainedPolicy> LoadTrainedPolicy(const std::string& path) {

@@ -31,6 +31,10 @@ struct TrainedPolicy {
   // likely action (discrete) when `deterministic`, else a sample.
   std::vector<double> Act(absl::Span<const double> observation,
                           bool deterministic);
+  // The policy and its normaliser as a serialised ONNX model
+  // (deploy/export/policy_onnx.h), with the distribution's parameters too
+  // when `distribution`.
+  absl::StatusOr<std::string> OnnxModel(bool distribution) const;
 
   struct Networks;  // the policy, the normaliser and the generator
   std::shared_ptr<Networks> networks;
