@@ -3,10 +3,12 @@
 #include <ATen/ATen.h>
 #include <torch/nn/init.h>
 
+#include <algorithm>
 #include <cmath>
 #include <tuple>
 
 #include "common/nn/networks.h"
+#include "common/nn/recurrent_cell_kernel.h"
 
 namespace vantage {
 namespace {
@@ -91,6 +93,40 @@ at::Tensor RecurrentTrunkImpl::Unroll(const at::Tensor& observations,
   }
   if (after != nullptr) *after = at::stack(states);
   return at::cat(features);
+}
+
+at::Tensor RecurrentTrunkImpl::UnrollWithoutGradients(
+    const at::Tensor& observations, const at::Tensor& starts,
+    const at::Tensor& state, at::Tensor* after) {
+  at::NoGradGuard no_grad;
+  const bool lstm = core_ == Core::kLstm;
+  RecurrentCellKernel kernel =
+      RecurrentCellKernel::Create(lstm ? RecurrentCellKernel::Kind::kLstm
+                                       : RecurrentCellKernel::Kind::kGru,
+                                  lstm ? lstm_->weight_ih : gru_->weight_ih,
+                                  lstm ? lstm_->weight_hh : gru_->weight_hh,
+                                  lstm ? lstm_->bias_ih : gru_->bias_ih,
+                                  lstm ? lstm_->bias_hh : gru_->bias_hh)
+          .value();
+  const int64_t steps = starts.size(0);
+  const int64_t rows = state.size(0);
+  const int64_t width = state_size();
+  const at::Tensor encoded = Encode(observations).to(at::kFloat).contiguous();
+  const int64_t inputs = encoded.size(1);
+  const at::Tensor begins = starts.to(at::kBool).contiguous();
+  at::Tensor current = state.to(at::kFloat).contiguous().clone();
+  at::Tensor states = at::empty({steps, rows, width}, at::kFloat);
+  float* s = current.data_ptr<float>();
+  for (int64_t t = 0; t < steps; ++t) {
+    const bool* start = begins.data_ptr<bool>() + t * rows;
+    for (int64_t r = 0; r < rows; ++r) {
+      if (start[r]) std::fill(s + r * width, s + (r + 1) * width, 0.0f);
+    }
+    kernel.Step(encoded.data_ptr<float>() + t * rows * inputs, rows, s);
+    std::copy(s, s + rows * width, states.data_ptr<float>() + t * rows * width);
+  }
+  if (after != nullptr) *after = states;
+  return states.narrow(2, 0, hidden_).reshape({steps * rows, hidden_});
 }
 
 }  // namespace vantage

@@ -56,6 +56,14 @@ class RecurrentTrunkImpl : public torch::nn::Module {
   // state_size()] (before any zeroing for the next step).
   at::Tensor Unroll(const at::Tensor& observations, const at::Tensor& starts,
                     const at::Tensor& state, at::Tensor* after = nullptr);
+  // The same without autograd, each step through RecurrentCellKernel (two
+  // BLAS products over all rows) instead of LibTorch's cell: for long
+  // passes that train nothing, such as the critic's over a batch. Agrees
+  // with Unroll up to float rounding.
+  at::Tensor UnrollWithoutGradients(const at::Tensor& observations,
+                                    const at::Tensor& starts,
+                                    const at::Tensor& state,
+                                    at::Tensor* after = nullptr);
 
   // Empty for the MLP torso.
   const ConvTorso& conv_torso() const { return conv_; }

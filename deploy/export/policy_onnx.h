@@ -8,8 +8,8 @@
 // networks take it, and the output `action`: the Gaussian mean clipped to
 // the action bounds (float [batch, k]) or the most likely action (int64
 // [batch]). With `distribution`, also the distribution's parameters:
-// `mean` and `log_std` (each [batch, k]) or `logits` [batch, n]. The model passes ONNX's checker
-// before it is returned.
+// `mean` and `log_std` (each [batch, k]) or `logits` [batch, n]. The model
+// passes ONNX's checker before it is returned.
 
 #include <string>
 

@@ -41,9 +41,9 @@ RecurrentCriticPass RunRecurrentCritic(
   }
   pass.start_states = at::stack(start_states);
   at::Tensor after;
-  const at::Tensor features =
-      trunk.Unroll(normalize(observations.reshape({(steps + 1) * n, -1})),
-                   starts, pass.start_states, &after);
+  const at::Tensor features = trunk.UnrollWithoutGradients(
+      normalize(observations.reshape({(steps + 1) * n, -1})), starts,
+      pass.start_states, &after);
   pass.after = after.slice(0, 0, steps);
   // Rollout-major, as AssembleBatch reads them.
   const at::Tensor stream_values =

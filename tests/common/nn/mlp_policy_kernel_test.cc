@@ -12,33 +12,13 @@
 #include "common/nn/networks.h"
 #include "common/nn/running_mean_std.h"
 #include "gtest/gtest.h"
+#include "tests/fakes/random_policy.h"
 #include "tests/fakes/vector_spec.h"
 
 namespace vantage {
 namespace {
 
 constexpr double kClip = 5.0;
-
-// Random weights of the scale the initialisation gives hidden layers,
-// 1 / sqrt(inputs) per weight (the output layer too, whose initial gain of
-// 0.01 would leave every output near 0), random biases, log-std and
-// normaliser.
-void Randomise(PolicyNetworkImpl& policy, RunningMeanStd& normalizer,
-               const EnvSpec& spec) {
-  at::NoGradGuard no_grad;
-  for (at::Tensor& parameter : policy.parameters()) {
-    const double scale =
-        parameter.dim() == 2 ? 1.0 / std::sqrt(parameter.size(1)) : 0.5;
-    parameter.copy_(at::randn(parameter.sizes()) * scale);
-  }
-  if (!spec.byte_observations()) {
-    ASSERT_TRUE(
-        normalizer
-            .Restore(10.0, at::randn({spec.observation_size}, at::kDouble),
-                     at::rand({spec.observation_size}, at::kDouble) + 0.1)
-            .ok());
-  }
-}
 
 // Observations as environments write them: doubles, some far enough out
 // to be clipped; integers in range for byte observations.
@@ -84,7 +64,7 @@ void CompareWithLibTorch(const Case& c) {
   config.hidden = c.hidden;
   PolicyNetwork policy(spec, config);
   RunningMeanStd normalizer(spec.observation_size);
-  Randomise(*policy, normalizer, spec);
+  RandomisePolicy(*policy, normalizer, spec);
   absl::StatusOr<MlpPolicyKernel> kernel =
       MlpPolicyKernel::Create(spec, *policy, normalizer, kClip);
   ASSERT_TRUE(kernel.ok()) << kernel.status();
@@ -130,7 +110,7 @@ void CompareRecurrentWithLibTorch(Core core, const Case& c) {
   config.core_size = 24;
   PolicyNetwork policy(spec, config);
   RunningMeanStd normalizer(spec.observation_size);
-  Randomise(*policy, normalizer, spec);
+  RandomisePolicy(*policy, normalizer, spec);
   absl::StatusOr<MlpPolicyKernel> kernel =
       MlpPolicyKernel::Create(spec, *policy, normalizer, kClip);
   ASSERT_TRUE(kernel.ok()) << kernel.status();

@@ -138,5 +138,30 @@ TEST(RecurrentTrunkTest, StepsAgreeWithAnUnroll) {
   }
 }
 
+// The critic's pass without autograd is the unroll, up to float rounding,
+// with episodes starting on the way.
+TEST(RecurrentTrunkTest, UnrollingWithoutGradientsAgrees) {
+  for (Core core : {Core::kGru, Core::kLstm}) {
+    at::manual_seed(6);
+    const EnvSpec spec = VectorSpec(false, 5, 2);
+    NetworkConfig config;
+    config.hidden = {8};
+    config.core = core;
+    config.core_size = 6;
+    RecurrentTrunk trunk(spec, config);
+    const at::Tensor observations = at::randn({kSteps * kRows, 5});
+    const at::Tensor starts = at::rand({kSteps, kRows}) < 0.25;
+    const at::Tensor state = at::randn({kRows, trunk->state_size()}) * 0.5;
+    at::NoGradGuard no_grad;
+    at::Tensor after, fast_after;
+    const at::Tensor features =
+        trunk->Unroll(observations, starts, state, &after);
+    const at::Tensor fast =
+        trunk->UnrollWithoutGradients(observations, starts, state, &fast_after);
+    EXPECT_TRUE(at::allclose(fast, features, 1e-5, 1e-6));
+    EXPECT_TRUE(at::allclose(fast_after, after, 1e-5, 1e-6));
+  }
+}
+
 }  // namespace
 }  // namespace vantage

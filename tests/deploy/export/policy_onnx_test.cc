@@ -19,6 +19,7 @@
 #include "common/nn/running_mean_std.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
+#include "tests/fakes/random_policy.h"
 #include "tests/fakes/vector_spec.h"
 
 namespace vantage {
@@ -26,24 +27,6 @@ namespace {
 
 constexpr int64_t kRows = 1000;
 constexpr double kClip = 5.0;
-
-// Weights of the scale hidden layers start with, for every layer, so that
-// the outputs are far from the output layer's initial zeros.
-void Randomise(PolicyNetworkImpl& policy, RunningMeanStd& normalizer,
-               const EnvSpec& spec) {
-  at::NoGradGuard no_grad;
-  for (at::Tensor& p : policy.parameters()) {
-    const double scale = p.dim() >= 2 ? 1.0 / std::sqrt(p[0].numel()) : 0.5;
-    p.copy_(at::randn(p.sizes()) * scale);
-  }
-  if (!spec.byte_observations()) {
-    ASSERT_TRUE(
-        normalizer
-            .Restore(10.0, at::randn({spec.observation_size}, at::kDouble),
-                     at::rand({spec.observation_size}, at::kDouble) + 0.1)
-            .ok());
-  }
-}
 
 // The model's outputs `names` for `observations` [kRows, obs] (float).
 std::vector<cv::Mat> RunOnOpenCv(const std::string& model,
@@ -90,7 +73,7 @@ Exported Export(const EnvSpec& spec, const NetworkConfig& config) {
   e.spec = spec;
   e.policy = PolicyNetwork(spec, config);
   e.normalizer = RunningMeanStd(spec.observation_size);
-  Randomise(*e.policy, e.normalizer, spec);
+  RandomisePolicy(*e.policy, e.normalizer, spec);
   OnnxExportOptions options;
   options.distribution = true;
   absl::StatusOr<std::string> model =
