@@ -6,9 +6,8 @@
 #include <torch/nn/modules/conv.h>
 #include <torch/nn/modules/linear.h>
 
-#include <cfloat>
+#include <algorithm>
 #include <cmath>
-#include <cstring>
 #include <exception>
 #include <string>
 #include <vector>
