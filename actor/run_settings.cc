@@ -59,10 +59,6 @@ const SettingsTable<NetworkConfig, pb::TrainingSettings>& CoreTable() {
   return *table;
 }
 
-bool NamesACore(const pb::TrainingSettings& training) {
-  return training.has_core() && training.core() != "none";
-}
-
 // The torso by name; the hidden sizes positive.
 absl::Status ResolveNetwork(pb::TrainingSettings& training) {
   absl::StatusOr<NetworkConfig> network =
@@ -112,6 +108,10 @@ EnvOptions EnvOptionsOf(const pb::RunConfig& run) {
   EnvOptionsTable().Read(run.training(), options);
   options.python_kwargs = run.training().env_kwargs();
   return options;
+}
+
+bool NamesACore(const pb::TrainingSettings& training) {
+  return training.has_core() && training.core() != "none";
 }
 
 absl::StatusOr<NetworkConfig> PolicyNetworkOf(const pb::RunConfig& run) {

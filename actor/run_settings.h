@@ -31,6 +31,9 @@ EnvOptions EnvOptionsOf(const pb::RunConfig& run);
 // InvalidArgument naming it.
 absl::StatusOr<NetworkConfig> PolicyNetworkOf(const pb::RunConfig& run);
 
+// Whether the training section names a recurrent core (gru or lstm).
+bool NamesACore(const pb::TrainingSettings& training);
+
 // The actor of a resolved run config: the run's env, wrapping, env streams
 // (training.envs), segment length, seed and policy network. A remote actor
 // keeps its own env name, env count and seed (see ActorEnvSeed).

@@ -27,6 +27,7 @@
 namespace vantage {
 namespace {
 
+// HalfCheetah's sizes, as BarePpoShape's defaults (BenchSpec).
 constexpr int64_t kObservations = 17;
 constexpr int64_t kActions = 6;
 constexpr int64_t kStreams = 16;
@@ -35,13 +36,6 @@ constexpr int64_t kSeqLen = 16;
 constexpr int kMinibatches = 32;
 constexpr int kEpochs = 10;
 constexpr int kRepetitions = 5;
-
-EnvSpec HalfCheetahSpec() {
-  BarePpoShape shape;
-  shape.observations = kObservations;
-  shape.actions = kActions;
-  return BenchSpec(shape);
-}
 
 // Random rows, no episode starts, small random chunk states.
 UpdateBatch RecurrentBatch(int64_t state_size) {
@@ -160,8 +154,9 @@ int RunRecurrentLearnerBenchmark(const NetworkConfig& core) {
   network.hidden = {64, 64};
   network.seq_len = kSeqLen;
   const UpdateBatch batch = RecurrentBatch(network.core_state_size());
-  PolicyNetwork policy(HalfCheetahSpec(), network);
-  ValueNetwork value = MakeValueNetwork(HalfCheetahSpec(), network, *policy);
+  const EnvSpec spec = BenchSpec(BarePpoShape());
+  PolicyNetwork policy(spec, network);
+  ValueNetwork value = MakeValueNetwork(spec, network, *policy);
   PpoConfig config;
   config.minibatches = kMinibatches;
   config.epochs = kEpochs;

@@ -5,6 +5,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_replace.h"
+#include "actor/run_settings.h"
 #include "deploy/run/distributed_config.h"
 #include "deploy/run/run_plan.h"
 #include "learner/algorithms/algorithm_config.h"
@@ -53,7 +54,7 @@ int64_t DefaultSegmentLength(int64_t horizon) {
 absl::Status ResolveSequences(const AlgorithmRunDefaults& run_defaults,
                               pb::TrainingSettings& t) {
   // Without a core, --core_size and --seq_len were refused already.
-  if (!t.has_core() || t.core() == "none") return absl::OkStatus();
+  if (!NamesACore(t)) return absl::OkStatus();
   if (t.horizon() % t.segment_length() != 0) {
     return FlagError("segment_length",
                      absl::StrCat("must divide --horizon (", t.horizon(),
