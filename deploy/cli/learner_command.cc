@@ -16,6 +16,7 @@
 #include "deploy/cli/stop_signal.h"
 #include "deploy/cli/train_command.h"
 #include "deploy/run/run_config.h"
+#include "deploy/run/run_evaluation.h"
 #include "learner/server/learner_server.h"
 #include "learner/service/actor_gateway.h"
 
@@ -105,6 +106,13 @@ absl::Status DescribeServer(const ResolvedRun& resolved,
   server.security = *std::move(security);
   server.metrics_address = absl::GetFlag(FLAGS_metrics);
   server.metrics_port_file = absl::GetFlag(FLAGS_metrics_port_file);
+  if (resolved.plan.evaluation.enabled()) {
+    absl::StatusOr<EvaluatePolicy> evaluate =
+        MakeRunEvaluation(resolved.plan.actor, resolved.plan.evaluation);
+    if (!evaluate.ok()) return evaluate.status();
+    server.eval_every = resolved.plan.evaluation.every;
+    server.evaluate = *std::move(evaluate);
+  }
   server.replicas.rank = absl::GetFlag(FLAGS_rank);
   server.replicas.world_size = resolved.config.distributed().learners();
   server.replicas.rendezvous = absl::GetFlag(FLAGS_rendezvous);

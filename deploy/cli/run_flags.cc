@@ -10,6 +10,7 @@
 #include "absl/strings/str_format.h"
 #include "absl/strings/str_join.h"
 #include "absl/strings/str_split.h"
+#include "actor/evaluation_config.h"
 #include "common/nn/network_config.h"
 #include "deploy/cli/command_line.h"
 #include "deploy/run/run_config.h"
@@ -322,6 +323,10 @@ std::map<std::string, std::string> RunFlagDefaults(bool with_mode) {
   defaults["core"] = CoreName(network.core);
   defaults["core_size"] = absl::StrCat(network.core_size);
   defaults["seq_len"] = absl::StrCat(network.seq_len);
+  // Nor does a run's config without evaluations hold their settings.
+  const EvaluationConfig evaluation;
+  defaults["eval_every"] = absl::StrCat(evaluation.every);
+  defaults["eval_episodes"] = absl::StrCat(evaluation.episodes);
   return defaults;
 }
 

@@ -2,6 +2,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "actor/actor_core.h"
+#include "deploy/run/run_evaluation.h"
 #include "learner/checkpoint/checkpoint.h"
 #include "learner/learner_core.h"
 #include "learner/run/training_run.h"
@@ -10,6 +11,17 @@ namespace vantage {
 namespace {
 
 constexpr char kActorState[] = "actor_state";
+
+// Before the row of each evaluated version, so that the row holds it and a
+// rerun or a resume repeats it.
+absl::Status EvaluateLocally(const RunPlan& plan, TrainingRun& run) {
+  if (!plan.evaluation.enabled()) return absl::OkStatus();
+  absl::StatusOr<EvaluatePolicy> evaluate =
+      MakeRunEvaluation(plan.actor, plan.evaluation);
+  if (!evaluate.ok()) return evaluate.status();
+  return run.EvaluateEvery(plan.evaluation.every, *std::move(evaluate),
+                           /*in_background=*/false);
+}
 
 }  // namespace
 
@@ -46,6 +58,9 @@ absl::Status RunLocalTraining(
         return (*actor)->RestoreState(state->second);
       });
   if (!run.ok()) return run.status();
+  if (absl::Status status = EvaluateLocally(plan, **run); !status.ok()) {
+    return status;
+  }
   LearnerCore& learner = (*run)->learner();
   auto actor_state = [&]() -> absl::StatusOr<CheckpointExtras> {
     absl::StatusOr<std::string> state = (*actor)->SaveState();

@@ -5,6 +5,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_replace.h"
+#include "actor/evaluation_config.h"
 #include "actor/run_settings.h"
 #include "deploy/run/distributed_config.h"
 #include "deploy/run/run_plan.h"
@@ -171,6 +172,9 @@ absl::StatusOr<pb::RunConfig> ResolveRunConfig(const pb::RunConfig& given) {
   }
   if (absl::Status status = ResolveRecordingSettings(*c.mutable_recording());
       !status.ok()) {
+    return status;
+  }
+  if (absl::Status status = ResolveEvaluationSettings(c); !status.ok()) {
     return status;
   }
   // The rules of the learner's own config (a shared torso's algorithm),

@@ -1,6 +1,7 @@
 #include "deploy/run/run_plan.h"
 
 #include "absl/strings/str_cat.h"
+#include "actor/evaluation_config.h"
 #include "actor/run_settings.h"
 #include "deploy/run/run_config_file.h"
 #include "learner/learner_settings.h"
@@ -21,6 +22,7 @@ absl::StatusOr<RunPlan> PlanRun(const pb::RunConfig& resolved) {
   plan.learner.observation_clip = plan.actor.observation_clip;
   plan.recording = RecordingConfigOf(resolved.recording());
   plan.recording.config_json = RunConfigToJson(resolved);
+  plan.evaluation = EvaluationConfigOf(resolved);
   return plan;
 }
 

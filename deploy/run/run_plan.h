@@ -10,6 +10,7 @@
 
 #include "absl/status/statusor.h"
 #include "actor/actor_config.h"
+#include "actor/evaluation_config.h"
 #include "learner/learner_config.h"
 #include "learner/run/recording_config.h"
 #include "proto/run_config.pb.h"
@@ -25,6 +26,8 @@ struct RunPlan {
   LearnerConfig learner;
   // Without a run directory: set by the request that names one.
   RecordingConfig recording;
+  // Evaluations during training (run on the actor's side of the wiring).
+  EvaluationConfig evaluation;
 };
 
 // The plan of a config that ResolveRunConfig returned; the recording's

@@ -1,16 +1,11 @@
 #include "deploy/run/trained_policy.h"
 
-#include <ATen/ATen.h>
-#include <ATen/CPUGeneratorImpl.h>
-#include <ATen/core/grad_mode.h>
-
 #include <filesystem>
+#include <utility>
 
 #include "absl/strings/str_cat.h"
 #include "actor/envs/env_registry.h"
-#include "common/nn/networks.h"
-#include "common/nn/policy_weights.h"
-#include "common/nn/running_mean_std.h"
+#include "common/nn/policy_runner.h"
 #include "deploy/export/policy_onnx.h"
 #include "deploy/run/run_config.h"
 #include "deploy/run/run_plan.h"
@@ -19,11 +14,8 @@
 namespace vantage {
 
 struct TrainedPolicy::Networks {
-  PolicyNetwork policy{nullptr};
-  RunningMeanStd normalizer{1};
-  double observation_clip = 10.0;
-  at::Generator generator = at::detail::createCPUGenerator(0);
-  at::Tensor state;  // a recurrent policy's, [1, state size]
+  explicit Networks(PolicyRunner runner) : runner(std::move(runner)) {}
+  PolicyRunner runner;
 };
 
 namespace {
@@ -55,53 +47,35 @@ absl::StatusOr<TrainedPolicy> LoadCheckpointFile(const std::string& path) {
   trained.checkpoint_path = path;
   trained.version = (*learner)->policy_version();
   trained.spec = (*env)->spec();
-  trained.networks = std::make_shared<TrainedPolicy::Networks>();
-  TrainedPolicy::Networks& networks = *trained.networks;
-  networks.policy = PolicyNetwork((*env)->spec(), learner_config.network);
-  networks.normalizer = RunningMeanStd((*env)->spec().observation_size);
-  networks.observation_clip = learner_config.observation_clip;
-  if (absl::Status status = ImportPolicyWeights(
-          (*learner)->CurrentWeights(), *networks.policy, networks.normalizer);
+  PolicyRunner runner((*env)->spec(), learner_config.network,
+                      learner_config.observation_clip);
+  if (absl::Status status = runner.Load((*learner)->CurrentWeights());
       !status.ok()) {
     return status;
   }
-  trained.StartEpisode();
+  trained.networks =
+      std::make_shared<TrainedPolicy::Networks>(std::move(runner));
   return trained;
 }
 
 }  // namespace
 
-void TrainedPolicy::Seed(uint64_t seed) {
-  networks->generator = at::detail::createCPUGenerator(seed);
-}
+void TrainedPolicy::Seed(uint64_t seed) { networks->runner.Seed(seed); }
 
-void TrainedPolicy::StartEpisode() {
-  Networks& n = *networks;
-  if (n.policy->recurrent()) n.state = n.policy->trunk()->InitialState(1);
-}
+void TrainedPolicy::StartEpisode() { networks->runner.StartEpisode(); }
 
 std::vector<double> TrainedPolicy::Act(absl::Span<const double> observation,
                                        bool deterministic) {
-  at::NoGradGuard no_grad;
-  Networks& n = *networks;
-  const at::Tensor x = ObservationsForNetwork(
-      spec, n.normalizer, ObservationTensor(spec, observation.data(), 1),
-      n.observation_clip);
-  const at::Tensor output =
-      n.policy->recurrent() ? n.policy->Step(x, n.state) : n.policy->forward(x);
-  const at::Tensor action = n.policy->Act(output, deterministic, n.generator)
-                                .to(at::kDouble)
-                                .contiguous();
-  const double* data = action.data_ptr<double>();
-  return std::vector<double>(data, data + action.numel());
+  return networks->runner.Act(observation, deterministic);
 }
 
 absl::StatusOr<std::string> TrainedPolicy::OnnxModel(bool distribution) const {
   OnnxExportOptions options;
   options.distribution = distribution;
   options.producer_version = absl::StrCat("policy version ", version);
-  return PolicyToOnnx(spec, *networks->policy, networks->normalizer,
-                      networks->observation_clip, options);
+  const PolicyRunner& runner = networks->runner;
+  return PolicyToOnnx(spec, runner.policy(), runner.normalizer(),
+                      runner.observation_clip(), options);
 }
 
 absl::StatusOr<TrainedPolicy> LoadTrainedPolicy(const std::string& path) {

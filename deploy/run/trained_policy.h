@@ -36,7 +36,7 @@ struct TrainedPolicy {
   // when `distribution`.
   absl::StatusOr<std::string> OnnxModel(bool distribution) const;
 
-  struct Networks;  // the policy, the normaliser and the generator
+  struct Networks;  // the policy, its normaliser and generator
   std::shared_ptr<Networks> networks;
 };
 

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <limits>
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
@@ -124,6 +125,51 @@ std::vector<ProgressColumn> ExplorationColumns() {
   };
 }
 
+// Empty in the rows without an evaluation; on the dashboard the newest
+// evaluation's figures stay until the next.
+double Evaluated(const ProgressRow& row, double EvaluationSummary::*field) {
+  return row.evaluation.has_value() ? (*row.evaluation).*field
+                                    : std::numeric_limits<double>::quiet_NaN();
+}
+
+std::vector<ProgressColumn> EvaluationColumns() {
+  return {
+      {"eval_version", "eval_policy_version", Metric::kGauge, Format::kNumber,
+       "Policy version of the newest evaluation (--eval_every).",
+       [](const ProgressRow& r) {
+         return r.evaluation.has_value()
+                    ? double(r.evaluation->version)
+                    : std::numeric_limits<double>::quiet_NaN();
+       }},
+      {"eval_return", "eval_return", Metric::kGauge, Format::kNumber,
+       "Mean return of the deterministic policy over the newest "
+       "evaluation's episodes.",
+       [](const ProgressRow& r) {
+         return Evaluated(r, &EvaluationSummary::mean);
+       }},
+      {"eval_return_std", "eval_return_std", Metric::kGauge, Format::kNumber,
+       "Standard deviation of the newest evaluation's episode returns.",
+       [](const ProgressRow& r) {
+         return Evaluated(r, &EvaluationSummary::std);
+       }},
+      {"eval_return_min", "eval_return_min", Metric::kGauge, Format::kNumber,
+       "Lowest episode return of the newest evaluation.",
+       [](const ProgressRow& r) {
+         return Evaluated(r, &EvaluationSummary::min);
+       }},
+      {"eval_return_max", "eval_return_max", Metric::kGauge, Format::kNumber,
+       "Highest episode return of the newest evaluation.",
+       [](const ProgressRow& r) {
+         return Evaluated(r, &EvaluationSummary::max);
+       }},
+      {"eval_length", "eval_episode_length", Metric::kGauge, Format::kNumber,
+       "Mean episode length of the newest evaluation.",
+       [](const ProgressRow& r) {
+         return Evaluated(r, &EvaluationSummary::mean_length);
+       }},
+  };
+}
+
 // Last in the file: the only columns a rerun with the same seed and flags
 // does not repeat.
 std::vector<ProgressColumn> TimeColumns() {
@@ -144,7 +190,8 @@ const std::vector<ProgressColumn>& ProgressColumns() {
     std::vector<ProgressColumn> all;
     for (const std::vector<ProgressColumn>& group :
          {RunProgressColumns(), UpdateColumns(), DiscardedWorkColumns(),
-          FeederColumns(), ExplorationColumns(), TimeColumns()}) {
+          FeederColumns(), ExplorationColumns(), EvaluationColumns(),
+          TimeColumns()}) {
       all.insert(all.end(), group.begin(), group.end());
     }
     return all;

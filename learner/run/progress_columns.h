@@ -5,9 +5,11 @@
 // learner's Prometheus series: one table feeds both, so a statistic added
 // here is in the file and on the dashboard alike.
 
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "common/rollout/policy_evaluation.h"
 #include "learner/update/update_stats.h"
 
 namespace vantage {
@@ -17,6 +19,9 @@ struct ProgressRow {
   double mean_return = 0.0;       // last 100 episodes; NaN: none finished yet
   double elapsed_seconds = 0.0;   // of the whole run, across resumes
   double steps_per_second = 0.0;  // since this process started
+  // An evaluation that finished since the previous row (of this update's
+  // version in a local run, of an earlier one in a distributed run).
+  std::optional<EvaluationSummary> evaluation;
 };
 
 struct ProgressColumn {

@@ -5,11 +5,14 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "absl/functional/function_ref.h"
 #include "absl/status/statusor.h"
+#include "common/rollout/policy_evaluation.h"
 #include "learner/checkpoint/checkpoint.h"
 #include "learner/learner_core.h"
+#include "learner/run/best_checkpoint.h"
 #include "learner/run/recording_config.h"
 #include "learner/run/run_directory.h"
 
@@ -28,16 +31,26 @@ struct RecorderConfig {
 };
 
 // Records a training run as it goes: a progress row per update, appended to
-// progress.csv, and a checkpoint every `checkpoint_every` updates and at
-// the end (when there is a run directory), plus the wall-clock figures.
+// progress.csv, and a checkpoint every `checkpoint_every` updates, at every
+// evaluated version and at the end (when there is a run directory), plus
+// the wall-clock figures and the best-evaluated checkpoint.
 class RunRecorder {
  public:
   RunRecorder(std::optional<RunDirectory> run, RecorderConfig config);
 
+  // The run evaluates every `every` updates: those versions are
+  // checkpointed and held until their evaluation, which keeps
+  // checkpoints/best.pt (with a run directory).
+  absl::Status EvaluateEvery(int64_t every);
+
   // `extras` adds the caller's byte strings to the checkpoint (e.g. the
   // local actor's state); it is called only when one is written.
+  // `evaluations` finished since the last row (the newest goes into the
+  // row; each is offered to the best checkpoint, after this version's
+  // checkpoint is written and held if it is to be evaluated).
   absl::StatusOr<ProgressRow> Record(
       const LearnerCore& learner, const UpdateStats& stats,
+      const std::vector<PolicyEvaluation>& evaluations,
       absl::FunctionRef<absl::StatusOr<CheckpointExtras>()> extras);
 
   // A checkpoint of the learner as it is now, unless its version already
@@ -54,8 +67,15 @@ class RunRecorder {
       const LearnerCore& learner, double elapsed_seconds,
       absl::FunctionRef<absl::StatusOr<CheckpointExtras>()> extras);
 
+  // Whether `version` is evaluated (and so checkpointed and held).
+  bool Evaluates(int64_t version) const;
+  // The best checkpoint keeps the evaluated versions that beat it.
+  absl::Status OfferToBest(const std::vector<PolicyEvaluation>& evaluations);
+
   std::optional<RunDirectory> run_;
   RecorderConfig config_;
+  int64_t eval_every_ = 0;
+  std::optional<BestCheckpoint> best_;
   std::chrono::steady_clock::time_point start_;
   int64_t checkpointed_version_ = -1;
 };

@@ -2,6 +2,7 @@
 
 #include <cstdio>
 #include <optional>
+#include <string>
 #include <utility>
 
 #include "learner/run/run_directory.h"
@@ -78,7 +79,45 @@ absl::StatusOr<ProgressRow> TrainingRun::Update(SegmentQueue& queue,
                  static_cast<long>(stats->rejected_segments),
                  stats->first_rejection.c_str());
   }
-  return recorder_.Record(*learner_, *stats, save);
+  return recorder_.Record(*learner_, *stats, Evaluations(), save);
+}
+
+absl::Status TrainingRun::EvaluateEvery(int64_t every, EvaluatePolicy evaluate,
+                                        bool in_background) {
+  if (absl::Status status = recorder_.EvaluateEvery(every); !status.ok()) {
+    return status;
+  }
+  eval_every_ = every;
+  evaluate_ = std::move(evaluate);
+  if (in_background) {
+    background_ = std::make_unique<BackgroundEvaluator>(evaluate_);
+  }
+  return absl::OkStatus();
+}
+
+std::vector<PolicyEvaluation> TrainingRun::Evaluations() {
+  std::vector<PolicyEvaluation> evaluations;
+  const int64_t version = learner_->policy_version();
+  if (eval_every_ > 0 && version % eval_every_ == 0) {
+    if (background_ != nullptr) {
+      background_->Submit(learner_->CurrentWeights());
+    } else if (absl::StatusOr<PolicyEvaluation> evaluation =
+                   evaluate_(learner_->CurrentWeights());
+               evaluation.ok()) {
+      evaluations.push_back(*std::move(evaluation));
+    } else {
+      // Training goes on: an evaluation is a measurement, not the run.
+      std::fprintf(stderr,
+                   "learner: the evaluation of version %ld failed: %s\n",
+                   static_cast<long>(version),
+                   std::string(evaluation.status().message()).c_str());
+    }
+  }
+  if (background_ == nullptr) return evaluations;
+  // The run's last row waits for its final evaluations.
+  if (done()) background_->Drain();
+  return background_->TakeFinished();
+  return evaluations;
 }
 
 absl::Status TrainingRun::CheckpointNow(const SaveExtras& save) {

@@ -11,11 +11,13 @@
 #include <functional>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "absl/status/statusor.h"
 #include "common/rollout/segment_queue.h"
 #include "learner/checkpoint/checkpoint.h"
 #include "learner/learner_core.h"
+#include "learner/run/background_evaluator.h"
 #include "learner/run/progress_columns.h"
 #include "learner/run/recording_config.h"
 #include "learner/run/run_recorder.h"
@@ -44,6 +46,13 @@ class TrainingRun {
       std::shared_ptr<ReplicaGroup> replicas = SoloReplicaGroup());
 
   LearnerCore& learner() { return *learner_; }
+
+  // Evaluates every `every` updates' version with `evaluate`: in the
+  // background (a learner process: its results go into the first row after
+  // they finish), or before the update's row, which holds it (a local run,
+  // so that a rerun or a resume repeats it). Keeps checkpoints/best.pt.
+  absl::Status EvaluateEvery(int64_t every, EvaluatePolicy evaluate,
+                             bool in_background);
   // The run's environment steps are done.
   bool done() const;
 
@@ -58,9 +67,15 @@ class TrainingRun {
   TrainingRun(std::unique_ptr<LearnerCore> learner, RunRecorder recorder,
               int64_t total_env_steps);
 
+  // The evaluations to record with this update's row.
+  std::vector<PolicyEvaluation> Evaluations();
+
   std::unique_ptr<LearnerCore> learner_;
   RunRecorder recorder_;
   const int64_t total_env_steps_;
+  int64_t eval_every_ = 0;
+  EvaluatePolicy evaluate_;
+  std::unique_ptr<BackgroundEvaluator> background_;
 };
 
 }  // namespace vantage

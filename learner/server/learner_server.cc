@@ -246,6 +246,13 @@ absl::Status LearnerProcess::Open() {
       replicas_);
   if (!run.ok()) return run.status();
   run_ = *std::move(run);
+  if (config_.eval_every > 0 && config_.evaluate && recording_.record) {
+    if (absl::Status status = run_->EvaluateEvery(
+            config_.eval_every, config_.evaluate, /*in_background=*/true);
+        !status.ok()) {
+      return status;
+    }
+  }
   if (recording_.resume) {
     std::fprintf(stderr,
                  "learner: resuming %s from policy version %ld (%ld env "

@@ -10,6 +10,7 @@
 #include "common/net/security_options.h"
 #include "learner/learner_config.h"
 #include "learner/parallel/gloo_replica_group.h"
+#include "learner/run/evaluate_policy.h"
 #include "learner/run/progress_columns.h"
 #include "learner/run/recording_config.h"
 #include "learner/service/actor_gateway.h"
@@ -41,6 +42,10 @@ struct LearnerServerConfig {
   std::string metrics_address;
   // If set, the metrics port goes there once serving (see port_file.h).
   std::string metrics_port_file;
+  // Evaluations every `eval_every` updates (0: none) with `evaluate`, on a
+  // low-priority thread of rank 0 (learner/run/background_evaluator.h).
+  int64_t eval_every = 0;
+  EvaluatePolicy evaluate;
   // This learner's place among the run's data-parallel learners (the
   // run config's distributed.learners); each trains on its own actors'
   // share of the batch. Only rank 0 writes the run directory.

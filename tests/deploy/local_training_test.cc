@@ -2,14 +2,18 @@
 
 #include <ATen/Parallel.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
 #include <vector>
 
+#include "absl/strings/numbers.h"
+#include "absl/strings/str_cat.h"
 #include "absl/strings/str_join.h"
 #include "absl/strings/str_split.h"
+#include "deploy/run/trained_policy.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
 #include "learner/checkpoint/checkpoint.h"
@@ -33,14 +37,18 @@ std::string FreshDirectory(const std::string& name) {
 }
 
 // `name`: an algorithm, or "ex2", optionally with a recurrent core
-// ("ppo_gru": PPO with a GRU of 16 units).
+// ("ppo_gru": PPO with a GRU of 16 units) or evaluations ("ppo_eval": of
+// 3 episodes every 2 updates).
 RunPlan SmallRun(const std::string& name, uint64_t seed,
                  const std::string& run_dir) {
   const std::vector<std::string> parts = absl::StrSplit(name, '_');
   const std::string& algorithm = parts[0];
   pb::RunConfig run;
   pb::TrainingSettings& training = *run.mutable_training();
-  if (parts.size() > 1) {
+  if (parts.size() > 1 && parts[1] == "eval") {
+    run.mutable_evaluation()->set_eval_every(2);
+    run.mutable_evaluation()->set_eval_episodes(3);
+  } else if (parts.size() > 1) {
     training.set_core(parts[1]);
     training.set_core_size(16);
   }
@@ -108,7 +116,8 @@ TEST(LocalTrainingTest, SameSeedSameProgressCsv) {
             "explained_variance,biased_fraction,mean_abs_bias,"
             "rejected_segments,rolled_back_updates,batch_actors,"
             "batch_env_slots,exploration_loss,"
-            "exploration_accuracy,exploration_bonus");
+            "exploration_accuracy,exploration_bonus,eval_version,eval_return,"
+            "eval_return_std,eval_return_min,eval_return_max,eval_length");
   EXPECT_EQ(first, DeterministicProgress(b));
   EXPECT_NE(first, DeterministicProgress(c));
   // One row per update, steps counted exactly.
@@ -180,16 +189,71 @@ TEST_P(ResumeTest, ResumedRunEqualsUninterruptedRun) {
 
 INSTANTIATE_TEST_SUITE_P(Algorithms, ResumeTest,
                          ::testing::Values("ppo", "a2c", "trpo", "ex2",
-                                           "ppo_gru", "a2c_lstm"));
+                                           "ppo_gru", "a2c_lstm", "ppo_eval"));
 
-// The rows without the three exploration columns (the last ones before the
-// wall clock, which DeterministicProgress drops).
+// Every second version is evaluated before its row, which holds the
+// evaluation; checkpoints/best.pt is the version whose evaluation was best
+// (best.json says which) and loads as a trained policy.
+TEST(LocalTrainingTest, EvaluationsFillTheirRowsAndKeepTheBestCheckpoint) {
+  at::set_num_threads(1);
+  const std::string dir = FreshDirectory("evaluated");
+  Train(SmallRun("ppo_eval", 3, dir));
+  const std::vector<std::string> rows = DeterministicProgress(dir);
+  ASSERT_EQ(rows.size(), 1u + kUpdates);
+  const std::vector<std::string> names = absl::StrSplit(rows[0], ',');
+  const auto column = [&](const std::string& name) {
+    return static_cast<size_t>(std::find(names.begin(), names.end(), name) -
+                               names.begin());
+  };
+  int64_t best_version = -1;
+  double best_return = -1e300;
+  for (int version = 1; version <= kUpdates; ++version) {
+    const std::vector<std::string> fields = absl::StrSplit(rows[version], ',');
+    const std::string& evaluated = fields[column("eval_version")];
+    if (version % 2 != 0) {
+      EXPECT_EQ(evaluated, "") << version;
+      EXPECT_EQ(fields[column("eval_return")], "") << version;
+      continue;
+    }
+    EXPECT_EQ(evaluated, std::to_string(version));
+    double mean = 0, low = 0, high = 0;
+    ASSERT_TRUE(absl::SimpleAtod(fields[column("eval_return")], &mean));
+    ASSERT_TRUE(absl::SimpleAtod(fields[column("eval_return_min")], &low));
+    ASSERT_TRUE(absl::SimpleAtod(fields[column("eval_return_max")], &high));
+    EXPECT_LE(low, mean);
+    EXPECT_LE(mean, high);
+    if (mean > best_return) {
+      best_return = mean;
+      best_version = version;
+    }
+  }
+  std::ifstream json(dir + "/checkpoints/best.json");
+  std::stringstream text;
+  text << json.rdbuf();
+  EXPECT_THAT(text.str(), ::testing::HasSubstr(absl::StrCat(
+                              "\"version\": ", best_version, ",")));
+  absl::StatusOr<TrainedPolicy> best =
+      LoadTrainedPolicy(dir + "/checkpoints/best.pt");
+  ASSERT_TRUE(best.ok()) << best.status();
+  EXPECT_EQ(best->version, best_version);
+  for (const auto& entry :
+       std::filesystem::directory_iterator(dir + "/checkpoints")) {
+    EXPECT_THAT(entry.path().filename().string(),
+                ::testing::Not(::testing::StartsWith("evaluating-")));
+  }
+}
+
+// The rows without the three exploration columns.
 std::vector<std::string> WithoutExploration(
     const std::vector<std::string>& rows) {
+  const std::vector<std::string> names = absl::StrSplit(ProgressHeader(), ',');
+  const auto first = static_cast<size_t>(
+      std::find(names.begin(), names.end(), "exploration_loss") -
+      names.begin());
   std::vector<std::string> kept;
   for (const std::string& row : rows) {
     std::vector<std::string> fields = absl::StrSplit(row, ',');
-    fields.resize(fields.size() - 3);
+    fields.erase(fields.begin() + first, fields.begin() + first + 3);
     kept.push_back(absl::StrJoin(fields, ","));
   }
   return kept;
@@ -214,16 +278,18 @@ TEST(LocalTrainingTest, Ex2ChangesTrainingOnlyThroughTheRewards) {
   EXPECT_NE(WithoutExploration(DeterministicProgress(shaped)),
             WithoutExploration(DeterministicProgress(plain)));
   // Updates 1-2: no model yet (bonus 0, no fit); 3: the first fit.
-  const auto field = [&](int row, int from_end) {
+  const std::vector<std::string> names = absl::StrSplit(ProgressHeader(), ',');
+  const auto field = [&](int row, const std::string& name) {
     const std::vector<std::string> fields =
         absl::StrSplit(silent_rows[row], ',');
-    return fields[fields.size() - from_end];
+    return fields[static_cast<size_t>(
+        std::find(names.begin(), names.end(), name) - names.begin())];
   };
-  EXPECT_EQ(field(1, 1), "0");
-  EXPECT_EQ(field(1, 3), "");
-  EXPECT_NE(field(2, 1), "0");
-  EXPECT_NE(field(3, 3), "");
-  EXPECT_GT(std::stod(field(3, 2)), 0.0);
+  EXPECT_EQ(field(1, "exploration_bonus"), "0");
+  EXPECT_EQ(field(1, "exploration_loss"), "");
+  EXPECT_NE(field(2, "exploration_bonus"), "0");
+  EXPECT_NE(field(3, "exploration_loss"), "");
+  EXPECT_GT(std::stod(field(3, "exploration_accuracy")), 0.0);
 }
 
 // A damaged newest checkpoint is reported and skipped: the run continues

@@ -158,6 +158,37 @@ TEST(RunConfigTest, ASharedTorsoNeedsOneOptimiserOverBothNetworks) {
 // A recurrent core: its settings appear in the config only with a core;
 // its chunks default to whole segments (a2c: its minibatches' steps); each
 // rule names its flag.
+// Evaluation settings are in a run's config only when it evaluates, so
+// every config from before them resolves as it did.
+TEST(RunConfigTest, EvaluationsResolveOnlyWhenTheRunEvaluates) {
+  absl::StatusOr<pb::RunConfig> plain = Resolve(R"({"training": {}})");
+  ASSERT_TRUE(plain.ok()) << plain.status();
+  EXPECT_FALSE(plain->has_evaluation());
+  EXPECT_FALSE(PlanRun(*plain)->evaluation.enabled());
+  absl::StatusOr<pb::RunConfig> off =
+      Resolve(R"({"evaluation": {"eval_every": 0}})");
+  ASSERT_TRUE(off.ok()) << off.status();
+  EXPECT_FALSE(off->has_evaluation());
+  absl::StatusOr<pb::RunConfig> on =
+      Resolve(R"({"evaluation": {"eval_every": 5}})");
+  ASSERT_TRUE(on.ok()) << on.status();
+  EXPECT_EQ(on->evaluation().eval_every(), 5);
+  EXPECT_EQ(on->evaluation().eval_episodes(), 10);
+  absl::StatusOr<RunPlan> plan = PlanRun(*on);
+  ASSERT_TRUE(plan.ok()) << plan.status();
+  EXPECT_EQ(plan->evaluation.every, 5);
+  EXPECT_EQ(plan->evaluation.episodes, 10);
+  const auto error = [](const std::string& json) {
+    return std::string(Resolve(json).status().message());
+  };
+  EXPECT_THAT(error(R"({"evaluation": {"eval_every": 5, "eval_episodes": 0}})"),
+              HasSubstr("--eval_episodes must be in [1, 100000]"));
+  EXPECT_THAT(error(R"({"evaluation": {"eval_every": -2}})"),
+              HasSubstr("--eval_every must be >= 0"));
+  EXPECT_THAT(error(R"({"evaluation": {"eval_episodes": 3}})"),
+              HasSubstr("--eval_episodes needs --eval_every"));
+}
+
 TEST(RunConfigTest, ARecurrentCoreResolvesItsChunksAndNamesEveryRule) {
   absl::StatusOr<pb::RunConfig> plain = Resolve(R"({"training": {}})");
   ASSERT_TRUE(plain.ok()) << plain.status();

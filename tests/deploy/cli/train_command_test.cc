@@ -140,6 +140,8 @@ TEST(TrainCommandTest, BadFlagsAreOneLineErrors) {
       {"train --resume=/no/such/run", "/no/such/run/config.json"},
       {"train --steps=10 --run_dir=" + taken, "already holds a run"},
       {"rollout --checkpoint=/no/such/run", "no checkpoint file"},
+      {"train --eval_every=5 --eval_episodes=0",
+       "--eval_episodes must be in [1, 100000]"},
   };
   for (const auto& [args, message] : cases) {
     const Outcome outcome = RunVantage(args);
