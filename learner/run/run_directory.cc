@@ -13,6 +13,7 @@
 #include "absl/strings/str_format.h"
 #include "absl/strings/str_join.h"
 #include "absl/strings/str_split.h"
+#include "common/util/cpu_model.h"
 
 namespace vantage {
 
@@ -44,8 +45,8 @@ absl::Status RunDirectory::CheckFree(const std::string& path) {
 }
 
 absl::Status RunDirectory::Clear(const std::string& path) {
-  for (const char* name :
-       {"config.json", "progress.csv", "checkpoints", "launch"}) {
+  for (const char* name : {"config.json", "progress.csv", "machine.json",
+                           "checkpoints", "launch"}) {
     std::error_code error;
     std::filesystem::remove_all(absl::StrCat(path, "/", name), error);
     if (error) {
@@ -93,6 +94,35 @@ std::string RunDirectory::progress_path() const {
 }
 std::string RunDirectory::checkpoint_directory() const {
   return path_ + "/checkpoints";
+}
+
+std::string RunDirectory::machine_path() const {
+  return path_ + "/machine.json";
+}
+
+absl::Status RunDirectory::RecordMachine() const {
+  // One model per line between the brackets, as this function writes them.
+  std::vector<std::string> models;
+  std::ifstream file(machine_path());
+  std::string line;
+  while (std::getline(file, line)) {
+    const size_t open = line.find('"');
+    const size_t close = line.rfind('"');
+    if (line.rfind("  \"", 0) == 0 && close > open) {
+      models.push_back(line.substr(open + 1, close - open - 1));
+    }
+  }
+  const std::string model = CpuModel();
+  if (std::find(models.begin(), models.end(), model) != models.end()) {
+    return absl::OkStatus();
+  }
+  models.push_back(model);
+  std::vector<std::string> quoted;
+  for (const std::string& m : models)
+    quoted.push_back(absl::StrCat("  \"", m, "\""));
+  return WriteFileAtomically(
+      machine_path(), absl::StrCat("{\"cpu_models\": [\n",
+                                   absl::StrJoin(quoted, ",\n"), "\n]}\n"));
 }
 
 std::vector<ProgressLine> ReadProgressLines(const std::string& run_dir) {

@@ -54,6 +54,12 @@ class RunDirectory {
   std::string config_path() const;
   std::string checkpoint_directory() const;
 
+  // Adds this machine's CPU model to machine.json ({"cpu_models": [...]},
+  // every model that ran a part of the run, in order), so that results
+  // of different machines are not compared unawares.
+  absl::Status RecordMachine() const;
+  std::string machine_path() const;
+
   // Drops the rows after update `updates` (written after the checkpoint a
   // resumed run continues from), atomically.
   absl::Status TruncateProgress(int64_t updates) const;

@@ -54,6 +54,11 @@ absl::StatusOr<std::unique_ptr<TrainingRun>> TrainingRun::Open(
     if (!created.ok()) return created.status();
     learner = *std::move(created);
   }
+  if (run.has_value()) {
+    if (absl::Status status = run->RecordMachine(); !status.ok()) {
+      return status;
+    }
+  }
   RecorderConfig recorder;
   recorder.recording = recording;
   recorder.total_env_steps = learner_config.total_env_steps;

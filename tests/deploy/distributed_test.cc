@@ -66,12 +66,7 @@ void ExpectSyncWithOneActorReproducesLocalMode(const std::string& tag,
   EXPECT_EQ(DeterministicProgress(remote), expected);
   if (ex2) {
     // The last row's exploration_loss is that of a fit.
-    const std::vector<std::string> names = absl::StrSplit(expected[0], ',');
-    const std::vector<std::string> fields =
-        absl::StrSplit(expected.back(), ',');
-    const auto loss = std::find(names.begin(), names.end(), "exploration_loss");
-    ASSERT_NE(loss, names.end());
-    EXPECT_FALSE(fields[static_cast<size_t>(loss - names.begin())].empty())
+    EXPECT_NE(ProgressField(expected, 6, "exploration_loss"), "")
         << expected.back();
   }
 }
@@ -242,21 +237,16 @@ TEST(DistributedTest, EvaluationsRunBesideTheLearnerAndKeepTheBest) {
   ASSERT_EQ(trained.exit_code, 0) << trained.err;
   const std::vector<std::string> rows = DeterministicProgress(run);
   ASSERT_EQ(rows.size(), 1u + 16);
-  const std::vector<std::string> names = absl::StrSplit(rows[0], ',');
-  const auto at = [&](const std::string& name) {
-    return static_cast<size_t>(std::find(names.begin(), names.end(), name) -
-                               names.begin());
-  };
   int64_t previous = 0;
   for (size_t row = 1; row < rows.size(); ++row) {
-    const std::vector<std::string> fields = absl::StrSplit(rows[row], ',');
-    if (fields[at("eval_version")].empty()) continue;
+    const std::string evaluated = ProgressField(rows, row, "eval_version");
+    if (evaluated.empty()) continue;
     int64_t version = 0;
-    ASSERT_TRUE(absl::SimpleAtoi(fields[at("eval_version")], &version));
+    ASSERT_TRUE(absl::SimpleAtoi(evaluated, &version)) << rows[row];
     EXPECT_EQ(version % 4, 0) << rows[row];
     EXPECT_GT(version, previous) << rows[row];
     EXPECT_LE(version, static_cast<int64_t>(row)) << rows[row];
-    EXPECT_FALSE(fields[at("eval_return")].empty()) << rows[row];
+    EXPECT_NE(ProgressField(rows, row, "eval_return"), "") << rows[row];
     previous = version;
   }
   EXPECT_EQ(previous, 16);

@@ -13,6 +13,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_join.h"
 #include "absl/strings/str_split.h"
+#include "common/util/cpu_model.h"
 #include "deploy/run/trained_policy.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
@@ -158,6 +159,28 @@ TEST(LocalTrainingTest, ResumingMigratesAnOlderProgressFile) {
   }
 }
 
+// machine.json names every CPU model that ran a part of the run: a run
+// resumed on another machine lists both.
+TEST(LocalTrainingTest, ARunRecordsTheMachinesThatRanIt) {
+  const std::string dir = FreshDirectory("machines");
+  Train(SmallRun("ppo", 1, dir), /*stop_after=*/2);
+  const auto read = [&] {
+    std::ifstream file(dir + "/machine.json");
+    std::stringstream text;
+    text << file.rdbuf();
+    return text.str();
+  };
+  const std::string here = CpuModel();
+  EXPECT_EQ(read(), "{\"cpu_models\": [\n  \"" + here + "\"\n]}\n");
+  std::ofstream(dir + "/machine.json")
+      << "{\"cpu_models\": [\n  \"Elsewhere 9000\"\n]}\n";
+  RunPlan resume = SmallRun("ppo", 1, dir);
+  resume.recording.resume = true;
+  Train(resume, /*stop_after=*/3);
+  EXPECT_EQ(read(), "{\"cpu_models\": [\n  \"Elsewhere 9000\",\n  \"" + here +
+                        "\"\n]}\n");
+}
+
 TEST(LocalTrainingTest, RefusesADirectoryThatHoldsARun) {
   const std::string dir = FreshDirectory("taken");
   Train(SmallRun("ppo", 1, dir), /*stop_after=*/1);
@@ -200,26 +223,22 @@ TEST(LocalTrainingTest, EvaluationsFillTheirRowsAndKeepTheBestCheckpoint) {
   Train(SmallRun("ppo_eval", 3, dir));
   const std::vector<std::string> rows = DeterministicProgress(dir);
   ASSERT_EQ(rows.size(), 1u + kUpdates);
-  const std::vector<std::string> names = absl::StrSplit(rows[0], ',');
-  const auto column = [&](const std::string& name) {
-    return static_cast<size_t>(std::find(names.begin(), names.end(), name) -
-                               names.begin());
-  };
   int64_t best_version = -1;
   double best_return = -1e300;
   for (int version = 1; version <= kUpdates; ++version) {
-    const std::vector<std::string> fields = absl::StrSplit(rows[version], ',');
-    const std::string& evaluated = fields[column("eval_version")];
+    const auto field = [&](const std::string& column) {
+      return ProgressField(rows, version, column);
+    };
     if (version % 2 != 0) {
-      EXPECT_EQ(evaluated, "") << version;
-      EXPECT_EQ(fields[column("eval_return")], "") << version;
+      EXPECT_EQ(field("eval_version"), "") << version;
+      EXPECT_EQ(field("eval_return"), "") << version;
       continue;
     }
-    EXPECT_EQ(evaluated, std::to_string(version));
+    EXPECT_EQ(field("eval_version"), std::to_string(version));
     double mean = 0, low = 0, high = 0;
-    ASSERT_TRUE(absl::SimpleAtod(fields[column("eval_return")], &mean));
-    ASSERT_TRUE(absl::SimpleAtod(fields[column("eval_return_min")], &low));
-    ASSERT_TRUE(absl::SimpleAtod(fields[column("eval_return_max")], &high));
+    ASSERT_TRUE(absl::SimpleAtod(field("eval_return"), &mean));
+    ASSERT_TRUE(absl::SimpleAtod(field("eval_return_min"), &low));
+    ASSERT_TRUE(absl::SimpleAtod(field("eval_return_max"), &high));
     EXPECT_LE(low, mean);
     EXPECT_LE(mean, high);
     if (mean > best_return) {
@@ -278,12 +297,8 @@ TEST(LocalTrainingTest, Ex2ChangesTrainingOnlyThroughTheRewards) {
   EXPECT_NE(WithoutExploration(DeterministicProgress(shaped)),
             WithoutExploration(DeterministicProgress(plain)));
   // Updates 1-2: no model yet (bonus 0, no fit); 3: the first fit.
-  const std::vector<std::string> names = absl::StrSplit(ProgressHeader(), ',');
   const auto field = [&](int row, const std::string& name) {
-    const std::vector<std::string> fields =
-        absl::StrSplit(silent_rows[row], ',');
-    return fields[static_cast<size_t>(
-        std::find(names.begin(), names.end(), name) - names.begin())];
+    return ProgressField(silent_rows, row, name);
   };
   EXPECT_EQ(field(1, "exploration_bonus"), "0");
   EXPECT_EQ(field(1, "exploration_loss"), "");

@@ -1,5 +1,6 @@
 #include "tests/fakes/run_files.h"
 
+#include <algorithm>
 #include <fstream>
 
 #include "absl/strings/str_join.h"
@@ -17,6 +18,17 @@ std::vector<std::string> DeterministicProgress(const std::string& run_dir) {
     rows.push_back(absl::StrJoin(fields, ","));
   }
   return rows;
+}
+
+std::string ProgressField(const std::vector<std::string>& rows, size_t row,
+                          const std::string& column) {
+  const std::string missing = "<no column " + column + ">";
+  if (rows.empty() || row >= rows.size()) return missing;
+  const std::vector<std::string> names = absl::StrSplit(rows[0], ',');
+  const std::vector<std::string> fields = absl::StrSplit(rows[row], ',');
+  const auto at = std::find(names.begin(), names.end(), column);
+  const auto index = static_cast<size_t>(at - names.begin());
+  return at == names.end() || index >= fields.size() ? missing : fields[index];
 }
 
 }  // namespace vantage
