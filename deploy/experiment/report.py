@@ -25,6 +25,14 @@ import run_files  # noqa: E402  (progress.csv, errors and entry, shared)
 PROG = "vantage experiment report"
 CONFIDENCE = 0.95
 RESAMPLES = 10000
+# The family-wise error rate of the report's tests (Holm), the power the
+# minimum detectable effects are stated at, the effect the seed counts are
+# for (a share of the baseline's mean final return), and the fewest seeds
+# a group needs for a test.
+ALPHA = 0.05
+POWER = 0.8
+RELATIVE_EFFECT = 0.10
+MIN_SEEDS = 3
 # Flags that place a cell or that the comparison is about: a group's
 # baseline is the group with the same other settings.
 NOT_MATCHED = {"env", "seed", "steps", "estimator", "rho", "ensemble"}
@@ -45,12 +53,22 @@ usage: vantage experiment report EXP_DIR [flags]
   with a 95% percentile-bootstrap confidence interval (10,000 resamples
   of the seeds of each group, seeded, so reports repeat) and Welch's
   t-test p-value, and the difference of the areas with its interval (for
-  tasks whose final returns all reach the maximum). A group beats (or trails) the baseline "with
-  confidence" when the interval excludes 0 and p < 0.05; the report says
-  so in words. Unfinished cells are listed, not counted. A summary table
-  before the envs gives every group's verdict, difference [CI] and p on
-  each env. One learning-curve figure per env (`vantage plot`) goes
-  beside the report.
+  tasks whose final returns all reach the maximum). The report's tests of
+  final returns are one family: their p-values are adjusted by Holm's
+  step-down method (family-wise error 0.05). Each comparison states its
+  minimum detectable effect (the difference Welch's test would find with
+  80% power at the family's strictest level, 0.05 / tests, from the two
+  groups' measured standard deviations) and the seeds per group a 10%
+  effect (of the baseline's mean) would need at that level. A group beats
+  (or trails) the baseline "with confidence" when the interval excludes 0
+  and the Holm-adjusted p < 0.05; the report says so in words. A group of
+  fewer than 3 finished seeds gets no test (the report says so). Every
+  comparison names the CPU models that ran its groups (each run's
+  machine.json): groups run on different models, or on unrecorded ones,
+  are flagged in the verdict. Unfinished cells are listed, not counted. A
+  summary table before the envs gives every group's verdict, difference
+  [CI] and adjusted p on each env. One learning-curve figure per env
+  (`vantage plot`) goes beside the report.
   Ends with a line `wrote FILE: E envs, G groups, R finished runs`.
 
 flags:
@@ -60,6 +78,11 @@ flags:
   --baseline=""
       the estimator every group is compared with (empty: the experiment's
       report.baseline, itself gae by default)
+  --match=""
+      comma-separated fields a group and its baseline must share besides
+      the settings that are not the comparison's (rho, ensemble): e.g.
+      --baseline=order:2 --match=rho tests each order statistic against
+      the 2nd order at the same rho
   --threshold=""
       ENV=RETURN[,ENV=RETURN...]: the returns whose first crossing is
       reported (empty: the experiment's report.thresholds)
@@ -85,11 +108,16 @@ def parse_arguments(argv):
   parser.add_argument("--out", default="")
   parser.add_argument("--baseline", default="")
   parser.add_argument("--threshold", default="")
+  parser.add_argument("--match", default="")
   parser.add_argument("--no_figures", action="store_true")
   args = parser.parse_args(argv)
   if not args.exp_dir:
     raise ReportError("name the experiment directory: vantage experiment "
                       "report EXP_DIR")
+  args.match = set(filter(None, args.match.split(",")))
+  for field in args.match - {"rho", "ensemble"}:
+    raise ReportError(f"--match={field}: only rho and ensemble can be "
+                      f"matched (the other settings always are)")
   args.thresholds = {}
   for entry in filter(None, args.threshold.split(",")):
     env, _, value = entry.partition("=")
@@ -151,11 +179,30 @@ def read_curve(run_dir):
       run_files.column_values(run_dir, columns, rows, "mean_return")))
 
 
+def read_cpu_models(run_dir):
+  """The CPU models that ran the run (its machine.json), or None when it
+  has no record (a run of a vantage before machine.json)."""
+  path = os.path.join(run_dir, "machine.json")
+  try:
+    with open(path, encoding="utf-8") as f:
+      models = json.load(f).get("cpu_models")
+  except FileNotFoundError:
+    return None
+  except (OSError, UnicodeDecodeError, json.JSONDecodeError,
+          AttributeError) as e:
+    raise ReportError(f"{path}: cannot read it ({e})")
+  if (not isinstance(models, list) or not models or
+      not all(isinstance(m, str) for m in models)):
+    raise ReportError(f"{path}: \"cpu_models\" is not a list of names")
+  return models
+
+
 class RunResult:
 
-  def __init__(self, cell, curve):
+  def __init__(self, cell, curve, cpu_models=None):
     self.cell = cell
     self.curve = curve
+    self.cpu_models = cpu_models
     steps = int(cell["config"]["training"]["steps"])
     self.finished = bool(curve) and curve[-1][0] >= steps
     finite = [(x, y) for x, y in curve or [] if math.isfinite(y)]
@@ -174,11 +221,11 @@ class RunResult:
     return None
 
 
-def group_key(cell):
+def group_key(cell, matched=frozenset()):
   """What a group's baseline must share with it."""
   flags = cell.get("flags", {})
   return tuple(sorted((k, v) for k, v in flags.items()
-                      if k not in NOT_MATCHED))
+                      if k not in NOT_MATCHED - matched))
 
 
 def estimator_of(cell):
@@ -194,11 +241,12 @@ def mean_sd(values):
 
 
 def compare(values, baseline):
-  """(difference of means, CI low, CI high, Welch p); NaNs where n < 2."""
+  """(difference of means, CI low, CI high, Welch p); NaNs where a group
+  has fewer than MIN_SEEDS values."""
   import numpy as np
   from scipy import stats
   difference = float(np.mean(values) - np.mean(baseline))
-  if len(values) < 2 or len(baseline) < 2:
+  if min(len(values), len(baseline)) < MIN_SEEDS:
     return difference, math.nan, math.nan, math.nan
   result = stats.bootstrap(
       (np.asarray(values), np.asarray(baseline)),
@@ -216,6 +264,50 @@ def compare(values, baseline):
   return difference, low, high, p
 
 
+def holm(p_values):
+  """Holm's step-down adjustment of a family of p-values (NaN ones are no
+  test and stay NaN)."""
+  tested = sorted((p, i) for i, p in enumerate(p_values) if math.isfinite(p))
+  adjusted = [math.nan] * len(p_values)
+  running = 0.0
+  for rank, (p, i) in enumerate(tested):
+    running = max(running, min(1.0, (len(tested) - rank) * p))
+    adjusted[i] = running
+  return adjusted
+
+
+def detectable(values, baseline, tests):
+  """(minimum detectable effect, seeds per group for a RELATIVE_EFFECT
+  effect) of Welch's test at level ALPHA / tests with POWER, from the
+  groups' sample standard deviations; NaN where they do not say."""
+  from scipy import stats
+  if min(len(values), len(baseline)) < MIN_SEEDS or tests < 1:
+    return math.nan, math.nan
+  var_a = statistics.variance(values)
+  var_b = statistics.variance(baseline)
+  se2 = var_a / len(values) + var_b / len(baseline)
+  if se2 <= 0:
+    return math.nan, math.nan
+  df = se2 ** 2 / ((var_a / len(values)) ** 2 / (len(values) - 1) +
+                   (var_b / len(baseline)) ** 2 / (len(baseline) - 1))
+  level = ALPHA / tests
+  mde = (stats.t.ppf(1 - level / 2, df) + stats.t.ppf(POWER, df)) * \
+      math.sqrt(se2)
+  effect = RELATIVE_EFFECT * abs(statistics.mean(baseline))
+  if effect <= 0:
+    return float(mde), math.nan
+  z = stats.norm.ppf(1 - level / 2) + stats.norm.ppf(POWER)
+  seeds = math.ceil(z * z * (var_a + var_b) / (effect * effect))
+  return float(mde), float(max(seeds, MIN_SEEDS))
+
+
+def cpu_names(runs):
+  """The CPU models of a group's runs, sorted; None if a run has none."""
+  if any(r.cpu_models is None for r in runs):
+    return None
+  return sorted({m for r in runs for m in r.cpu_models})
+
+
 def number(value, digits=1):
   if value is None or not math.isfinite(value):
     return "n/a"
@@ -227,6 +319,7 @@ def signed(value):
 
 
 def verdict(difference, low, high, p):
+  """From the interval and the Holm-adjusted p."""
   if not (math.isfinite(low) and math.isfinite(p)):
     return "unknown"
   if low > 0 and p < 0.05:
@@ -241,13 +334,35 @@ class Comparison:
 
   def __init__(self, group, base, runs, base_runs):
     self.group, self.base = group, base
-    finals = [r.final for r in runs]
-    base_finals = [r.final for r in base_runs]
-    self.runs, self.base_runs = len(finals), len(base_finals)
-    self.difference, self.low, self.high, self.p = compare(finals,
-                                                           base_finals)
+    self.finals = [r.final for r in runs]
+    self.base_finals = [r.final for r in base_runs]
+    self.runs, self.base_runs = len(self.finals), len(self.base_finals)
+    self.difference, self.low, self.high, self.p = compare(
+        self.finals, self.base_finals)
     self.auc = compare([r.auc for r in runs], [r.auc for r in base_runs])
-    self.kind = verdict(self.difference, self.low, self.high, self.p)
+    self.cpus, self.base_cpus = cpu_names(runs), cpu_names(base_runs)
+    self.adjust(self.p, 1)
+
+  def adjust(self, p_holm, tests):
+    """The family's verdict: its Holm-adjusted p among `tests` tests."""
+    self.p_holm = p_holm
+    self.mde, self.seeds = detectable(self.finals, self.base_finals, tests)
+    self.kind = ("too few seeds"
+                 if min(self.runs, self.base_runs) < MIN_SEEDS else
+                 verdict(self.difference, self.low, self.high, self.p_holm))
+
+  def cpu_problem(self):
+    """Why the groups' machines make the comparison doubtful, or ""."""
+    if self.cpus is None or self.base_cpus is None:
+      return "CPU models unrecorded"
+    if self.cpus != self.base_cpus or len(self.cpus) > 1:
+      return (f"MIXED CPU models ({' + '.join(self.cpus)} vs "
+              f"{' + '.join(self.base_cpus)})")
+    return ""
+
+  def label(self):
+    problem = self.cpu_problem()
+    return f"{self.kind} ({problem})" if problem else self.kind
 
   def interval(self):
     return (f"{signed(self.difference)} [{signed(self.low)}, "
@@ -255,37 +370,58 @@ class Comparison:
 
   def cells(self):
     difference, low, high, _ = self.auc
-    return [self.interval(), number(self.p, 3),
-            f"{signed(difference)} [{signed(low)}, {signed(high)}]"]
+    cpus = ("unrecorded" if self.cpus is None
+            else " + ".join(self.cpus))
+    return [self.interval(), number(self.p, 3), number(self.p_holm, 3),
+            number(self.mde), number(self.seeds, 0),
+            f"{signed(difference)} [{signed(low)}, {signed(high)}]",
+            cpus + (" ⚠" if self.cpu_problem() else "")]
 
   def sentence(self):
+    problem = self.cpu_problem()
+    warning = f" ⚠ {problem}: the difference may be the machines'." \
+        if problem.startswith("MIXED") else (
+            f" ({problem}.)" if problem else "")
+    return self.verdict_sentence() + warning
+
+  def verdict_sentence(self):
     group, base = f"`{self.group}`", f"`{self.base}`"
     counts = f"{self.runs} vs {self.base_runs} runs"
+    power = (f"; detectable with 80% power: {number(self.mde)}, a 10% "
+             f"effect needs {number(self.seeds, 0)} seeds a group"
+             if math.isfinite(self.mde) else "")
     stated = (f"{signed(self.difference)}, 95% CI [{signed(self.low)}, "
-              f"{signed(self.high)}], p = {number(self.p, 3)} ({counts}).")
+              f"{signed(self.high)}], p = {number(self.p, 3)}, Holm "
+              f"{number(self.p_holm, 3)} ({counts}{power}).")
     if self.kind == "better":
-      return (f"{group} beats {base} with confidence: "
-              f"{signed(self.difference)} final return, 95% CI "
-              f"[{signed(self.low)}, {signed(self.high)}], p = "
-              f"{number(self.p, 3)} ({counts}).")
+      return f"{group} beats {base} with confidence: {stated}"
     if self.kind == "worse":
       return f"{group} is worse than {base} with confidence: {stated}"
     if self.kind == "unclear":
       return f"{group} is not distinguishable from {base}: {stated}"
-    if min(self.runs, self.base_runs) < 2:
-      return (f"{group} vs {base}: {signed(self.difference)}; too few runs "
-              f"for a confidence interval ({counts}).")
+    if min(self.runs, self.base_runs) < MIN_SEEDS:
+      return (f"{group} vs {base}: {signed(self.difference)}; fewer than "
+              f"{MIN_SEEDS} seeds in a group, so no test ({counts}).")
     return (f"{group} vs {base}: {signed(self.difference)}; every run of "
             f"both ended at the same return, so there is no test "
             f"({counts}).")
+
+
+def adjust_family(comparisons):
+  """Holm over every comparison of the report that has a test."""
+  adjusted = holm([c.p for c in comparisons])
+  tests = sum(1 for c in comparisons if math.isfinite(c.p))
+  for comparison, p_holm in zip(comparisons, adjusted):
+    comparison.adjust(p_holm, tests)
 
 
 def table_header(baseline_name, threshold):
   header = ["group", "runs", "final return", "AUC (mean return)"]
   if threshold is not None:
     header.append(f"steps to {number(threshold)}")
-  header += [f"final - {baseline_name} [95% CI]", "Welch p",
-             f"AUC - {baseline_name} [95% CI]"]
+  header += [f"final - {baseline_name} [95% CI]", "Welch p", "Holm p",
+             "detectable (80%)", "seeds for 10%",
+             f"AUC - {baseline_name} [95% CI]", "CPU models"]
   return ["| " + " | ".join(header) + " |",
           "|" + "|".join(["---"] * len(header)) + "|"]
 
@@ -306,45 +442,70 @@ def group_row(group, runs, total, threshold):
   return row
 
 
-def env_section(env, results, baseline_name, threshold, figure,
-                figure_problem):
-  """The env's Markdown lines, its group and finished-run counts and its
-  comparisons with the baseline."""
-  groups = {}
-  for result in results:
-    groups.setdefault(result.cell["group"], []).append(result)
+class EnvResults:
+  """An env's groups of cells, their finished runs and their comparisons
+  with the baseline (adjusted later, with the whole report's family)."""
+
+  def __init__(self, env, results, baseline_name, matched=frozenset()):
+    self.env, self.baseline_name = env, baseline_name
+    self.matched = frozenset(matched)
+    self.groups = {}
+    for result in results:
+      self.groups.setdefault(result.cell["group"], []).append(result)
+    self.finished = {
+        g: [r for r in rs if r.finished and math.isfinite(r.final)]
+        for g, rs in self.groups.items()}
+    self.baselines = {}
+    for group, runs in self.groups.items():
+      cell = runs[0].cell
+      if estimator_of(cell) == baseline_name:
+        self.baselines.setdefault(group_key(cell, self.matched), group)
+    self.order = sorted(self.groups, key=lambda g: (estimator_of(
+        self.groups[g][0].cell) != baseline_name, g))
+    self.comparisons = {}
+    for group in self.order:
+      base = self.base_of(group)
+      if base is not None and base != group and self.finished[group] and \
+          self.finished[base]:
+        self.comparisons[group] = Comparison(
+            group, base, self.finished[group], self.finished[base])
+
+  def base_of(self, group):
+    return self.baselines.get(
+        group_key(self.groups[group][0].cell, self.matched))
+
+  def runs(self):
+    return sum(len(r) for r in self.finished.values())
+
+
+def env_section(results, threshold, figure, figure_problem):
+  """The env's Markdown lines."""
+  env = results.env
   lines = [f"## {env}", ""]
   if figure:
     lines += [f"![learning curves on {env}]({figure})", ""]
   elif figure_problem:
     lines += [f"(No figure: {figure_problem}.)", ""]
-  lines += table_header(baseline_name, threshold)
-  finished = {g: [r for r in rs if r.finished and math.isfinite(r.final)]
-              for g, rs in groups.items()}
-  baselines = {}
-  for group, runs in groups.items():
-    cell = runs[0].cell
-    if estimator_of(cell) == baseline_name:
-      baselines.setdefault(group_key(cell), group)
-  comparisons = []
-  order = sorted(groups, key=lambda g: (estimator_of(
-      groups[g][0].cell) != baseline_name, g))
-  for group in order:
-    runs = finished[group]
-    row = group_row(group, runs, len(groups[group]), threshold)
-    base = baselines.get(group_key(groups[group][0].cell))
-    if base is None or base == group or not runs or not finished[base]:
-      row += ["—" if base == group else "no baseline", "", ""]
+  lines += table_header(results.baseline_name, threshold)
+  for group in results.order:
+    runs = results.finished[group]
+    row = group_row(group, runs, len(results.groups[group]), threshold)
+    comparison = results.comparisons.get(group)
+    if comparison is None:
+      base = results.base_of(group)
+      row += ["—" if base == group else "no baseline"] + [""] * 6
     else:
-      comparisons.append(Comparison(group, base, runs, finished[base]))
-      row += comparisons[-1].cells()
+      row += comparison.cells()
     lines.append("| " + " | ".join(row) + " |")
   lines.append("")
+  comparisons = [results.comparisons[g] for g in results.order
+                 if g in results.comparisons]
   lines += [f"- {c.sentence()}" for c in comparisons] or [
       "- No group has a baseline to be compared with."]
-  unfinished = [r.cell["dir"] for g in order for r in groups[g]
-                if not r.finished]
-  no_return = [r.cell["dir"] for g in order for r in groups[g]
+  unfinished = [r.cell["dir"] for g in results.order
+                for r in results.groups[g] if not r.finished]
+  no_return = [r.cell["dir"] for g in results.order
+               for r in results.groups[g]
                if r.finished and not math.isfinite(r.final)]
   if unfinished:
     lines += ["", f"Unfinished, not counted: {', '.join(unfinished)}."]
@@ -352,8 +513,7 @@ def env_section(env, results, baseline_name, threshold, figure,
     lines += ["", f"Finished without a completed episode in their last 100 "
               f"(no final return), not counted: {', '.join(no_return)}."]
   lines.append("")
-  return lines, len(groups), sum(len(r) for r in finished.values()), \
-      comparisons
+  return lines
 
 
 def summary_section(comparisons_by_env, baseline_name):
@@ -364,27 +524,33 @@ def summary_section(comparisons_by_env, baseline_name):
   groups = sorted({c.group for env in envs for c in comparisons_by_env[env]})
   lines = [f"## Summary: final return against `{baseline_name}`", "",
            "Each cell: the verdict, the difference of the final returns "
-           "[95% CI] and Welch's p (details in the env's section).", "",
+           "[95% CI] and its Holm-adjusted p (details in the env's "
+           "section).", "",
            "| group | " + " | ".join(envs) + " |",
            "|" + "|".join(["---"] * (len(envs) + 1)) + "|"]
   for group in groups:
     row = [f"`{group}`"]
     for env in envs:
       match = [c for c in comparisons_by_env[env] if c.group == group]
-      row.append(f"{match[0].kind} {match[0].interval()}, p "
-                 f"{number(match[0].p, 3)}" if match else "")
+      row.append(f"{match[0].label()} {match[0].interval()}, Holm p "
+                 f"{number(match[0].p_holm, 3)}" if match else "")
     lines.append("| " + " | ".join(row) + " |")
-  tally = {}
+  tally, flagged = {}, {}
   for env in envs:
     for c in comparisons_by_env[env]:
       tally.setdefault(c.group, []).append(c.kind)
+      if c.cpu_problem():
+        flagged.setdefault(c.group, []).append(env)
   lines.append("")
   for group in groups:
     kinds = tally[group]
     counted = ", ".join(f"{kind} on {kinds.count(kind)}"
-                        for kind in ("better", "worse", "unclear", "unknown")
+                        for kind in ("better", "worse", "unclear",
+                                     "too few seeds", "unknown")
                         if kind in kinds)
-    lines.append(f"- `{group}`: {counted} of {len(kinds)} envs.")
+    machines = (f" CPU models mixed or unrecorded on "
+                f"{', '.join(flagged[group])}." if group in flagged else "")
+    lines.append(f"- `{group}`: {counted} of {len(kinds)} envs.{machines}")
   lines.append("")
   return lines
 
@@ -419,8 +585,10 @@ def main(argv):
     raise ReportError(f"--out={out}: its directory does not exist")
   by_env = {}
   for cell in experiment["cells"]:
-    curve = read_curve(os.path.join(args.exp_dir, cell["dir"]))
-    by_env.setdefault(cell["env"], []).append(RunResult(cell, curve))
+    run_dir = os.path.join(args.exp_dir, cell["dir"])
+    curve = read_curve(run_dir)
+    cpus = read_cpu_models(run_dir) if curve is not None else None
+    by_env.setdefault(cell["env"], []).append(RunResult(cell, curve, cpus))
   for env in thresholds:
     if env not in by_env:
       raise ReportError(f"--threshold: no cell runs {env} (envs: "
@@ -436,11 +604,21 @@ def main(argv):
             f"{len(experiment['cells'])} cells. Final return: the last "
             f"100 episodes' mean at the end of a run. Groups are compared "
             f"with `{baseline_name}` by a 95% percentile bootstrap over "
-            f"seeds and Welch's t-test; \"with confidence\" means the "
-            f"interval excludes 0 and p < 0.05.", ""]
-  groups_total = runs_total = 0
-  sections, comparisons = [], {}
-  for env in sorted(by_env):
+            f"seeds and Welch's t-test; the report's tests are one family, "
+            f"their p-values adjusted by Holm's method; \"with "
+            f"confidence\" means the interval excludes 0 and the adjusted "
+            f"p < 0.05. \"Detectable (80%)\": the difference the test "
+            f"finds with 80% power at the family's strictest level; "
+            f"\"seeds for 10%\": the seeds per group that a difference of "
+            f"10% of the baseline's mean would need there. A group of fewer "
+            f"than {MIN_SEEDS} seeds gets no test. Comparisons of groups "
+            f"run on different CPU models (or unrecorded ones) are "
+            f"flagged.", ""]
+  results = {env: EnvResults(env, by_env[env], baseline_name, args.match)
+             for env in sorted(by_env)}
+  adjust_family([c for r in results.values() for c in r.comparisons.values()])
+  sections = []
+  for env, env_results in results.items():
     figure = problem = None
     if not args.no_figures:
       figure_path = os.path.join(out_dir, "figures", f"{env}.png")
@@ -450,13 +628,13 @@ def main(argv):
         figure = os.path.relpath(figure_path, out_dir)
       elif drawn:
         problem = drawn
-    section, groups, runs, comparisons[env] = env_section(
-        env, by_env[env], baseline_name, thresholds.get(env), figure,
-        problem)
-    sections += section
-    groups_total += groups
-    runs_total += runs
-  lines += summary_section(comparisons, baseline_name) + sections
+    sections += env_section(env_results, thresholds.get(env), figure,
+                            problem)
+  groups_total = sum(len(r.groups) for r in results.values())
+  runs_total = sum(r.runs() for r in results.values())
+  lines += summary_section(
+      {env: list(r.comparisons.values()) for env, r in results.items()},
+      baseline_name) + sections
   with open(out, "w", encoding="utf-8") as f:
     f.write("\n".join(lines))
   print(f"wrote {out}: {len(by_env)} envs, {groups_total} groups, "

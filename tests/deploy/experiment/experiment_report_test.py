@@ -8,8 +8,9 @@ The experiment directory is written by hand (experiment.json, config.json
 and progress.csv of every cell) with returns chosen so that every number of
 the report can be computed here independently: means, sample standard
 deviations and areas by hand, Welch's t-test by integrating Student's t
-density, and the bootstrap interval from the exact bootstrap distribution
-(every resample enumerated).
+density (and its quantiles by bisection on that integral), Holm's
+adjustment by its definition, and the bootstrap interval from the exact
+bootstrap distribution (every resample enumerated).
 """
 
 import itertools
@@ -38,11 +39,22 @@ CURVES = {
                     [60, 120]]),  # the last one is unfinished
     },
     "InvertedPendulum": {
-        "gae": ("gae", [[50, 90, 95], [60, 80, 99]]),
+        "gae": ("gae", [[50, 90, 95], [60, 80, 99], [55, 85, 97]]),
         "min-rho0.4-E1-16-64-2048": ("min", [[100, 200, 300],
-                                             [50, 150, 310]]),
+                                             [50, 150, 310],
+                                             [80, 180, 305]]),
+    },
+    # Two baseline seeds: no test.
+    "Swimmer": {
+        "gae": ("gae", [[10, 20, 30], [12, 22, 32]]),
+        "max-rho0.4-E1-16-64-2048": ("max", [[15, 25, 35], [16, 26, 36],
+                                             [17, 27, 37]]),
     },
 }
+# The CPU model of each cell's machine.json: "CPU A" unless named here;
+# Swimmer's cells have none (runs of a vantage before machine.json).
+CPU_B = ("InvertedPendulum", "min-rho0.4-E1-16-64-2048", 2)
+UNRECORDED = "Swimmer"
 
 
 def take_vantage_flag(argv):
@@ -74,6 +86,10 @@ def write_experiment(root):
         os.makedirs(path)
         with open(os.path.join(path, "config.json"), "w") as f:
           json.dump(config, f)
+        if env != UNRECORDED:
+          cpu = "CPU B" if (env, group, seed) == CPU_B else "CPU A"
+          with open(os.path.join(path, "machine.json"), "w") as f:
+            json.dump({"cpu_models": [cpu]}, f)
         with open(os.path.join(path, "progress.csv"), "w") as f:
           f.write("env_steps,updates,mean_return,elapsed_s,sps\n")
           for i, value in enumerate(curve):
@@ -113,6 +129,53 @@ def welch_p(a, b):
     u = (i + 0.5) * h
     total += density(t / u) * t / (u * u) * h
   return 2 * total
+
+
+def t_tail(t, df, n=20000):
+  """P(T > t) for Student's t with df degrees of freedom, t >= 0."""
+  c = math.gamma((df + 1) / 2) / (math.sqrt(df * math.pi) * math.gamma(df / 2))
+  if t == 0:
+    return 0.5
+  h = 1.0 / n
+  return sum(c * (1 + (t / u) ** 2 / df) ** (-(df + 1) / 2) * t / (u * u) * h
+             for u in ((i + 0.5) * h for i in range(n)))
+
+
+def t_quantile(q, df):
+  """The q-quantile (q >= 0.5) of Student's t, by bisection."""
+  low, high = 0.0, 100.0
+  for _ in range(50):
+    middle = (low + high) / 2
+    if 1 - t_tail(middle, df) < q:
+      low = middle
+    else:
+      high = middle
+  return (low + high) / 2
+
+
+def z_quantile(q):
+  low, high = 0.0, 10.0
+  for _ in range(80):
+    middle = (low + high) / 2
+    if 0.5 * (1 + math.erf(middle / math.sqrt(2))) < q:
+      low = middle
+    else:
+      high = middle
+  return (low + high) / 2
+
+
+def detectable(a, b, tests):
+  """Minimum detectable effect (80% power, Welch, level 0.05 / tests) and
+  seeds per group for 10% of b's mean, as the report defines them."""
+  va, vb = sd(a) ** 2, sd(b) ** 2
+  se2 = va / len(a) + vb / len(b)
+  df = se2 ** 2 / ((va / len(a)) ** 2 / (len(a) - 1) +
+                   (vb / len(b)) ** 2 / (len(b) - 1))
+  level = 0.05 / tests
+  mde = (t_quantile(1 - level / 2, df) + t_quantile(0.8, df)) * math.sqrt(se2)
+  z = z_quantile(1 - level / 2) + z_quantile(0.8)
+  seeds = math.ceil(z * z * (va + vb) / (0.1 * mean(b)) ** 2)
+  return mde, max(seeds, 3)
 
 
 def exact_bootstrap_interval(a, b):
@@ -161,7 +224,7 @@ class ReportTest(unittest.TestCase):
     self.assertEqual(self.result.returncode, 0, self.result.stderr)
     self.assertEqual(
         self.result.stdout.strip().splitlines()[-1],
-        f"wrote {self.exp}/report.md: 2 envs, 4 groups, 10 finished runs")
+        f"wrote {self.exp}/report.md: 3 envs, 6 groups, 17 finished runs")
 
   def test_final_returns_areas_and_the_comparison_by_hand(self):
     section, rows = table_rows(self.report, "Hopper")
@@ -189,10 +252,19 @@ class ReportTest(unittest.TestCase):
     exact_low, exact_high = exact_bootstrap_interval(max_finals, gae_finals)
     self.assertLess(abs(low - exact_low), 4, (low, exact_low))
     self.assertLess(abs(high - exact_high), 4, (high, exact_high))
-    self.assertAlmostEqual(parse_number(biased[4]),
-                           welch_p(max_finals, gae_finals), places=3)
-    match = re.fullmatch(r"(\S+) \[(\S+), (\S+)\]", biased[5])
-    self.assertIsNotNone(match, biased[5])
+    p = welch_p(max_finals, gae_finals)
+    self.assertAlmostEqual(parse_number(biased[4]), p, places=3)
+    # Holm over the report's two tests (Swimmer's has too few seeds):
+    # InvertedPendulum's is far smaller, so this one keeps its p.
+    p_other = welch_p([300, 310, 305], [95, 99, 97])
+    self.assertAlmostEqual(parse_number(biased[5]),
+                           max(2 * p_other, p), places=3)
+    mde, seeds = detectable(max_finals, gae_finals, tests=2)
+    self.assertAlmostEqual(parse_number(biased[6]), mde, places=0)
+    self.assertEqual(parse_number(biased[7]), seeds)
+    self.assertEqual(biased[9], "CPU A")
+    match = re.fullmatch(r"(\S+) \[(\S+), (\S+)\]", biased[8])
+    self.assertIsNotNone(match, biased[8])
     self.assertAlmostEqual(parse_number(match.group(1)),
                            mean(max_areas) - mean(gae_areas), places=1)
     exact_low, exact_high = exact_bootstrap_interval(max_areas, gae_areas)
@@ -201,46 +273,71 @@ class ReportTest(unittest.TestCase):
     # p = 0.055: the interval excludes 0 but the test does not agree.
     self.assertIn("`max-rho0.4-E1-16-64-2048` is not distinguishable from "
                   "`gae`", section)
+    self.assertIn(f"a 10% effect needs {seeds:,} seeds a group", section)
     self.assertIn("Unfinished, not counted: "
                   "Hopper/max-rho0.4-E1-16-64-2048/seed-3.", section)
 
   def test_threshold_and_a_confident_win(self):
     section, rows = table_rows(self.report, "InvertedPendulum")
-    self.assertEqual(rows["gae"][3], "not reached (0/2)")
-    # Reached at 1000 and 2000 steps: the median is 1500.
-    self.assertEqual(rows["min-rho0.4-E1-16-64-2048"][3],
-                     "1,500 (2/2 reached)")
-    p = welch_p([300, 310], [95, 99])
-    self.assertLess(p, 0.05)
-    self.assertAlmostEqual(parse_number(rows["min-rho0.4-E1-16-64-2048"][5]),
-                           p, places=3)
-    # Two runs a side: the exact bootstrap interval is [201, 215].
-    self.assertIn("+208.0 [+201.0, +215.0]",
-                  rows["min-rho0.4-E1-16-64-2048"][4])
+    self.assertEqual(rows["gae"][3], "not reached (0/3)")
+    # Reached at 1000, 2000 and 2000 steps: the median is 2000.
+    minimum = rows["min-rho0.4-E1-16-64-2048"]
+    self.assertEqual(minimum[3], "2,000 (3/3 reached)")
+    finals, base = [300, 310, 305], [95, 99, 97]
+    p = welch_p(finals, base)
+    self.assertLess(2 * p, 0.05)
+    self.assertAlmostEqual(parse_number(minimum[5]), p, places=3)
+    self.assertAlmostEqual(parse_number(minimum[6]), 2 * p, places=3)
+    match = re.fullmatch(r"(\S+) \[(\S+), (\S+)\]", minimum[4])
+    self.assertIsNotNone(match, minimum[4])
+    difference, low, high = map(parse_number, match.groups())
+    self.assertAlmostEqual(difference, mean(finals) - mean(base), places=1)
+    exact_low, exact_high = exact_bootstrap_interval(finals, base)
+    self.assertLess(abs(low - exact_low), 2, (low, exact_low))
+    self.assertLess(abs(high - exact_high), 2, (high, exact_high))
     self.assertIn("`min-rho0.4-E1-16-64-2048` beats `gae` with confidence: "
-                  "+208.0 final return", section)
+                  "+208.0, 95% CI", section)
+    # One of its seeds ran on another CPU: said loudly.
+    self.assertEqual(minimum[10], "CPU A + CPU B ⚠")
+    self.assertIn("⚠ MIXED CPU models (CPU A + CPU B vs CPU A): the "
+                  "difference may be the machines'.", section)
+
+  def test_fewer_than_three_seeds_get_no_test(self):
+    section, rows = table_rows(self.report, "Swimmer")
+    biased = rows["max-rho0.4-E1-16-64-2048"]
+    self.assertEqual(biased[3], "+5.0 [n/a, n/a]")
+    self.assertEqual(biased[4:8], ["n/a", "n/a", "n/a", "n/a"])
+    self.assertEqual(biased[9], "unrecorded ⚠")
+    self.assertIn("`max-rho0.4-E1-16-64-2048` vs `gae`: +5.0; fewer than 3 "
+                  "seeds in a group, so no test (3 vs 2 runs). (CPU models "
+                  "unrecorded.)", section)
 
   def test_a_summary_of_every_comparison_before_the_envs(self):
     summary = self.report.split("## Summary: final return against `gae`\n",
                                 1)[1].split("\n## ", 1)[0]
     self.assertLess(self.report.index("## Summary"),
                     self.report.index("## Hopper"))
-    self.assertIn("| group | Hopper | InvertedPendulum |", summary)
+    self.assertIn("| group | Hopper | InvertedPendulum | Swimmer |", summary)
     p_max = welch_p([130, 150, 170], [100, 110, 120])
-    p_min = welch_p([300, 310], [95, 99])
+    p_min = welch_p([300, 310, 305], [95, 99, 97])
     rows = {line.split(" | ")[0]: line for line in summary.splitlines()
             if line.startswith("| `")}
     max_row = rows["| `max-rho0.4-E1-16-64-2048`"].split(" | ")
     self.assertTrue(max_row[1].startswith("unclear +40.0 ["), max_row)
-    self.assertTrue(max_row[1].endswith(f", p {p_max:.3f}"), max_row)
-    self.assertEqual(max_row[2], " |")  # no such group on InvertedPendulum
-    self.assertEqual(rows["| `min-rho0.4-E1-16-64-2048`"],
-                     f"| `min-rho0.4-E1-16-64-2048` |  | better +208.0 "
-                     f"[+201.0, +215.0], p {p_min:.3f} |")
-    self.assertIn("- `max-rho0.4-E1-16-64-2048`: unclear on 1 of 1 envs.",
-                  summary)
-    self.assertIn("- `min-rho0.4-E1-16-64-2048`: better on 1 of 1 envs.",
-                  summary)
+    self.assertTrue(max_row[1].endswith(f", Holm p {p_max:.3f}"), max_row)
+    self.assertEqual(max_row[2], "")  # no such group on InvertedPendulum
+    self.assertEqual(max_row[3], "too few seeds (CPU models unrecorded) "
+                     "+5.0 [n/a, n/a], Holm p n/a |")
+    min_row = rows["| `min-rho0.4-E1-16-64-2048`"].split(" | ")
+    self.assertTrue(min_row[2].startswith(
+        "better (MIXED CPU models (CPU A + CPU B vs CPU A)) +208.0 ["),
+        min_row)
+    self.assertTrue(min_row[2].endswith(f", Holm p {2 * p_min:.3f}"), min_row)
+    self.assertIn("- `max-rho0.4-E1-16-64-2048`: unclear on 1, too few seeds "
+                  "on 1 of 2 envs. CPU models mixed or unrecorded on "
+                  "Swimmer.", summary)
+    self.assertIn("- `min-rho0.4-E1-16-64-2048`: better on 1 of 1 envs. CPU "
+                  "models mixed or unrecorded on InvertedPendulum.", summary)
 
   def test_figures_beside_the_report(self):
     for env in CURVES:
@@ -313,6 +410,68 @@ class ReportTest(unittest.TestCase):
                               capture_output=True, text=True, timeout=60)
       self.assertEqual(result.returncode, 2, result.stderr)
       self.assertIn(f"{progress} {message}", result.stderr)
+      self.assertEqual(result.stderr.count("\n"), 1, result.stderr)
+
+  def test_a_matched_baseline_shares_the_rho(self):
+    # order:4 and order:2 at two rhos: with --match=rho each order:4 group
+    # is compared with the order:2 group of its own rho.
+    exp = os.path.join(self.root, "matched")
+    shutil.rmtree(exp, ignore_errors=True)
+    finals = {("order:2", "0.2"): [100, 110, 120],
+              ("order:2", "0.8"): [200, 210, 220],
+              ("order:4", "0.2"): [110, 120, 130],
+              ("order:4", "0.8"): [250, 260, 270]}
+    cells = []
+    for (estimator, rho), values in finals.items():
+      group = f"order{estimator[-1]}-rho{rho}"
+      for seed, final in enumerate(values):
+        directory = f"Hopper/{group}/seed-{seed}"
+        config = {"training": {"env": "Hopper", "seed": str(seed),
+                               "steps": "1000"},
+                  "advantage": {"estimator": estimator, "rho": float(rho)}}
+        cells.append({"dir": directory, "env": "Hopper", "group": group,
+                      "seed": str(seed), "config": config,
+                      "flags": {"env": "Hopper", "seed": str(seed),
+                                "estimator": estimator, "rho": rho}})
+        os.makedirs(os.path.join(exp, directory))
+        with open(os.path.join(exp, directory, "config.json"), "w") as f:
+          json.dump(config, f)
+        with open(os.path.join(exp, directory, "progress.csv"), "w") as f:
+          f.write(f"env_steps,updates,mean_return,elapsed_s,sps\n"
+                  f"1000,1,{final},1,1\n")
+    with open(os.path.join(exp, "experiment.json"), "w") as f:
+      json.dump({"name": "matched", "cells": cells}, f)
+    result = subprocess.run([VANTAGE, "experiment", "report", exp,
+                             "--baseline=order:2", "--match=rho",
+                             "--no_figures"],
+                            capture_output=True, text=True, timeout=60)
+    self.assertEqual(result.returncode, 0, result.stderr)
+    with open(os.path.join(exp, "report.md")) as f:
+      _, rows = table_rows(f.read(), "Hopper")
+    self.assertTrue(rows["order4-rho0.2"][3].startswith("+10.0 ["),
+                    rows["order4-rho0.2"])
+    self.assertTrue(rows["order4-rho0.8"][3].startswith("+50.0 ["),
+                    rows["order4-rho0.8"])
+    bad = subprocess.run([VANTAGE, "experiment", "report", exp,
+                          "--match=env"],
+                         capture_output=True, text=True, timeout=60)
+    self.assertEqual(bad.returncode, 2, bad.stderr)
+    self.assertIn("--match=env: only rho and ensemble can be matched",
+                  bad.stderr)
+
+  def test_a_damaged_machine_record_is_named(self):
+    exp = os.path.join(self.root, "damaged_machine")
+    shutil.rmtree(exp, ignore_errors=True)
+    write_experiment(exp)
+    machine = os.path.join(exp, "Hopper", "gae", "seed-1", "machine.json")
+    for text in ("{not json", '{"cpu_models": "CPU A"}'):
+      with open(machine, "w") as f:
+        f.write(text)
+      result = subprocess.run([VANTAGE, "experiment", "report", exp,
+                               "--no_figures"],
+                              capture_output=True, text=True, timeout=60)
+      self.assertEqual(result.returncode, 2, result.stderr)
+      self.assertIn(machine, result.stderr)
       self.assertEqual(result.stderr.count("\n"), 1, result.stderr)
 
 
