@@ -88,6 +88,16 @@ at::Tensor Ex2Bonus::Inputs(const std::vector<Rollout>& rollouts) const {
       actions =
           at::one_hot(actions.reshape({-1}).to(at::kLong), spec_.action_size)
               .to(at::kFloat);
+    } else {
+      // What the environment executes, scaled to [-1, 1]: a policy sample
+      // beyond the bounds (the actor stores it unclipped, for its
+      // log-probability) must not look novel, or widening the policy
+      // becomes the cheapest way to earn the bonus.
+      const at::Tensor low = at::tensor(spec_.action_low, at::kDouble);
+      const at::Tensor high = at::tensor(spec_.action_high, at::kDouble);
+      actions =
+          ((actions.to(at::kDouble) - (low + high) / 2) / ((high - low) / 2))
+              .clamp(-1.0, 1.0);
     }
     rows.push_back(at::cat({states, actions.to(at::kFloat)}, 1));
   }

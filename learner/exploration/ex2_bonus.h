@@ -79,7 +79,8 @@ class Ex2Bonus {
                     const std::string& prefix);
 
   // The model's inputs for the rollouts' steps: [sum T, width], states
-  // with the actions (one-hot if discrete) when use_actions.
+  // with the actions when use_actions (one-hot if discrete; continuous
+  // ones clipped to the bounds and scaled to [-1, 1]).
   at::Tensor Inputs(const std::vector<Rollout>& rollouts) const;
 
  private:
