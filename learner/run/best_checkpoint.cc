@@ -65,10 +65,15 @@ absl::Status BestCheckpoint::Hold(const std::string& checkpoint_path,
   std::error_code error;
   fs::remove(held_path(version), error);
   fs::create_hard_link(checkpoint_path, held_path(version), error);
+  // A file system without hard links gets a copy.
   if (error) {
-    return absl::InternalError(absl::StrCat("cannot link ", checkpoint_path,
-                                            " as ", held_path(version), ": ",
-                                            error.message()));
+    error.clear();
+    fs::copy_file(checkpoint_path, held_path(version), error);
+  }
+  if (error) {
+    return absl::InternalError(
+        absl::StrCat("cannot link or copy ", checkpoint_path, " as ",
+                     held_path(version), ": ", error.message()));
   }
   return absl::OkStatus();
 }

@@ -7,7 +7,8 @@
 // says which ({"version": V, "eval_return": R, ...}). An evaluation comes
 // after its version's checkpoint (in a distributed run, updates later), so
 // that checkpoint is held meanwhile as evaluating-<version>.pt, a hard link
-// that pruning the newest checkpoints does not touch.
+// (a copy where the file system has none) that pruning the newest
+// checkpoints does not touch.
 
 #include <cstdint>
 #include <limits>

@@ -122,7 +122,6 @@ std::vector<PolicyEvaluation> TrainingRun::Evaluations() {
   // The run's last row waits for its final evaluations.
   if (done()) background_->Drain();
   return background_->TakeFinished();
-  return evaluations;
 }
 
 absl::Status TrainingRun::CheckpointNow(const SaveExtras& save) {
