@@ -82,7 +82,9 @@ class PrometheusTest(unittest.TestCase):
          "--metrics=0", "--checkpoint_every=1000", "--run_dir=" + cls.run_dir,
          # EX2 fits from the second update on, for its panels.
          "--exploration=ex2", "--ex2_replay_min=1024",
-         "--ex2_first_train_iterations=50", "--ex2_train_iterations=20"],
+         "--ex2_first_train_iterations=50", "--ex2_train_iterations=20",
+         # Evaluations from the second update on, for theirs.
+         "--eval_every=2", "--eval_episodes=2"],
         stdout=cls.train_log, stderr=subprocess.STDOUT, start_new_session=True)
     cls.listen = f"127.0.0.1:{free_port()}"
     cls.state = os.path.join(cls.tmp, "prometheus")
@@ -97,6 +99,9 @@ class PrometheusTest(unittest.TestCase):
       # Enough scrapes for rate() over a minute, and a few updates.
       wait_for("4 updates scraped", lambda: cls.scalar(
           f'vantage_learner_policy_version{{run="{cls.run_dir}"}}') >= 4, 60)
+      wait_for("an evaluation scraped", lambda: cls.scalar(
+          f'vantage_learner_eval_policy_version{{run="{cls.run_dir}"}}') >= 2,
+               120)
       time.sleep(12)
     except Exception:
       cls.tearDownClass()
