@@ -14,6 +14,8 @@
 #include <string>
 #include <vector>
 
+#include "absl/strings/numbers.h"
+#include "absl/strings/str_cat.h"
 #include "absl/strings/str_split.h"
 #include "deploy/run/local_training.h"
 #include "deploy/run/run_config.h"
@@ -102,6 +104,26 @@ TEST(PythonEnvTrainingTest, PpoLearnsCartPoleDistributed) {
   }
   std::sort(best.begin(), best.end());
   EXPECT_GE(best[1], 450.0);
+}
+
+// A distributed run evaluates a Python environment on the learner's own
+// thread (its interpreter used off the main thread), and its last row
+// holds the final version's evaluation.
+TEST(PythonEnvTrainingTest, ALearnerEvaluatesAPythonEnvBesideTraining) {
+  const std::string run = FreshDirectory("python_evaluated");
+  const Outcome outcome = RunVantage(
+      "train --env=python:cartpole:make --steps=20480 --eval_every=2 "
+      "--eval_episodes=3 --run_dir=" +
+      run);
+  ASSERT_EQ(outcome.exit_code, 0) << outcome.err;
+  const std::vector<std::string> rows = DeterministicProgress(run);
+  ASSERT_EQ(rows.size(), 1u + 5);
+  EXPECT_EQ(ProgressField(rows, 5, "eval_version"), "4");
+  double mean = 0.0;
+  ASSERT_TRUE(absl::SimpleAtod(ProgressField(rows, 5, "eval_return"), &mean));
+  // CartPole's returns are episode lengths: at least 8 steps, at most 500.
+  EXPECT_GE(mean, 8.0);
+  EXPECT_LE(mean, 500.0);
 }
 
 // An environment whose step() now and then never returns: the hung actor's
