@@ -1,11 +1,13 @@
 #include "actor/policy_evaluator.h"
 
+#include <algorithm>
 #include <random>
 #include <utility>
 #include <vector>
 
 #include "absl/strings/str_cat.h"
 #include "actor/envs/env_registry.h"
+#include "common/nn/mlp_policy_kernel.h"
 #include "common/nn/policy_runner.h"
 
 namespace vantage {
@@ -41,6 +43,25 @@ PolicyEvaluator::PolicyEvaluator(std::unique_ptr<Environment> env,
       episodes_(episodes),
       seed_(seed) {}
 
+// The deterministic action through MlpPolicyKernel (BLAS, no per-operator
+// dispatch: an evaluation beside a learner should cost it little), or
+// through LibTorch for a policy the kernel cannot run.
+struct PolicyEvaluator::FastPolicy {
+  MlpPolicyKernel kernel;
+  std::vector<float> outputs;
+  std::vector<float> state;
+
+  void StartEpisode() { std::fill(state.begin(), state.end(), 0.0f); }
+  std::vector<double> Act(const EnvSpec& spec,
+                          const std::vector<double>& observation) {
+    kernel.Forward(observation.data(), 1, outputs.data(),
+                   state.empty() ? nullptr : state.data());
+    if (!spec.discrete) return {outputs.begin(), outputs.end()};
+    return {static_cast<double>(
+        std::max_element(outputs.begin(), outputs.end()) - outputs.begin())};
+  }
+};
+
 PolicyEvaluator::~PolicyEvaluator() = default;
 
 const EnvSpec& PolicyEvaluator::spec() const { return env_->spec(); }
@@ -49,6 +70,16 @@ absl::StatusOr<PolicyEvaluation> PolicyEvaluator::Evaluate(
     const PolicyWeights& weights) {
   if (absl::Status status = runner_->Load(weights); !status.ok()) {
     return status;
+  }
+  fast_.reset();
+  absl::StatusOr<MlpPolicyKernel> kernel =
+      MlpPolicyKernel::Create(spec(), runner_->policy(), runner_->normalizer(),
+                              runner_->observation_clip());
+  if (kernel.ok()) {
+    fast_ =
+        std::make_unique<FastPolicy>(FastPolicy{*std::move(kernel), {}, {}});
+    fast_->outputs.resize(fast_->kernel.output_size());
+    fast_->state.resize(fast_->kernel.state_size());
   }
   PolicyEvaluation evaluation;
   evaluation.version = weights.version;
@@ -74,9 +105,11 @@ absl::Status PolicyEvaluator::PlayEpisode(uint64_t seed, double& total,
     return status;
   }
   runner_->StartEpisode();
+  if (fast_ != nullptr) fast_->StartEpisode();
   while (length < kMaxEpisodeSteps) {
     const std::vector<double> action =
-        runner_->Act(observation, /*deterministic=*/true);
+        fast_ != nullptr ? fast_->Act(env_->spec(), observation)
+                         : runner_->Act(observation, /*deterministic=*/true);
     absl::StatusOr<StepResult> step =
         env_->Step(action, absl::MakeSpan(observation));
     if (!step.ok()) return step.status();

@@ -44,8 +44,11 @@ class PolicyEvaluator {
                   uint64_t seed);
   absl::Status PlayEpisode(uint64_t seed, double& total, int64_t& length);
 
+  struct FastPolicy;
+
   std::unique_ptr<Environment> env_;
   std::unique_ptr<PolicyRunner> runner_;
+  std::unique_ptr<FastPolicy> fast_;
   const int episodes_;
   const uint64_t seed_;
 };

@@ -268,9 +268,12 @@ std::optional<Measured> TimeRun(const TrainBenchRun& run) {
     return std::nullopt;
   }
   Measured measured;
-  // Start-up (process launch, the first batch's acting) is not throughput.
+  // Start-up (process launch, the first batch's acting) is not throughput,
+  // nor is the end: with --eval_every the last row waits for the final
+  // version's evaluation, a one-off cost. Every run is measured alike,
+  // from the second row to the one before the last.
   const ProgressPoint& first = points[1];
-  const ProgressPoint& last = points.back();
+  const ProgressPoint& last = points[points.size() - 2];
   measured.sps =
       (last.env_steps - first.env_steps) / (last.elapsed - first.elapsed);
   measured.learner = ReadTimeSplit(log, /*learner=*/true);

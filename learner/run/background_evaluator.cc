@@ -1,5 +1,6 @@
 #include "learner/run/background_evaluator.h"
 
+#include <sched.h>
 #include <sys/resource.h>
 #include <sys/syscall.h>
 #include <unistd.h>
@@ -60,8 +61,13 @@ int64_t BackgroundEvaluator::skipped() const {
 }
 
 void BackgroundEvaluator::Loop() {
-  // Linux gives each thread its own nice value.
-  setpriority(PRIO_PROCESS, static_cast<id_t>(syscall(SYS_gettid)), 19);
+  // Linux schedules each thread on its own: SCHED_IDLE runs it only when
+  // nothing else wants the core (below even nice 19, which it falls back
+  // to where the policy is refused).
+  sched_param idle{};
+  if (sched_setscheduler(0, SCHED_IDLE, &idle) != 0) {
+    setpriority(PRIO_PROCESS, static_cast<id_t>(syscall(SYS_gettid)), 19);
+  }
   while (true) {
     PolicyWeights weights;
     {
