@@ -15,6 +15,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/types/span.h"
+#include "common/nn/distributions.h"
 #include "common/util/state_bytes.h"
 
 namespace vantage {
@@ -48,6 +49,13 @@ void StoreObservations(absl::Span<const double> values, at::Tensor row) {
       out[i] = static_cast<float>(values[i]);
     }
   }
+}
+
+// Masks of one byte per action, [rows, actions], as a bool tensor view.
+at::Tensor MaskTensor(const std::vector<uint8_t>& masks, int64_t rows) {
+  return at::from_blob(const_cast<uint8_t*>(masks.data()),
+                       {rows, static_cast<int64_t>(masks.size()) / rows},
+                       at::kBool);
 }
 
 // A recurrent policy's `count` state floats (none for a feed-forward one,
@@ -121,6 +129,10 @@ void ActorCore::Act(const at::Tensor& observations_row, float* actions,
     kernel_outputs_.resize(m * kernel_->output_size());
     kernel_->Forward(envs_->observations().data(), m, kernel_outputs_.data(),
                      core_states_.data());
+    if (!envs_->action_masks().empty()) {
+      MaskLogitsInPlace(kernel_outputs_.data(), envs_->action_masks().data(), m,
+                        kernel_->output_size());
+    }
     kernel_->Act(kernel_outputs_.data(), m, generator_, actions, log_probs);
   } else {
     const at::Tensor inputs = ObservationsForNetwork(
@@ -136,6 +148,9 @@ void ActorCore::Act(const at::Tensor& observations_row, float* actions,
                   core_states_.data());
     } else {
       output = policy_->forward(inputs);
+    }
+    if (!envs_->action_masks().empty()) {
+      output = MaskLogits(output, MaskTensor(envs_->action_masks(), m));
     }
     const at::Tensor action = policy_->Act(output, false, generator_);
     const at::Tensor log_prob = policy_->LogProb(output, action);
@@ -179,6 +194,8 @@ struct ActorCore::Rollout {
   std::vector<std::vector<at::Tensor>> finals;
   // A recurrent policy's state before step 0 [m, state size].
   at::Tensor core_states;
+  // Masked actions: each step's legal actions [steps, m, actions].
+  at::Tensor action_masks;
   std::vector<Segment> segments;
 };
 
@@ -201,6 +218,10 @@ absl::Status ActorCore::CollectSegments(SegmentSink& sink) {
             {rollout.m, static_cast<int64_t>(core_states_.size()) / rollout.m})
             .clone();
   }
+  if (spec().action_masks) {
+    rollout.action_masks =
+        at::empty({rollout.steps, rollout.m, spec().action_size}, at::kBool);
+  }
   for (int64_t t = 0; t < rollout.steps; ++t) {
     if (absl::Status status = CollectStep(t, rollout); !status.ok()) {
       return status;
@@ -213,6 +234,11 @@ absl::Status ActorCore::CollectSegments(SegmentSink& sink) {
 absl::Status ActorCore::CollectStep(int64_t t, Rollout& rollout) {
   const int64_t m = rollout.m;
   const auto inference_start = std::chrono::steady_clock::now();
+  if (rollout.action_masks.defined()) {
+    const std::vector<uint8_t>& masks = envs_->action_masks();
+    std::memcpy(rollout.action_masks[t].data_ptr<bool>(), masks.data(),
+                masks.size());
+  }
   Act(rollout.observations[t],
       rollout.actions.data_ptr<float>() + t * m * rollout.act,
       rollout.log_probs.data_ptr<float>() + t * m);
@@ -279,6 +305,9 @@ absl::Status ActorCore::SendSegments(Rollout& rollout, SegmentSink& sink) {
             : at::stack(rollout.finals[i]);
     if (rollout.core_states.defined()) {
       segment.core_state = rollout.core_states[i].clone();
+    }
+    if (rollout.action_masks.defined()) {
+      segment.action_masks = rollout.action_masks.select(1, i).clone();
     }
     if (absl::Status status = sink.Send(std::move(segment)); !status.ok()) {
       return status;

@@ -7,6 +7,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "actor/envs/env_registry.h"
+#include "common/nn/distributions.h"
 #include "common/nn/mlp_policy_kernel.h"
 #include "common/nn/policy_runner.h"
 
@@ -53,10 +54,14 @@ struct PolicyEvaluator::FastPolicy {
 
   void StartEpisode() { std::fill(state.begin(), state.end(), 0.0f); }
   std::vector<double> Act(const EnvSpec& spec,
-                          const std::vector<double>& observation) {
+                          const std::vector<double>& observation,
+                          const std::vector<uint8_t>& mask) {
     kernel.Forward(observation.data(), 1, outputs.data(),
                    state.empty() ? nullptr : state.data());
     if (!spec.discrete) return {outputs.begin(), outputs.end()};
+    if (!mask.empty()) {
+      MaskLogitsInPlace(outputs.data(), mask.data(), 1, spec.action_size);
+    }
     return {static_cast<double>(
         std::max_element(outputs.begin(), outputs.end()) - outputs.begin())};
   }
@@ -107,9 +112,12 @@ absl::Status PolicyEvaluator::PlayEpisode(uint64_t seed, double& total,
   runner_->StartEpisode();
   if (fast_ != nullptr) fast_->StartEpisode();
   while (length < kMaxEpisodeSteps) {
+    absl::StatusOr<std::vector<uint8_t>> mask = ReadActionMask(*env_);
+    if (!mask.ok()) return mask.status();
     const std::vector<double> action =
-        fast_ != nullptr ? fast_->Act(env_->spec(), observation)
-                         : runner_->Act(observation, /*deterministic=*/true);
+        fast_ != nullptr
+            ? fast_->Act(env_->spec(), observation, *mask)
+            : runner_->Act(observation, /*deterministic=*/true, *mask);
     absl::StatusOr<StepResult> step =
         env_->Step(action, absl::MakeSpan(observation));
     if (!step.ok()) return step.status();

@@ -66,14 +66,45 @@ VectorEnv::VectorEnv(std::vector<std::unique_ptr<Environment>> envs,
   truncated_.resize(m);
   episode_returns_.resize(m);
   episode_lengths_.resize(m);
+  if (s.action_masks) action_masks_.resize(m * s.action_size);
 }
 
 absl::Status VectorEnv::ResetOne(int index) {
   episode_returns_[index] = 0.0;
   episode_lengths_[index] = 0;
-  return envs_[index]->Reset(
-      seeds_(), absl::MakeSpan(observations_)
-                    .subspan(index * observation_size_, observation_size_));
+  if (absl::Status status = envs_[index]->Reset(
+          seeds_(), absl::MakeSpan(observations_)
+                        .subspan(index * observation_size_, observation_size_));
+      !status.ok()) {
+    return status;
+  }
+  return ReadMask(index);
+}
+
+absl::Status VectorEnv::ReadMask(int index) {
+  if (action_masks_.empty()) return absl::OkStatus();
+  const int64_t n = spec().action_size;
+  absl::Span<uint8_t> mask =
+      absl::MakeSpan(action_masks_).subspan(index * n, n);
+  absl::Status status = envs_[index]->ActionMask(mask);
+  if (status.ok()) status = CheckActionMask(spec(), mask);
+  // An env without a usable mask has no action to take until it resets.
+  if (!status.ok()) std::fill(mask.begin(), mask.end(), 0);
+  return status;
+}
+
+absl::Status VectorEnv::CheckLegal(int index, double action) const {
+  if (action_masks_.empty() || !(action >= 0) ||
+      action >= static_cast<double>(spec().action_size)) {
+    return absl::OkStatus();  // the env's own CheckAction names a bad index
+  }
+  const int64_t n = spec().action_size;
+  if (action_masks_[index * n + static_cast<int64_t>(action)]) {
+    return absl::OkStatus();
+  }
+  return absl::InvalidArgumentError(
+      absl::StrCat(spec().name, ": action ", action,
+                   " is illegal in this state (its action mask is 0)"));
 }
 
 absl::Status VectorEnv::Reset() {
@@ -82,6 +113,19 @@ absl::Status VectorEnv::Reset() {
     if (absl::Status status = ResetOne(i); !status.ok()) return status;
   }
   return absl::OkStatus();
+}
+
+absl::StatusOr<StepResult> VectorEnv::StepOne(int index,
+                                              absl::Span<const double> action,
+                                              absl::Span<double> observation) {
+  if (absl::Status legal = CheckLegal(index, action[0]); !legal.ok()) {
+    return legal;
+  }
+  absl::StatusOr<StepResult> result = envs_[index]->Step(action, observation);
+  if (!result.ok() || result->terminated || result->truncated) return result;
+  // An episode that ended has no mask until its reset reads one.
+  if (absl::Status status = ReadMask(index); !status.ok()) return status;
+  return result;
 }
 
 absl::Status VectorEnv::Step(absl::Span<const double> actions) {
@@ -96,8 +140,9 @@ absl::Status VectorEnv::Step(absl::Span<const double> actions) {
     absl::Span<double> observation =
         absl::MakeSpan(observations_)
             .subspan(i * observation_size_, observation_size_);
-    absl::StatusOr<StepResult> result = envs_[i]->Step(
-        actions.subspan(i * action_width_, action_width_), observation);
+    const absl::Span<const double> action =
+        actions.subspan(i * action_width_, action_width_);
+    absl::StatusOr<StepResult> result = StepOne(i, action, observation);
     if (!result.ok()) {
       // Nothing stale may pass for this step's outcome.
       rewards_[i] = 0.0;
@@ -296,7 +341,13 @@ absl::Status VectorEnv::ApplyState(SavedState& saved) {
   episode_lengths_ = std::move(saved.lengths);
   finished_ = std::move(saved.finished);
   for (size_t i = 0; i < envs_.size(); ++i) {
-    if (!saved.env_states[i].empty()) continue;
+    if (!saved.env_states[i].empty()) {
+      // A mask is the restored state's, which the environment knows again.
+      if (absl::Status status = ReadMask(static_cast<int>(i)); !status.ok()) {
+        return status;
+      }
+      continue;
+    }
     SayOnce(absl::StrCat(spec().name,
                          " saved no state: its episodes restart on resume"));
     if (absl::Status status = ResetOne(static_cast<int>(i)); !status.ok()) {

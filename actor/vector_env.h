@@ -55,6 +55,10 @@ class VectorEnv {
   absl::Span<const double> rewards() const { return rewards_; }
   const std::vector<uint8_t>& terminated() const { return terminated_; }
   const std::vector<uint8_t>& truncated() const { return truncated_; }
+  // Masked discrete actions (EnvSpec::action_masks): [size, actions], 1
+  // where an action is legal in each env's current state; empty otherwise.
+  // Step refuses an illegal action.
+  const std::vector<uint8_t>& action_masks() const { return action_masks_; }
   // Episodes that ended during the last Step.
   const std::vector<FinishedEpisode>& finished() const { return finished_; }
 
@@ -81,6 +85,13 @@ class VectorEnv {
       const std::vector<absl::string_view>& env_states);
   VectorEnv(std::vector<std::unique_ptr<Environment>> envs, uint64_t seed);
   absl::Status ResetOne(int index);
+  // Env `index` one step, refusing an illegal action, and its next mask.
+  absl::StatusOr<StepResult> StepOne(int index, absl::Span<const double> action,
+                                     absl::Span<double> observation);
+  // Env `index`'s mask for its current state, checked (masked actions only).
+  absl::Status ReadMask(int index);
+  // Env `index`'s action is legal in its current state (or none are masked).
+  absl::Status CheckLegal(int index, double action) const;
 
   std::vector<std::unique_ptr<Environment>> envs_;
   std::mt19937_64 seeds_;
@@ -91,6 +102,7 @@ class VectorEnv {
   std::vector<double> rewards_;
   std::vector<uint8_t> terminated_;
   std::vector<uint8_t> truncated_;
+  std::vector<uint8_t> action_masks_;
   std::vector<double> episode_returns_;
   std::vector<int64_t> episode_lengths_;
   std::vector<FinishedEpisode> finished_;

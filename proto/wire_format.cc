@@ -230,6 +230,9 @@ void SegmentToProto(const Segment& segment, pb::Segment* proto) {
   if (segment.core_state.defined()) {
     TensorToProto(segment.core_state, proto->mutable_core_state());
   }
+  if (segment.action_masks.defined()) {
+    TensorToProto(segment.action_masks, proto->mutable_action_masks());
+  }
   proto->mutable_episode_returns()->Add(segment.episode_returns.begin(),
                                         segment.episode_returns.end());
   proto->mutable_episode_lengths()->Add(segment.episode_lengths.begin(),
@@ -284,6 +287,13 @@ absl::StatusOr<Segment> SegmentFromProto(const pb::Segment& proto,
     if (!state.ok()) return state.status();
     segment.core_state = *std::move(state);
   }
+  // Optional: only masked discrete actions' segments carry them.
+  if (proto.has_action_masks()) {
+    absl::StatusOr<at::Tensor> masks = DecodeField(
+        true, proto.action_masks(), "segment.action_masks", kBool, max_bytes);
+    if (!masks.ok()) return masks.status();
+    segment.action_masks = *std::move(masks);
+  }
   segment.episode_returns.assign(proto.episode_returns().begin(),
                                  proto.episode_returns().end());
   segment.episode_lengths.assign(proto.episode_lengths().begin(),
@@ -297,11 +307,13 @@ int64_t MaxSegmentMessageBytes(const EnvSpec& spec, int64_t max_steps,
   const int64_t act = spec.discrete ? 1 : spec.action_size;
   // observations [T+1, obs] and at most T final observations, float32 or
   // uint8; actions [T, act], rewards and log-probs [T] float32; two bool
-  // [T]; at most T episodes of a double and a varint (<= 10 bytes) each.
+  // [T] and masked actions' bool [T, actions]; at most T episodes of a double
+  // and a varint (<= 10 bytes) each.
   const int64_t observation_bytes = spec.byte_observations() ? 1 : 4;
   const int64_t payload =
       observation_bytes * spec.observation_size * (2 * t + 1) + 4 * act * t +
-      8 * t + 2 * t + 18 * t + 4 * core_state_size;
+      8 * t + 2 * t + 18 * t + 4 * core_state_size +
+      (spec.action_masks ? spec.action_size * t : 0);
   // Tags, lengths, shapes and the four integers, generously.
   constexpr int64_t kFraming = 4096;
   return payload + kFraming;
@@ -367,6 +379,7 @@ void EnvSpecToProto(const EnvSpec& spec, pb::EnvSpec* proto) {
   proto->mutable_observation_shape()->Add(spec.observation_shape.begin(),
                                           spec.observation_shape.end());
   proto->set_observation_high(spec.observation_high);
+  proto->set_action_masks(spec.action_masks);
 }
 
 absl::StatusOr<EnvSpec> EnvSpecFromProto(const pb::EnvSpec& proto,
@@ -410,6 +423,7 @@ absl::StatusOr<EnvSpec> EnvSpecFromProto(const pb::EnvSpec& proto,
   spec.observation_shape.assign(proto.observation_shape().begin(),
                                 proto.observation_shape().end());
   spec.observation_high = proto.observation_high();
+  spec.action_masks = proto.action_masks();
 
   if (spec.name.empty()) return Invalid("spec.name", "empty");
   if (spec.observation_size < 1) {
@@ -422,6 +436,10 @@ absl::StatusOr<EnvSpec> EnvSpecFromProto(const pb::EnvSpec& proto,
   if (spec.action_size < 1) {
     return Invalid("spec.action_size",
                    absl::StrCat(spec.action_size, ", expected >= 1"));
+  }
+  if (spec.action_masks && !spec.discrete) {
+    return Invalid("spec.action_masks",
+                   "true for continuous actions, which take no masks");
   }
   // A continuous action space has one [low, high] per dimension; a discrete
   // one has none, and bounds there would mean the sender got the kind wrong.
@@ -484,6 +502,10 @@ absl::Status CheckSameSpec(const EnvSpec& expected, const EnvSpec& got) {
   if (expected.action_size != got.action_size) {
     return Differs("action_size", absl::StrCat(expected.action_size),
                    absl::StrCat(got.action_size));
+  }
+  if (expected.action_masks != got.action_masks) {
+    return Differs("action_masks", expected.action_masks ? "true" : "false",
+                   got.action_masks ? "true" : "false");
   }
   if (absl::Status status =
           SameBounds("action_low", expected.action_low, got.action_low);

@@ -11,6 +11,7 @@
 #include "actor/envs/bullet/biped_walk.h"
 #include "actor/envs/bullet/bullet_hopper.h"
 #include "actor/envs/bullet/terrain_biped.h"
+#include "actor/envs/choice/lit_buttons.h"
 #include "actor/envs/maze/first_person_maze.h"
 #include "actor/envs/memory/cue_recall.h"
 #include "actor/envs/minatar/minatar_env.h"
@@ -53,6 +54,7 @@ const std::map<std::string, Factory>& Factories() {
         {"Humanoid", Plain(MakeHumanoid)},
         {"InvertedDoublePendulum", Plain(MakeInvertedDoublePendulum)},
         {"InvertedPendulum", MakeInvertedPendulum},
+        {"LitButtons", MakeLitButtons},
         {"MinAtarAsterix", Plain(MakeMinAtarAsterix)},
         {"MinAtarBreakout", Plain(MakeMinAtarBreakout)},
         {"MinAtarFreeway", Plain(MakeMinAtarFreeway)},
@@ -111,6 +113,7 @@ absl::StatusOr<std::unique_ptr<Environment>> MakeEnvironment(
 std::vector<EnvOptionInfo> EnvironmentOptions(const std::string& name) {
   if (name == "CueRecall") return CueRecallOptions();
   if (name == "InvertedPendulum") return InvertedPendulumOptions();
+  if (name == "LitButtons") return LitButtonsOptions();
   return GymTaskOptions(name);
 }
 

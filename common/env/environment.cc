@@ -8,7 +8,8 @@
 namespace vantage {
 
 std::string EnvSpec::ActionString() const {
-  return absl::StrCat(discrete ? "discrete:" : "continuous:", action_size);
+  return absl::StrCat(discrete ? "discrete:" : "continuous:", action_size,
+                      action_masks ? " masked" : "");
 }
 
 std::string EnvSpec::ObservationString() const {
@@ -25,6 +26,11 @@ absl::StatusOr<std::string> Environment::SaveState() const {
 absl::Status Environment::RestoreState(absl::string_view) {
   return absl::UnimplementedError(absl::StrCat(
       spec().name, ": this environment cannot restore a saved state"));
+}
+
+absl::Status Environment::ActionMask(absl::Span<uint8_t>) const {
+  return absl::UnimplementedError(
+      absl::StrCat(spec().name, ": this environment has no action masks"));
 }
 
 absl::StatusOr<Frame> Environment::Render(int, int) {
@@ -52,6 +58,48 @@ absl::Status CheckAction(const EnvSpec& spec, absl::Span<const double> action) {
                      " is not an integer in [0, ", spec.action_size, ")"));
   }
   return absl::OkStatus();
+}
+
+absl::Status CheckActionMask(const EnvSpec& spec,
+                             absl::Span<const uint8_t> mask) {
+  if (!spec.action_masks || !spec.discrete) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        spec.name, ": an action mask for ", spec.ActionString(),
+        " actions, which take none (only masked discrete actions do)"));
+  }
+  if (mask.size() != static_cast<size_t>(spec.action_size)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(spec.name, ": the action mask has ", mask.size(),
+                     " entries, expected ", spec.action_size));
+  }
+  bool any_legal = false;
+  for (size_t i = 0; i < mask.size(); ++i) {
+    if (mask[i] > 1) {
+      return absl::InvalidArgumentError(
+          absl::StrCat(spec.name, ": action mask entry ", i, " is ",
+                       static_cast<int>(mask[i]), ", expected 0 or 1"));
+    }
+    any_legal = any_legal || mask[i] == 1;
+  }
+  if (!any_legal) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        spec.name, ": the action mask is all zero (no legal action)"));
+  }
+  return absl::OkStatus();
+}
+
+absl::StatusOr<std::vector<uint8_t>> ReadActionMask(const Environment& env) {
+  const EnvSpec& spec = env.spec();
+  if (!spec.action_masks) return std::vector<uint8_t>();
+  std::vector<uint8_t> mask(spec.action_size);
+  if (absl::Status status = env.ActionMask(absl::MakeSpan(mask));
+      !status.ok()) {
+    return status;
+  }
+  if (absl::Status status = CheckActionMask(spec, mask); !status.ok()) {
+    return status;
+  }
+  return mask;
 }
 
 absl::Status CheckStep(const EnvSpec& spec, bool needs_reset,

@@ -34,12 +34,16 @@ struct EnvSpec {
   int64_t action_size = 0;
   std::vector<double> action_low;
   std::vector<double> action_high;
+  // Discrete only: at every step the environment says which actions are
+  // legal (Environment::ActionMask); actors sample only those and the
+  // learner scores the policy on them alone.
+  bool action_masks = false;
   // Steps after which the time limit truncates an episode (0: none).
   int64_t max_episode_steps = 1000;
   // Simulated seconds per step (physics timestep x frame skip).
   double control_dt = 0.0;
 
-  // "continuous:6" or "discrete:4".
+  // "continuous:6", "discrete:4" or "discrete:4 masked".
   std::string ActionString() const;
   bool byte_observations() const { return observation_high > 0; }
   // "17" or "uint8 4x10x10".
@@ -85,6 +89,13 @@ class Environment {
   // InvalidArgument and leaves this environment as it was.
   virtual absl::Status RestoreState(absl::string_view state);
 
+  // Which actions are legal in the current state (after Reset, Step or
+  // RestoreState): mask[i] = 1 for a legal action i, 0 for an illegal
+  // one, spec().action_size entries of which at least one is 1. Only
+  // environments whose spec says action_masks have one; the default says
+  // it has none.
+  virtual absl::Status ActionMask(absl::Span<uint8_t> mask) const;
+
   // A picture of the current state, `width` x `height` pixels (both >= 1),
   // for videos of episodes. It only reads the simulation: rendering or not
   // changes nothing the environment later produces. The default says the
@@ -95,6 +106,16 @@ class Environment {
 // Checks an action's size and finiteness against the spec (and, if
 // discrete, that it is an integer in range); the message names the entry.
 absl::Status CheckAction(const EnvSpec& spec, absl::Span<const double> action);
+
+// A mask as Environment::ActionMask must write it: action_size entries,
+// each 0 or 1, at least one 1, for a spec with action_masks. The message
+// names what is wrong.
+absl::Status CheckActionMask(const EnvSpec& spec,
+                             absl::Span<const uint8_t> mask);
+
+// `env`'s mask for its current state, checked (CheckActionMask); empty
+// when its spec has no action masks.
+absl::StatusOr<std::vector<uint8_t>> ReadActionMask(const Environment& env);
 
 // The observation fields agree: observation_shape is empty or three
 // positive dimensions whose product is observation_size, and

@@ -31,6 +31,9 @@ class EnvironmentWrapper : public Environment {
   absl::Status RestoreState(absl::string_view state) override {
     return inner_->RestoreState(state);
   }
+  absl::Status ActionMask(absl::Span<uint8_t> mask) const override {
+    return inner_->ActionMask(mask);
+  }
   absl::StatusOr<Frame> Render(int width, int height) override {
     return inner_->Render(width, height);
   }

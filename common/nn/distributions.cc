@@ -50,4 +50,16 @@ at::Tensor CategoricalKl(const at::Tensor& old_logits,
   return (at::exp(old_log_p) * (old_log_p - new_log_p)).sum(-1);
 }
 
+at::Tensor MaskLogits(const at::Tensor& logits, const at::Tensor& masks) {
+  if (!masks.defined()) return logits;
+  return logits.masked_fill(masks.logical_not(), kIllegalLogit);
+}
+
+void MaskLogitsInPlace(float* logits, const uint8_t* masks, int64_t rows,
+                       int64_t n) {
+  for (int64_t i = 0, size = rows * n; i < size; ++i) {
+    if (!masks[i]) logits[i] = kIllegalLogit;
+  }
+}
+
 }  // namespace vantage

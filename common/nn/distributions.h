@@ -6,6 +6,8 @@
 
 #include <ATen/core/Tensor.h>
 
+#include <cstdint>
+
 namespace vantage {
 
 // log(sqrt(2 pi)), the Gaussian's normalising term per dimension.
@@ -31,6 +33,22 @@ at::Tensor CategoricalEntropy(const at::Tensor& logits);
 // KL(old || new).
 at::Tensor CategoricalKl(const at::Tensor& old_logits,
                          const at::Tensor& new_logits);
+
+// Action masks: an illegal action's logit becomes kIllegalLogit, so that
+// its probability is exactly 0 in float while every log-probability,
+// entropy term (0 * finite) and KL term stays finite, which -inf would not
+// give. The same value everywhere a policy acts or is scored.
+constexpr float kIllegalLogit = -1e9f;
+
+// `logits` [B, n] with the illegal entries of `masks` ([B, n] bool, 1:
+// legal) replaced; `logits` itself when `masks` is undefined (no masks).
+// The replaced entries pass no gradient.
+at::Tensor MaskLogits(const at::Tensor& logits, const at::Tensor& masks);
+
+// The same in place on `rows` rows of n floats, from masks of one byte per
+// entry.
+void MaskLogitsInPlace(float* logits, const uint8_t* masks, int64_t rows,
+                       int64_t n);
 
 }  // namespace vantage
 

@@ -4,6 +4,8 @@
 #include <ATen/CPUGeneratorImpl.h>
 #include <ATen/core/grad_mode.h>
 
+#include "common/nn/distributions.h"
+
 namespace vantage {
 
 PolicyRunner::PolicyRunner(const EnvSpec& spec, const NetworkConfig& network,
@@ -34,13 +36,18 @@ void PolicyRunner::StartEpisode() {
 }
 
 std::vector<double> PolicyRunner::Act(absl::Span<const double> observation,
-                                      bool deterministic) {
+                                      bool deterministic,
+                                      absl::Span<const uint8_t> mask) {
   at::NoGradGuard no_grad;
   const at::Tensor x = ObservationsForNetwork(
       spec_, normalizer_, ObservationTensor(spec_, observation.data(), 1),
       observation_clip_);
-  const at::Tensor output =
+  at::Tensor output =
       policy_->recurrent() ? policy_->Step(x, state_) : policy_->forward(x);
+  if (!mask.empty()) {
+    MaskLogitsInPlace(output.data_ptr<float>(), mask.data(), 1,
+                      static_cast<int64_t>(mask.size()));
+  }
   const at::Tensor action = policy_->Act(output, deterministic, generator_)
                                 .to(at::kDouble)
                                 .contiguous();

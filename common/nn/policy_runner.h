@@ -36,9 +36,11 @@ class PolicyRunner {
   // starts); nothing for a feed-forward one.
   void StartEpisode();
   // The action for one observation: the mean (continuous) or the most
-  // likely action (discrete) when `deterministic`, else a sample.
+  // likely action (discrete) when `deterministic`, else a sample; among
+  // the legal ones of `mask` (ReadActionMask's; empty: no masks).
   std::vector<double> Act(absl::Span<const double> observation,
-                          bool deterministic);
+                          bool deterministic,
+                          absl::Span<const uint8_t> mask = {});
 
   const EnvSpec& spec() const { return spec_; }
   PolicyNetworkImpl& policy() const { return *policy_.ptr(); }

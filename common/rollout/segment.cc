@@ -175,6 +175,42 @@ absl::Status CheckCoreState(const Segment& segment, int64_t size,
                 limits.max_abs_observation);
 }
 
+// Masked discrete actions' masks: one row per step, each with a legal
+// action, the one taken among them; none for any other run.
+absl::Status CheckActionMasks(const Segment& segment, const EnvSpec& spec) {
+  if (!spec.action_masks) {
+    if (!segment.action_masks.defined()) return absl::OkStatus();
+    return absl::InvalidArgumentError(absl::StrCat(
+        "segment field action_masks is set, but this run's actions (",
+        spec.ActionString(), ") take no masks"));
+  }
+  const int64_t steps = segment.steps();
+  if (absl::Status status = Expect(segment.action_masks, "action_masks",
+                                   {steps, spec.action_size}, at::kBool);
+      !status.ok()) {
+    return status;
+  }
+  const at::Tensor masks = segment.action_masks.contiguous();
+  const at::Tensor actions = segment.actions.contiguous();
+  const bool* mask = masks.data_ptr<bool>();
+  const float* action = actions.data_ptr<float>();
+  for (int64_t t = 0; t < steps; ++t, mask += spec.action_size) {
+    if (std::none_of(mask, mask + spec.action_size,
+                     [](bool legal) { return legal; })) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("segment field action_masks is all zero at step ", t,
+                       " (no legal action)"));
+    }
+    const int64_t taken = static_cast<int64_t>(action[t]);
+    if (!mask[taken]) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("segment field actions holds ", taken, " at step ", t,
+                       ", which that step's action mask makes illegal"));
+    }
+  }
+  return absl::OkStatus();
+}
+
 }  // namespace
 
 absl::Status ValidateSegment(const Segment& segment, const EnvSpec& spec,
@@ -226,6 +262,9 @@ absl::Status ValidateSegment(const Segment& segment, const EnvSpec& spec,
           "in [0, ",
           spec.action_size, ")"));
     }
+  }
+  if (absl::Status status = CheckActionMasks(segment, spec); !status.ok()) {
+    return status;
   }
   if (AnyBoth(segment.terminated, segment.truncated)) {
     return absl::InvalidArgumentError(

@@ -38,6 +38,9 @@ struct Segment {
   // A recurrent policy's state before step 0 [state size] (zero if an
   // episode starts there); undefined for a feed-forward policy.
   at::Tensor core_state;
+  // [T, actions] bool: the legal actions at each step, for masked discrete
+  // actions (EnvSpec::action_masks); undefined otherwise.
+  at::Tensor action_masks;
 
   // Episodes that ended inside this segment.
   std::vector<double> episode_returns;
@@ -60,7 +63,8 @@ struct Segment {
 // begun in an earlier segment) nor than spec.max_episode_steps, each return
 // within max_abs_reward * length, and a core_state of exactly
 // `core_state_size` finite floats within max_abs_observation (none when 0;
-// with one, exactly max_steps steps).
+// with one, exactly max_steps steps), and for masked actions a mask
+// [T, actions] whose every row has a legal action, the one taken.
 // The message names the field.
 absl::Status ValidateSegment(const Segment& segment, const EnvSpec& spec,
                              int64_t max_steps, const ValueLimits& limits = {},

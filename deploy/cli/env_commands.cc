@@ -206,12 +206,19 @@ class RolloutActions {
     if (trained_.has_value()) trained_->StartEpisode();
   }
 
-  const std::vector<double>& Act(const std::vector<double>& observation) {
+  // `mask`: the legal actions (ReadActionMask's; empty: all are).
+  const std::vector<double>& Act(const std::vector<double>& observation,
+                                 const std::vector<uint8_t>& mask) {
     if (trained_.has_value()) {
-      action_ = trained_->Act(observation, deterministic_);
+      action_ = trained_->Act(observation, deterministic_, mask);
     } else if (spec_.discrete) {
-      action_[0] = static_cast<double>(std::uniform_int_distribution<int64_t>(
-          0, spec_.action_size - 1)(rng_));
+      std::vector<int64_t> legal;
+      for (int64_t i = 0; i < spec_.action_size; ++i) {
+        if (mask.empty() || mask[i]) legal.push_back(i);
+      }
+      action_[0] =
+          static_cast<double>(legal[std::uniform_int_distribution<size_t>(
+              0, legal.size() - 1)(rng_)]);
     } else {
       for (size_t i = 0; i < action_.size(); ++i) {
         // Unbounded actuators get actions in [-1, 1].
@@ -260,8 +267,10 @@ int PlayEpisode(Environment& env, int64_t episode, uint64_t seed,
   double episode_return = 0.0;
   int64_t length = 0;
   while (recorded.ok()) {
+    absl::StatusOr<std::vector<uint8_t>> mask = ReadActionMask(env);
+    if (!mask.ok()) return Fail("rollout", mask.status(), kRuntimeError);
     absl::StatusOr<StepResult> result =
-        env.Step(actions.Act(observation), absl::MakeSpan(observation));
+        env.Step(actions.Act(observation, *mask), absl::MakeSpan(observation));
     if (!result.ok()) return Fail("rollout", result.status(), kRuntimeError);
     totals.digest.Add(observation);
     if (recording) recorded = video.Add(env, &video_code);

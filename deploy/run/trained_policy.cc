@@ -65,8 +65,9 @@ void TrainedPolicy::Seed(uint64_t seed) { networks->runner.Seed(seed); }
 void TrainedPolicy::StartEpisode() { networks->runner.StartEpisode(); }
 
 std::vector<double> TrainedPolicy::Act(absl::Span<const double> observation,
-                                       bool deterministic) {
-  return networks->runner.Act(observation, deterministic);
+                                       bool deterministic,
+                                       absl::Span<const uint8_t> mask) {
+  return networks->runner.Act(observation, deterministic, mask);
 }
 
 absl::StatusOr<std::string> TrainedPolicy::OnnxModel(bool distribution) const {

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <utility>
 
+#include "common/nn/distributions.h"
 #include "common/util/scratch_buffer.h"
 #include "learner/algorithms/gradient_step.h"
 
@@ -49,6 +50,9 @@ FirstOrderUpdater::FlatRows FirstOrderUpdater::StartFlatUpdate(
       flat_->Inputs(batch.observations), FloatRows(batch.actions, size),
       FloatRows(batch.behaviour_log_probs, size),
       FloatRows(batch.advantages, size), FloatRows(batch.returns, size)};
+  if (batch.action_masks.defined()) {
+    rows.masks = batch.action_masks.to(at::kByte).contiguous();
+  }
   if (batch.seq_len > 0) {
     rows.starts = batch.starts.to(at::kByte).contiguous();
     rows.states = FloatRows(batch.chunk_states, batch.chunk_states.size(0));
@@ -68,6 +72,16 @@ FirstOrderUpdater::Gathered FirstOrderUpdater::GatherAndForward(
   GatherRows(rows.behaviour.data_ptr<float>(), 1, index, count, behaviour_);
   GatherRows(rows.advantages.data_ptr<float>(), 1, index, count, advantages_);
   GatherRows(rows.returns.data_ptr<float>(), 1, index, count, returns_);
+  const uint8_t* masks = nullptr;
+  if (rows.masks.defined()) {
+    const int64_t n = rows.masks.size(1);
+    const uint8_t* all = rows.masks.data_ptr<uint8_t>();
+    uint8_t* gathered = GrowScratch(masks_, count * n);
+    for (int64_t r = 0; r < count; ++r) {
+      std::copy_n(all + index[r] * n, n, gathered + r * n);
+    }
+    masks = gathered;
+  }
   if (minibatch.chunks.defined()) {
     const int64_t chunks = minibatch.chunks.size(0);
     const uint8_t* starts = rows.starts.data_ptr<uint8_t>();
@@ -76,9 +90,9 @@ FirstOrderUpdater::Gathered FirstOrderUpdater::GatherAndForward(
     GatherRows(rows.states.data_ptr<float>(), rows.states.size(1),
                minibatch.chunks.data_ptr<int64_t>(), chunks, states_);
     flat_->ForwardSequences(inputs_.data(), actions_.data(), gathered,
-                            states_.data(), rows.seq_len, chunks);
+                            states_.data(), rows.seq_len, chunks, masks);
   } else {
-    flat_->Forward(inputs_.data(), actions_.data(), count);
+    flat_->Forward(inputs_.data(), actions_.data(), count, masks);
   }
   return Gathered{count, behaviour_.data(), advantages_.data(),
                   returns_.data()};
@@ -86,13 +100,20 @@ FirstOrderUpdater::Gathered FirstOrderUpdater::GatherAndForward(
 
 ChunkOutputs FirstOrderUpdater::Evaluate(const UpdateBatch& batch,
                                          const ChunkMinibatch& minibatch) {
+  ChunkOutputs out;
   if (minibatch.chunks.defined()) {
-    return RunChunks(*policy_, *value_, batch, minibatch);
+    out = RunChunks(*policy_, *value_, batch, minibatch);
+  } else {
+    const at::Tensor observations =
+        batch.observations.index_select(0, minibatch.rows);
+    out = ChunkOutputs{policy_->forward(observations),
+                       value_->forward(observations)};
   }
-  const at::Tensor observations =
-      batch.observations.index_select(0, minibatch.rows);
-  return ChunkOutputs{policy_->forward(observations),
-                      value_->forward(observations)};
+  if (batch.action_masks.defined()) {
+    out.policy = MaskLogits(out.policy,
+                            batch.action_masks.index_select(0, minibatch.rows));
+  }
+  return out;
 }
 
 float* FirstOrderUpdater::d_log_probs(int64_t rows) {

@@ -75,6 +75,7 @@ class FirstOrderUpdater : public PolicyUpdater {
   // chunks' start states.
   struct FlatRows {
     at::Tensor inputs, actions, behaviour, advantages, returns;
+    at::Tensor masks;  // masked actions' uint8 [rows, actions]; else undefined
     at::Tensor starts, states;
     int64_t seq_len = 0;
   };
@@ -142,7 +143,7 @@ class FirstOrderUpdater : public PolicyUpdater {
   // Scratch of GatherAndForward: one minibatch's rows.
   std::vector<float> inputs_, actions_, behaviour_, advantages_, returns_,
       states_;
-  std::vector<uint8_t> starts_;
+  std::vector<uint8_t> starts_, masks_;
 };
 
 }  // namespace vantage

@@ -247,20 +247,20 @@ void FlatActorCritic::MlpBackward(Mlp& mlp, const float* inputs, int64_t rows,
 }
 
 void FlatActorCritic::Forward(const float* inputs, const float* actions,
-                              int64_t rows) {
+                              int64_t rows, const uint8_t* masks) {
   rows_ = rows;
   inputs_ = inputs;
   actions_ = actions;
   MlpForward(policy_, inputs, rows);
   MlpForward(value_, inputs, rows);
-  Heads(actions, rows);
+  Heads(actions, masks, rows);
 }
 
 void FlatActorCritic::ForwardSequences(const float* inputs,
                                        const float* actions,
                                        const uint8_t* starts,
                                        const float* states, int64_t steps,
-                                       int64_t chunks) {
+                                       int64_t chunks, const uint8_t* masks) {
   const int64_t rows = steps * chunks;
   rows_ = rows;
   inputs_ = inputs;
@@ -273,16 +273,17 @@ void FlatActorCritic::ForwardSequences(const float* inputs,
   core_->Forward(parameters_.data(), encoded, starts, states, steps, chunks);
   MlpForward(policy_, core_->features(), rows);
   MlpForward(value_, core_->features(), rows);
-  Heads(actions, rows);
+  Heads(actions, masks, rows);
 }
 
-void FlatActorCritic::Heads(const float* actions, int64_t rows) {
+void FlatActorCritic::Heads(const float* actions, const uint8_t* masks,
+                            int64_t rows) {
   GrowScratch(values_, rows);
   std::memcpy(values_.data(), value_.outputs.back().data(),
               sizeof(float) * rows);
   GrowScratch(log_probs_, rows);
   if (discrete_) {
-    CategoricalHead(actions, rows);
+    CategoricalHead(actions, masks, rows);
   } else {
     GaussianHead(actions, rows);
   }
@@ -308,9 +309,14 @@ void FlatActorCritic::GaussianHead(const float* actions, int64_t rows) {
   mean_entropy_ = entropy;
 }
 
-void FlatActorCritic::CategoricalHead(const float* actions, int64_t rows) {
+void FlatActorCritic::CategoricalHead(const float* actions,
+                                      const uint8_t* masks, int64_t rows) {
   const int64_t n = spec_.action_size;
-  const float* logits = policy_.outputs.back().data();
+  // The policy layer's outputs are not read again by Backward (no tanh
+  // after it), so the masked logits replace them; an illegal action's
+  // probability is then 0 and so is every gradient through its logit.
+  float* logits = policy_.outputs.back().data();
+  if (masks != nullptr) MaskLogitsInPlace(logits, masks, rows, n);
   float* log_p = GrowScratch(head_, rows * n);
   float* entropies = GrowScratch(entropies_, rows);
   double entropy_sum = 0.0;

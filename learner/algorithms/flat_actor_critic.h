@@ -56,8 +56,11 @@ class FlatActorCritic {
 
   // Both networks on `rows` inputs, and the policy's log-probabilities of
   // `actions` ([rows, action_width()]; indices as floats when discrete).
-  // Both arrays must stay unchanged until Backward. Feed-forward networks.
-  void Forward(const float* inputs, const float* actions, int64_t rows);
+  // Masked discrete actions score the policy under `masks` ([rows,
+  // actions] bytes, 1: legal; null: no masks). Every array must stay
+  // unchanged until Backward. Feed-forward networks.
+  void Forward(const float* inputs, const float* actions, int64_t rows,
+               const uint8_t* masks = nullptr);
 
   // Networks with a recurrent core (FlatRecurrentCore): the same over
   // `steps` steps of `chunks` sequences, rows time-major (step t of chunk j
@@ -68,7 +71,8 @@ class FlatActorCritic {
   int64_t state_size() const { return core_ ? core_->state_size() : 0; }
   void ForwardSequences(const float* inputs, const float* actions,
                         const uint8_t* starts, const float* states,
-                        int64_t steps, int64_t chunks);
+                        int64_t steps, int64_t chunks,
+                        const uint8_t* masks = nullptr);
   const float* log_probs() const { return log_probs_.data(); }  // [rows]
   const float* values() const { return values_.data(); }        // [rows]
   // The mean over the rows of the policy's entropy.
@@ -120,11 +124,12 @@ class FlatActorCritic {
   void MlpBackward(Mlp& mlp, const float* inputs, int64_t rows,
                    std::vector<float>& gradient, float* d_inputs = nullptr);
   // The values and log-probabilities after both networks' forward passes.
-  void Heads(const float* actions, int64_t rows);
+  void Heads(const float* actions, const uint8_t* masks, int64_t rows);
   // Backward's path through a recurrent trunk from both heads' gradients.
   void TrunkBackward(int64_t rows);
   void GaussianHead(const float* actions, int64_t rows);
-  void CategoricalHead(const float* actions, int64_t rows);
+  void CategoricalHead(const float* actions, const uint8_t* masks,
+                       int64_t rows);
 
   EnvSpec spec_;
   bool discrete_ = false;

@@ -19,6 +19,10 @@ struct UpdateBatch {
   at::Tensor behaviour_log_probs;  // [T*N] of the policy that acted
   at::Tensor advantages;           // [T*N] rho-mixed: the policy's
   at::Tensor returns;              // [T*N] V + GAE: the critic's
+  // Masked discrete actions: [T*N, actions] bool, the legal actions the
+  // actor sampled from, which every policy output is scored under
+  // (MaskLogits); undefined otherwise.
+  at::Tensor action_masks;
   // Some steps were acted by an older version than the one updating (an
   // asynchronous run's lag).
   bool lagged = false;

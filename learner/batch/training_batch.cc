@@ -63,6 +63,9 @@ absl::StatusOr<TrainingBatch> AssembleBatch(
       stack([](const Rollout& r) { return r.behaviour_log_probs; });
   batch.policy_versions =
       stack([](const Rollout& r) { return r.policy_versions; });
+  if (rollouts[0].action_masks.defined()) {
+    batch.action_masks = stack([](const Rollout& r) { return r.action_masks; });
+  }
   return batch;
 }
 
@@ -78,6 +81,9 @@ UpdateBatch MakeUpdateBatch(
   update.behaviour_log_probs = batch.behaviour_log_probs.reshape({samples});
   update.advantages = advantages.mixed.reshape({samples});
   update.returns = advantages.returns.reshape({samples});
+  if (batch.action_masks.defined()) {
+    update.action_masks = batch.action_masks.reshape({samples, -1});
+  }
   if (batch.seq_len > 0) {
     update.starts = batch.starts.reshape({samples});
     update.chunk_states = batch.chunk_states;

@@ -21,6 +21,8 @@ struct TrainingBatch {
   at::Tensor actions;                // [T, N, act]
   at::Tensor behaviour_log_probs;    // [T, N]
   at::Tensor policy_versions;        // [T, N] int64
+  // Masked discrete actions: [T, N, actions] bool; undefined otherwise.
+  at::Tensor action_masks;
   // Recurrent policies: where episodes start ([T, N] bool: the core's state
   // is zeroed before the step) and the core's state before each chunk of
   // seq_len steps ([T / seq_len * N, state], chunk c of stream n at row

@@ -48,7 +48,7 @@ absl::Status RolloutStitcher::Add(Segment segment) {
 Rollout RolloutStitcher::Cut(int64_t actor_id, int64_t env_slot,
                              Stream& stream) {
   std::vector<at::Tensor> observations, actions, rewards, terminated, truncated,
-      finals, log_probs, versions;
+      finals, log_probs, versions, masks;
   int64_t needed = horizon_;
   at::Tensor next_observation;  // s_T: the observation after the last step
   // Recurrent runs take whole segments, so a rollout starts where one does.
@@ -65,6 +65,8 @@ Rollout RolloutStitcher::Cut(int64_t actor_id, int64_t env_slot,
     terminated.push_back(s.terminated.slice(0, b, e));
     truncated.push_back(s.truncated.slice(0, b, e));
     log_probs.push_back(s.behaviour_log_probs.slice(0, b, e));
+    if (s.action_masks.defined())
+      masks.push_back(s.action_masks.slice(0, b, e));
     versions.push_back(at::full({take}, s.policy_version, at::kLong));
     // The final observations of the truncated steps in [b, e).
     const int64_t before = s.truncated.slice(0, 0, b).sum().item<int64_t>();
@@ -91,6 +93,7 @@ Rollout RolloutStitcher::Cut(int64_t actor_id, int64_t env_slot,
   rollout.behaviour_log_probs = at::cat(log_probs);
   rollout.policy_versions = at::cat(versions);
   rollout.core_state = core_state;
+  if (!masks.empty()) rollout.action_masks = at::cat(masks);
   return rollout;
 }
 

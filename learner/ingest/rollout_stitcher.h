@@ -31,6 +31,9 @@ struct Rollout {
   // A recurrent policy's state before step 0 [state size] (its first
   // segment's); undefined for a feed-forward policy.
   at::Tensor core_state;
+  // Masked discrete actions: the legal actions at each step [T, actions]
+  // bool; undefined otherwise.
+  at::Tensor action_masks;
 };
 
 struct StitcherStats {

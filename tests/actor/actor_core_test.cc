@@ -2,9 +2,11 @@
 
 #include <ATen/ATen.h>
 
+#include "common/nn/distributions.h"
 #include "common/rollout/segment.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
+#include "tests/fakes/random_policy.h"
 
 namespace vantage {
 namespace {
@@ -138,6 +140,57 @@ TEST(ActorCoreTest, BadConfigAndWeightsAreRefused) {
   PolicyWeights nan_weights = InitialWeights(actor->spec(), 3);
   nan_weights.parameters.back().view({-1})[0] = NAN;
   EXPECT_FALSE(actor->SetWeights(nan_weights).ok());
+}
+
+// Masked actions over 100k steps of LitButtons (3 of 32 buttons legal)
+// from a policy with random weights (logits far apart, so that an unmasked
+// sample would often be illegal): every action is legal under the mask its
+// segment carries (the environment would refuse it otherwise), and the
+// behaviour log-probabilities are the policy's under those masks.
+TEST(ActorCoreTest, MaskedActionsAreNeverIllegalOver100kSteps) {
+  ActorConfig config = Config();
+  config.env = "LitButtons";
+  config.num_envs = 8;
+  config.segment_length = 64;
+  auto actor = std::move(*ActorCore::Create(config));
+  ASSERT_TRUE(actor->spec().action_masks);
+  at::manual_seed(12);
+  PolicyNetwork policy(actor->spec(), config.network);
+  RunningMeanStd normalizer(actor->spec().observation_size);
+  RandomisePolicy(*policy, normalizer, actor->spec());
+  {
+    at::NoGradGuard no_grad;
+    for (at::Tensor& parameter : policy->parameters()) parameter.mul_(3.0);
+  }
+  ASSERT_TRUE(
+      actor->SetWeights(ExportPolicyWeights(*policy, normalizer, 1)).ok());
+  ASSERT_TRUE(actor->acts_without_libtorch());
+  int64_t steps = 0;
+  int64_t unmasked_would_be_illegal = 0;
+  while (steps < 100000) {
+    for (const Segment& s : Collect(*actor)) {
+      ASSERT_TRUE(ValidateSegment(s, actor->spec(), 64).ok())
+          << ValidateSegment(s, actor->spec(), 64);
+      const at::Tensor actions = s.actions.to(at::kLong);
+      EXPECT_TRUE(s.action_masks.gather(1, actions).all().item<bool>());
+      steps += s.steps();
+      if (steps > 64 * 8) continue;  // the log-probabilities once
+      at::NoGradGuard no_grad;
+      const at::Tensor output = policy->forward(
+          normalizer.Normalize(s.observations.slice(0, 0, 64), 10.0));
+      EXPECT_TRUE(at::allclose(
+          policy->LogProb(MaskLogits(output, s.action_masks), s.actions),
+          s.behaviour_log_probs, 1e-5, 1e-5));
+      unmasked_would_be_illegal +=
+          s.action_masks.gather(1, output.argmax(1, true))
+              .logical_not()
+              .sum()
+              .item<int64_t>();
+    }
+  }
+  EXPECT_EQ(actor->env_steps(), steps);
+  // The policy alone prefers illegal buttons most of the time.
+  EXPECT_GT(unmasked_would_be_illegal, 64 * 8 / 2);
 }
 
 }  // namespace

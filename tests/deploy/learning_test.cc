@@ -1,8 +1,9 @@
 // Tests that fail if nothing is learned, one per algorithm, on
 // InvertedPendulum: a uniformly random policy keeps the pole up for about
 // 5-8 steps (return 5-8), the best possible return is 1000; one of a
-// categorical policy on MinAtar's Breakout; and recurrent policies on a
-// task that only memory solves. Runs are seeded and local mode
+// categorical policy on MinAtar's Breakout; recurrent policies on a
+// task that only memory solves; and masked actions on a task where most
+// actions are illegal. Runs are seeded and local mode
 // is deterministic, so the margins below guard against regressions in the
 // code, not against luck.
 
@@ -137,6 +138,22 @@ TEST(LearningTest, PpoWithAnLstmCoreRecallsTheCue) {
 // 0.5 (seed 1: 0.4).
 TEST(LearningTest, AFeedForwardPolicyCannotRecallTheCue) {
   EXPECT_LE(BestMeanReturn(CueRecall("", 80000)), 0.5);
+}
+
+// LitButtons (32 buttons, 3 lit at each step with values in [0, 1), 16
+// presses an episode): pressing any lit button scores 8 an episode (a
+// mean of 100 episodes spreads by 0.12), the best one 12. With action
+// masks only the lit buttons can be pressed and PPO learns to choose among
+// them (seed 1: best 9.6 in 64k steps); the same task punishing an unlit
+// press (-1) first has to learn which buttons are lit, and in the same
+// 64k steps still scores less than pressing any lit button would (seed 1:
+// best 3.0).
+TEST(LearningTest, PpoLearnsAMaskedTaskFasterThanOnePunishingIllegalActions) {
+  const double masked = BestMeanReturn(Config("LitButtons", "ppo", 65536, 1));
+  const double punished =
+      BestMeanReturn(Config("LitButtons:masked=false", "ppo", 65536, 1));
+  EXPECT_GE(masked, 9.25);
+  EXPECT_LE(punished, 8.0);
 }
 
 }  // namespace

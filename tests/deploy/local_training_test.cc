@@ -38,22 +38,25 @@ std::string FreshDirectory(const std::string& name) {
 }
 
 // `name`: an algorithm, or "ex2", optionally with a recurrent core
-// ("ppo_gru": PPO with a GRU of 16 units) or evaluations ("ppo_eval": of
-// 3 episodes every 2 updates).
+// ("ppo_gru": PPO with a GRU of 16 units), evaluations ("ppo_eval": of
+// 3 episodes every 2 updates) or masked actions ("ppo_masked": on
+// LitButtons instead of Hopper).
 RunPlan SmallRun(const std::string& name, uint64_t seed,
                  const std::string& run_dir) {
   const std::vector<std::string> parts = absl::StrSplit(name, '_');
   const std::string& algorithm = parts[0];
   pb::RunConfig run;
   pb::TrainingSettings& training = *run.mutable_training();
+  training.set_env("Hopper");
   if (parts.size() > 1 && parts[1] == "eval") {
     run.mutable_evaluation()->set_eval_every(2);
     run.mutable_evaluation()->set_eval_episodes(3);
+  } else if (parts.size() > 1 && parts[1] == "masked") {
+    training.set_env("LitButtons");
   } else if (parts.size() > 1) {
     training.set_core(parts[1]);
     training.set_core_size(16);
   }
-  training.set_env("Hopper");
   training.set_envs(kEnvs);
   // A2C's rollouts are 5n steps (n = 4 here).
   training.set_steps(kUpdates * kEnvs * (algorithm == "a2c" ? 20 : kHorizon));
@@ -212,7 +215,9 @@ TEST_P(ResumeTest, ResumedRunEqualsUninterruptedRun) {
 
 INSTANTIATE_TEST_SUITE_P(Algorithms, ResumeTest,
                          ::testing::Values("ppo", "a2c", "trpo", "ex2",
-                                           "ppo_gru", "a2c_lstm", "ppo_eval"));
+                                           "ppo_gru", "a2c_lstm", "ppo_eval",
+                                           "ppo_masked", "a2c_masked",
+                                           "trpo_masked"));
 
 // Every second version is evaluated before its row, which holds the
 // evaluation; checkpoints/best.pt is the version whose evaluation was best

@@ -325,6 +325,31 @@ TEST(SegmentWireTest, ACoreStateRoundTripsAndIsOptional) {
             MaxSegmentMessageBytes(ContinuousSpec(), 16) + 4 * 48);
 }
 
+// Masked discrete actions' masks travel as bools; other segments have none,
+// and masks of another dtype are refused by name.
+TEST(SegmentWireTest, ActionMasksRoundTripAndAreOptional) {
+  Segment segment = RealisticSegment();
+  absl::StatusOr<Segment> back = SegmentOverWire(segment);
+  ASSERT_TRUE(back.ok()) << back.status();
+  EXPECT_FALSE(back->action_masks.defined());
+  segment.action_masks = at::rand({segment.steps(), 5}) > 0.5;
+  back = SegmentOverWire(segment);
+  ASSERT_TRUE(back.ok()) << back.status();
+  EXPECT_TRUE(at::equal(segment.action_masks, back->action_masks));
+  segment.action_masks = at::ones({segment.steps(), 5});
+  EXPECT_THAT(SegmentOverWire(segment).status().message(),
+              ::testing::HasSubstr("segment.action_masks"));
+  EnvSpec masked;
+  masked.name = "Masked";
+  masked.observation_size = 4;
+  masked.discrete = true;
+  masked.action_size = 5;
+  EnvSpec unmasked = masked;
+  masked.action_masks = true;
+  EXPECT_GE(MaxSegmentMessageBytes(masked, 16),
+            MaxSegmentMessageBytes(unmasked, 16) + 5 * 16);
+}
+
 TEST(SegmentWireTest, EmptyFinalObservationsKeepTheirShape) {
   Segment segment = RealisticSegment();
   segment.truncated.zero_();
@@ -680,7 +705,10 @@ TEST(EnvSpecWireTest, RoundTrips) {
   pixels.observation_size = 3 * 42 * 40;
   pixels.observation_shape = {3, 42, 40};
   pixels.observation_high = 255;
-  for (const EnvSpec& spec : {continuous, discrete, pixels}) {
+  EnvSpec masked = discrete;
+  masked.name = "Masked";
+  masked.action_masks = true;
+  for (const EnvSpec& spec : {continuous, discrete, pixels, masked}) {
     absl::StatusOr<EnvSpec> back = SpecOverWire(spec);
     ASSERT_TRUE(back.ok()) << back.status();
     EXPECT_TRUE(CheckSameSpec(spec, *back).ok()) << CheckSameSpec(spec, *back);
@@ -690,6 +718,7 @@ TEST(EnvSpecWireTest, RoundTrips) {
     EXPECT_EQ(back->control_dt, spec.control_dt);
     EXPECT_EQ(back->observation_shape, spec.observation_shape);
     EXPECT_EQ(back->observation_high, spec.observation_high);
+    EXPECT_EQ(back->action_masks, spec.action_masks);
   }
 }
 
@@ -708,6 +737,8 @@ TEST(EnvSpecWireTest, RefusesImpossibleSpecs) {
        "spec.action_low: 5 values, expected 6 for continuous:6"},
       {[](EnvSpec& s) { s.action_high.push_back(1.0); },
        "spec.action_high: 7 values, expected 6 for continuous:6"},
+      {[](EnvSpec& s) { s.action_masks = true; },
+       "spec.action_masks: true for continuous actions, which take no masks"},
       {[](EnvSpec& s) {
          s.discrete = true;
          s.action_high.clear();
@@ -817,6 +848,8 @@ TEST(EnvSpecWireTest, CheckSameSpecNamesTheFirstDifference) {
        "env spec differs in observation_shape: expected none, got 17x1x1"},
       {[](EnvSpec& s) { s.observation_high = 1; },
        "env spec differs in observation_high: expected 0, got 1"},
+      {[](EnvSpec& s) { s.action_masks = true; },
+       "env spec differs in action_masks: expected false, got true"},
       // Several differences: the first in declaration order is named.
       {[](EnvSpec& s) {
          s.control_dt = 0.01;

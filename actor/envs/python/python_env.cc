@@ -120,8 +120,9 @@ class PythonEnv final : public Environment {
                 py::str(result.get_type().attr("__name__")).cast<std::string>(),
                 ", not (observation, info)"));
           }
-          absl::Status written = WriteObservation(result.cast<py::tuple>()[0],
-                                                  "reset()", observation);
+          py::tuple parts = result.cast<py::tuple>();
+          absl::Status written = WriteObservationAndMask(
+              parts[0], parts[1], "reset()", false, observation);
           if (!written.ok()) return written;
           return true;
         });
@@ -151,18 +152,19 @@ class PythonEnv final : public Environment {
                           .cast<std::string>()));
           }
           py::tuple parts = out.cast<py::tuple>();
-          absl::Status written =
-              WriteObservation(parts[0], "step()", observation);
-          if (!written.ok()) return written;
           StepResult step;
+          step.terminated = parts[2].cast<bool>();
+          step.truncated = !step.terminated && parts[3].cast<bool>();
+          absl::Status written = WriteObservationAndMask(
+              parts[0], parts[4], "step()", step.terminated || step.truncated,
+              observation);
+          if (!written.ok()) return written;
           step.reward = parts[1].cast<double>();
           if (!std::isfinite(step.reward)) {
             return absl::InvalidArgumentError(
                 absl::StrCat(spec_.name, ": step() returned the reward ",
                              step.reward, ", which is not finite"));
           }
-          step.terminated = parts[2].cast<bool>();
-          step.truncated = !step.terminated && parts[3].cast<bool>();
           return step;
         });
     if (!result.ok()) {
@@ -172,6 +174,20 @@ class PythonEnv final : public Environment {
     }
     if (result->terminated || result->truncated) needs_reset_ = true;
     return result;
+  }
+
+  absl::Status ActionMask(absl::Span<uint8_t> mask) const override {
+    if (masks_ == MaskSource::kNone) return Environment::ActionMask(mask);
+    if (needs_reset_) {
+      return absl::FailedPreconditionError(
+          absl::StrCat(spec_.name, ": no action mask before a reset"));
+    }
+    if (mask.size() != mask_.size()) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          spec_.name, ": the mask holds ", mask_.size(), " entries"));
+    }
+    std::copy(mask_.begin(), mask_.end(), mask.begin());
+    return absl::OkStatus();
   }
 
   absl::StatusOr<std::string> SaveState() const override {
@@ -189,6 +205,10 @@ class PythonEnv final : public Environment {
           writer.PutBytes(spec_.name);
           writer.PutBool(needs_reset_);
           writer.PutBytes(std::string(pickled));
+          // Only a masked env's: an unmasked one's state is as before.
+          if (masks_ != MaskSource::kNone) {
+            writer.PutBytes(std::string(mask_.begin(), mask_.end()));
+          }
           return std::move(writer).Finish();
         });
   }
@@ -199,6 +219,13 @@ class PythonEnv final : public Environment {
     reader.ExpectEqual("the environment", reader.GetBytes("name"), spec_.name);
     const bool needs_reset = reader.GetBool("needs_reset");
     const std::string pickled(reader.GetBytes("get_state()"));
+    std::vector<uint8_t> mask;
+    if (masks_ != MaskSource::kNone) {
+      const absl::string_view bytes = reader.GetBytes("action mask");
+      mask.assign(bytes.begin(), bytes.end());
+      reader.Check(needs_reset || CheckActionMask(spec_, mask).ok(),
+                   "a bad action mask");
+    }
     if (absl::Status status = reader.Finish(); !status.ok()) return status;
     absl::StatusOr<bool> restored = WithPython<bool>(
         spec_.name, "set_state()", [&]() -> absl::StatusOr<bool> {
@@ -212,6 +239,7 @@ class PythonEnv final : public Environment {
         });
     if (!restored.ok()) return restored.status();
     needs_reset_ = needs_reset;
+    if (masks_ != MaskSource::kNone) mask_ = std::move(mask);
     return absl::OkStatus();
   }
 
@@ -249,8 +277,15 @@ class PythonEnv final : public Environment {
   // The spec from the spaces (GIL held).
   absl::StatusOr<bool> Describe() {
     py::module_& bridge = PythonBridge();
-    py::tuple observation = bridge.attr("describe_space")(
-        env_.attr("observation_space"), "observation");
+    py::object observation_space = env_.attr("observation_space");
+    py::object inner =
+        bridge.attr("masked_observation_space")(observation_space);
+    if (!inner.is_none()) {
+      masks_ = MaskSource::kObservationKey;
+      observation_space = inner;
+    }
+    py::tuple observation =
+        bridge.attr("describe_space")(observation_space, "observation");
     if (observation[0].cast<std::string>() != "box") {
       return absl::InvalidArgumentError(
           absl::StrCat(spec_.name,
@@ -265,6 +300,7 @@ class PythonEnv final : public Environment {
     if (absl::Status status = DescribeActions(action); !status.ok()) {
       return status;
     }
+    if (absl::Status status = DescribeMasks(); !status.ok()) return status;
     spec_.max_episode_steps =
         bridge.attr("max_episode_steps")(env_).cast<int64_t>();
     spec_.control_dt = 1.0 / 30;
@@ -344,6 +380,94 @@ class PythonEnv final : public Environment {
       return absl::InvalidArgumentError(
           absl::StrCat(spec_.name, ": the action space has no dimensions"));
     }
+    return absl::OkStatus();
+  }
+
+  // Masks come with a Discrete action space, from an observation key or
+  // from the info of every reset and step, which the first reset's says
+  // (GIL held).
+  absl::Status DescribeMasks() {
+    if (masks_ == MaskSource::kObservationKey && !spec_.discrete) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          spec_.name,
+          ": the observation has an action_mask key, but the action space "
+          "is not Discrete (masks choose among discrete actions)"));
+    }
+    if (masks_ == MaskSource::kNone && spec_.discrete &&
+        PythonBridge().attr("first_info_has_action_mask")(env_).cast<bool>()) {
+      masks_ = MaskSource::kInfo;
+    }
+    spec_.action_masks = masks_ != MaskSource::kNone;
+    mask_.assign(spec_.action_masks ? spec_.action_size : 0, 0);
+    return absl::OkStatus();
+  }
+
+  // The observation of a reset or step, and its mask where the env gives
+  // them: `info` is that call's info (GIL held). An episode that ended
+  // needs no mask (no action follows it).
+  absl::Status WriteObservationAndMask(py::handle value, py::handle info,
+                                       const char* call, bool ended,
+                                       absl::Span<double> out) {
+    py::handle observation = value;
+    py::object mask;
+    if (masks_ == MaskSource::kObservationKey) {
+      if (!py::isinstance<py::dict>(value)) {
+        return absl::InvalidArgumentError(absl::StrCat(
+            spec_.name, ": ", call,
+            " returned an observation that is not a dict of observation and "
+            "action_mask, as its space says"));
+      }
+      py::dict parts = py::reinterpret_borrow<py::dict>(value);
+      if (!parts.contains("observation") || !parts.contains("action_mask")) {
+        return absl::InvalidArgumentError(
+            absl::StrCat(spec_.name, ": ", call,
+                         " returned an observation without the observation and "
+                         "action_mask keys"));
+      }
+      observation = parts["observation"];
+      mask = parts["action_mask"];
+    } else if (masks_ == MaskSource::kInfo && py::isinstance<py::dict>(info) &&
+               py::reinterpret_borrow<py::dict>(info).contains("action_mask")) {
+      mask = py::reinterpret_borrow<py::dict>(info)["action_mask"];
+    }
+    if (absl::Status status = WriteObservation(observation, call, out);
+        !status.ok()) {
+      return status;
+    }
+    if (masks_ == MaskSource::kNone || ended) return absl::OkStatus();
+    if (!mask) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          spec_.name, ": ", call,
+          "'s info has no action_mask (the first reset's had one, so every "
+          "reset and step must)"));
+    }
+    return ReadMask(mask, call);
+  }
+
+  // `value` as the mask of the state just reached: a sequence of
+  // action_size booleans (or 0/1 integers), one of them true (GIL held).
+  absl::Status ReadMask(py::handle value, const char* call) {
+    py::array array = py::array::ensure(value);
+    const char kind = array ? array.dtype().kind() : '?';
+    if (!array || array.ndim() != 1 ||
+        std::string("biu").find(kind) == std::string::npos) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          spec_.name, ": ", call,
+          " gave an action_mask that is not a 1-D array of booleans"));
+    }
+    auto values =
+        py::array_t<int64_t, py::array::c_style | py::array::forcecast>::ensure(
+            array);
+    std::vector<uint8_t> mask(values.size());
+    for (size_t i = 0; i < mask.size(); ++i) {
+      const int64_t v = values.data()[i];
+      mask[i] = v == 0 || v == 1 ? static_cast<uint8_t>(v) : uint8_t{2};
+    }
+    if (absl::Status status = CheckActionMask(spec_, mask); !status.ok()) {
+      return absl::InvalidArgumentError(
+          absl::StrCat(status.message(), " (", call, "'s action_mask)"));
+    }
+    mask_ = std::move(mask);
     return absl::OkStatus();
   }
 
@@ -468,6 +592,10 @@ class PythonEnv final : public Environment {
   py::object reset_;
   py::object step_;
   bool needs_reset_ = true;
+  // Where the env's action masks come from, and the current state's.
+  enum class MaskSource { kNone, kObservationKey, kInfo };
+  MaskSource masks_ = MaskSource::kNone;
+  std::vector<uint8_t> mask_;
 };
 
 }  // namespace

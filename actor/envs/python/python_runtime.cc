@@ -60,6 +60,21 @@ def make(target, kwargs_json):
     return factory(**kwargs)
 
 
+def masked_observation_space(space):
+    # PettingZoo's convention for masks in the observation: a Dict of the
+    # observation and the mask.
+    spaces = getattr(space, "spaces", None)
+    if isinstance(spaces, dict) and set(spaces) == {"observation",
+                                                    "action_mask"}:
+        return spaces["observation"]
+    return None
+
+
+def first_info_has_action_mask(env):
+    _, info = env.reset(seed=0)
+    return isinstance(info, dict) and "action_mask" in info
+
+
 def describe_space(space, what):
     kind = type(space).__name__
     if hasattr(space, "spaces"):

@@ -81,7 +81,10 @@ AlgorithmStats A2cUpdater::FlatUpdate(const UpdateBatch& batch,
           flat_rows.inputs.data_ptr<float>() + begin * flat_rows.inputs.size(1),
           flat_rows.actions.data_ptr<float>() +
               begin * flat_rows.actions.size(1),
-          rows);
+          rows,
+          flat_rows.masks.defined() ? flat_rows.masks.data_ptr<uint8_t>() +
+                                          begin * flat_rows.masks.size(1)
+                                    : nullptr);
     }
     const float* log_probs = net.log_probs();
     const float* values = net.values();

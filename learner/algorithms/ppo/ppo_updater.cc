@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "common/nn/distributions.h"
 #include "common/util/scratch_buffer.h"
 #include "learner/algorithms/flat_adam.h"
 #include "learner/algorithms/gradient_step.h"
@@ -74,8 +75,9 @@ PpoUpdater::Decoupled PpoUpdater::Decouple(const UpdateBatch& batch) {
                                     Evaluate(batch, all).policy,
                                     batch.actions.index_select(0, all.rows)));
   } else {
-    proximal =
-        policy_->LogProb(policy_->forward(batch.observations), batch.actions);
+    proximal = policy_->LogProb(
+        MaskLogits(policy_->forward(batch.observations), batch.action_masks),
+        batch.actions);
   }
   out.weights =
       at::exp(proximal - batch.behaviour_log_probs.to(proximal.dtype()));

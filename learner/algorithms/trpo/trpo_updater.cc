@@ -10,6 +10,7 @@
 #include <limits>
 #include <numeric>
 
+#include "common/nn/distributions.h"
 #include "learner/algorithms/gradient_step.h"
 #include "learner/algorithms/trpo/conjugate_gradient.h"
 #include "learner/parallel/replica_reductions.h"
@@ -82,9 +83,7 @@ AlgorithmStats TrpoUpdater::Update(const UpdateBatch& batch,
   stats.max_gradient_norm = std::numeric_limits<double>::quiet_NaN();
   {
     at::NoGradGuard no_grad;
-    stats.entropy = policy_->Entropy(policy_->forward(batch.observations))
-                        .mean()
-                        .item<double>();
+    stats.entropy = policy_->Entropy(Outputs(batch)).mean().item<double>();
   }
   double surrogate = 0.0;
   stats.approx_kl = PolicyStep(batch, advantages, surrogate);
@@ -99,7 +98,7 @@ double TrpoUpdater::PolicyStep(const UpdateBatch& batch,
   PolicyStepInputs step{batch, advantages, at::Tensor(), at::Tensor()};
   {
     at::NoGradGuard no_grad;
-    step.old_output = policy_->forward(batch.observations);
+    step.old_output = Outputs(batch);
     if (!policy_->discrete()) step.old_log_std = policy_->log_std().clone();
   }
   const at::Tensor objective = Surrogate(step);
@@ -111,9 +110,13 @@ double TrpoUpdater::PolicyStep(const UpdateBatch& batch,
   return LineSearch(step, full_step, objective_before, surrogate_after);
 }
 
+at::Tensor TrpoUpdater::Outputs(const UpdateBatch& batch) {
+  return MaskLogits(policy_->forward(batch.observations), batch.action_masks);
+}
+
 at::Tensor TrpoUpdater::Surrogate(const PolicyStepInputs& step) {
   PolicyNetworkImpl& policy = *policy_;
-  const at::Tensor output = policy.forward(step.batch.observations);
+  const at::Tensor output = Outputs(step.batch);
   const at::Tensor ratio = at::exp(policy.LogProb(output, step.batch.actions) -
                                    step.batch.behaviour_log_probs);
   return (ratio * step.advantages).mean() +
@@ -122,9 +125,7 @@ at::Tensor TrpoUpdater::Surrogate(const PolicyStepInputs& step) {
 
 at::Tensor TrpoUpdater::MeanKl(const PolicyStepInputs& step) {
   PolicyNetworkImpl& policy = *policy_;
-  return policy
-      .Kl(step.old_output, step.old_log_std,
-          policy.forward(step.batch.observations))
+  return policy.Kl(step.old_output, step.old_log_std, Outputs(step.batch))
       .mean();
 }
 

@@ -50,6 +50,8 @@ class TrpoUpdater : public PolicyUpdater {
                     double& surrogate_after);
   // Importance-weighted against the policy that acted (the actors' version
   // may lag the learner's).
+  // The policy's outputs on the batch, scored under its action masks.
+  at::Tensor Outputs(const UpdateBatch& batch);
   at::Tensor Surrogate(const PolicyStepInputs& step);
   at::Tensor MeanKl(const PolicyStepInputs& step);
   at::Tensor FisherProduct(const PolicyStepInputs& step, const at::Tensor& v);

@@ -44,6 +44,55 @@ TEST(SegmentTest, ValidSegmentPasses) {
   EXPECT_TRUE(ValidateSegment(ValidSegment(), Spec(), 128).ok());
 }
 
+// Four discrete actions whose legality the environment masks.
+EnvSpec MaskedSpec() {
+  EnvSpec spec = Spec();
+  spec.discrete = true;
+  spec.action_size = 4;
+  spec.action_masks = true;
+  return spec;
+}
+
+// ValidSegment's steps acting 0, 1, 2, 3 with masks that allow each.
+Segment MaskedSegment() {
+  Segment s = ValidSegment();
+  s.actions = at::arange(4, at::kFloat).reshape({4, 1});
+  s.action_masks = at::eye(4, at::kBool);
+  s.action_masks[0][3] = true;
+  return s;
+}
+
+TEST(SegmentTest, MaskedActionsNeedMasksThatAllowWhatWasTaken) {
+  EXPECT_TRUE(ValidateSegment(MaskedSegment(), MaskedSpec(), 128).ok());
+  Segment s = MaskedSegment();
+  s.action_masks = at::Tensor();
+  EXPECT_THAT(ValidateSegment(s, MaskedSpec(), 128).message(),
+              HasSubstr("action_masks is missing"));
+  s = MaskedSegment();
+  s.action_masks = at::ones({4, 3}, at::kBool);
+  EXPECT_THAT(ValidateSegment(s, MaskedSpec(), 128).message(),
+              HasSubstr("action_masks has shape [4, 3], expected [4, 4]"));
+  s = MaskedSegment();
+  s.action_masks = at::ones({4, 4}, at::kByte);
+  EXPECT_THAT(ValidateSegment(s, MaskedSpec(), 128).message(),
+              HasSubstr("action_masks has dtype Byte, expected Bool"));
+  s = MaskedSegment();
+  s.action_masks[2].fill_(false);
+  EXPECT_THAT(ValidateSegment(s, MaskedSpec(), 128).message(),
+              HasSubstr("action_masks is all zero at step 2"));
+  s = MaskedSegment();
+  s.actions[1][0] = 3.0f;  // legal at step 0 only
+  EXPECT_THAT(ValidateSegment(s, MaskedSpec(), 128).message(),
+              HasSubstr("actions holds 3 at step 1, which that step's action "
+                        "mask makes illegal"));
+  // A run without masks takes none.
+  EnvSpec unmasked = MaskedSpec();
+  unmasked.action_masks = false;
+  EXPECT_THAT(ValidateSegment(MaskedSegment(), unmasked, 128).message(),
+              HasSubstr("action_masks is set, but this run's actions "
+                        "(discrete:4) take no masks"));
+}
+
 TEST(SegmentTest, EveryDefectIsNamed) {
   Segment s = ValidSegment();
   s.observations = at::zeros({4, 3});

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "common/nn/distributions.h"
 #include "common/nn/networks.h"
 #include "gtest/gtest.h"
 #include "learner/algorithms/flat_adam.h"
@@ -15,6 +16,14 @@
 
 namespace vantage {
 namespace {
+
+// Random masks [rows, n] as uint8 under which each row's action (indices
+// as floats [rows, 1]) is legal.
+at::Tensor MasksAllowing(const at::Tensor& actions, int64_t n) {
+  at::Tensor masks = at::rand({actions.size(0), n}) < 0.4;
+  masks.scatter_(1, actions.to(at::kLong), true);
+  return masks.to(at::kByte).contiguous();
+}
 
 // Weights of the scale hidden layers start with (1 / sqrt(inputs)), for
 // every layer, so that the outputs and the log-std are far from their
@@ -72,6 +81,7 @@ struct Case {
   int64_t actions;
   std::vector<int64_t> hidden;
   bool bytes;
+  bool masked = false;  // discrete only: action masks
 };
 
 class FlatActorCriticTest : public ::testing::TestWithParam<Case> {};
@@ -105,27 +115,37 @@ TEST_P(FlatActorCriticTest, ForwardAndGradientsAreAutograds) {
   const at::Tensor d_values = at::randn({kRows});
   const double entropy_weight = -0.37;
 
+  const at::Tensor masks =
+      c.masked ? MasksAllowing(actions, c.actions) : at::Tensor();
+
   const at::Tensor inputs = flat->Inputs(observations);
-  flat->Forward(inputs.data_ptr<float>(), actions.data_ptr<float>(), kRows);
+  flat->Forward(inputs.data_ptr<float>(), actions.data_ptr<float>(), kRows,
+                c.masked ? masks.data_ptr<uint8_t>() : nullptr);
   flat->Backward(d_log_probs.data_ptr<float>(), entropy_weight,
                  d_values.data_ptr<float>());
 
-  const at::Tensor output = policy->forward(observations);
+  const at::Tensor output =
+      MaskLogits(policy->forward(observations),
+                 c.masked ? masks.to(at::kBool) : at::Tensor());
   ExpectAutogradsResults(*flat, *policy, output, actions,
                          value->forward(observations), d_log_probs,
                          entropy_weight, d_values, parameters);
 }
 
-INSTANTIATE_TEST_SUITE_P(Heads, FlatActorCriticTest,
-                         ::testing::Values(Case{false, 17, 6, {64, 64}, false},
-                                           Case{true, 11, 5, {32}, false},
-                                           Case{false, 3, 1, {}, false},
-                                           Case{true, 9, 4, {16, 8}, true}));
+INSTANTIATE_TEST_SUITE_P(
+    Heads, FlatActorCriticTest,
+    ::testing::Values(Case{false, 17, 6, {64, 64}, false},
+                      Case{true, 11, 5, {32}, false},
+                      Case{false, 3, 1, {}, false},
+                      Case{true, 9, 4, {16, 8}, true},
+                      Case{true, 11, 5, {32}, false, true},
+                      Case{true, 9, 4, {16, 8}, true, true}));
 
 struct RecurrentCase {
   Core core;
   bool discrete;
   std::vector<int64_t> hidden;
+  bool masked = false;  // discrete only: action masks
 };
 
 class FlatRecurrentTest : public ::testing::TestWithParam<RecurrentCase> {};
@@ -165,19 +185,24 @@ TEST_P(FlatRecurrentTest, SequencesAndGradientsThroughTimeAreAutograds) {
   const at::Tensor d_log_probs = at::randn({kRows});
   const at::Tensor d_values = at::randn({kRows});
   const double entropy_weight = -0.37;
+  const at::Tensor masks = c.masked ? MasksAllowing(actions, 3) : at::Tensor();
 
   const at::Tensor inputs = flat->Inputs(observations);
   flat->ForwardSequences(inputs.data_ptr<float>(), actions.data_ptr<float>(),
                          start_bytes.data_ptr<uint8_t>(),
-                         states.data_ptr<float>(), kSteps, kChunks);
+                         states.data_ptr<float>(), kSteps, kChunks,
+                         c.masked ? masks.data_ptr<uint8_t>() : nullptr);
   flat->Backward(d_log_probs.data_ptr<float>(), entropy_weight,
                  d_values.data_ptr<float>());
 
   RecurrentTrunk trunk = policy->trunk();
   const at::Tensor features = trunk->Unroll(observations, starts, states);
-  ExpectAutogradsResults(*flat, *policy, policy->Head(features), actions,
-                         value->Head(features), d_log_probs, entropy_weight,
-                         d_values, parameters);
+  ExpectAutogradsResults(
+      *flat, *policy,
+      MaskLogits(policy->Head(features),
+                 c.masked ? masks.to(at::kBool) : at::Tensor()),
+      actions, value->Head(features), d_log_probs, entropy_weight, d_values,
+      parameters);
 }
 
 INSTANTIATE_TEST_SUITE_P(
@@ -185,7 +210,8 @@ INSTANTIATE_TEST_SUITE_P(
     ::testing::Values(RecurrentCase{Core::kGru, false, {16, 8}},
                       RecurrentCase{Core::kGru, true, {}},
                       RecurrentCase{Core::kLstm, false, {16}},
-                      RecurrentCase{Core::kLstm, true, {8, 8}}));
+                      RecurrentCase{Core::kLstm, true, {8, 8}},
+                      RecurrentCase{Core::kGru, true, {16}, true}));
 
 TEST(FlatActorCriticTest, PushWritesTheModulesAndPullReadsThem) {
   at::manual_seed(4);
