@@ -211,6 +211,22 @@ absl::Status CheckActionMasks(const Segment& segment, const EnvSpec& spec) {
   return absl::OkStatus();
 }
 
+// Discrete actions are indices in range, legal under their masks if the
+// run has masks.
+absl::Status CheckDiscreteActions(const Segment& segment, const EnvSpec& spec) {
+  if (spec.discrete) {
+    const at::Tensor a = segment.actions;
+    if (!(a == a.floor()).all().item<bool>() || (a < 0).any().item<bool>() ||
+        (a >= static_cast<double>(spec.action_size)).any().item<bool>()) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          "segment field actions holds values that are not action indices "
+          "in [0, ",
+          spec.action_size, ")"));
+    }
+  }
+  return CheckActionMasks(segment, spec);
+}
+
 }  // namespace
 
 absl::Status ValidateSegment(const Segment& segment, const EnvSpec& spec,
@@ -253,17 +269,7 @@ absl::Status ValidateSegment(const Segment& segment, const EnvSpec& spec,
       !status.ok()) {
     return status;
   }
-  if (spec.discrete) {
-    const at::Tensor a = segment.actions;
-    if (!(a == a.floor()).all().item<bool>() || (a < 0).any().item<bool>() ||
-        (a >= static_cast<double>(spec.action_size)).any().item<bool>()) {
-      return absl::InvalidArgumentError(absl::StrCat(
-          "segment field actions holds values that are not action indices "
-          "in [0, ",
-          spec.action_size, ")"));
-    }
-  }
-  if (absl::Status status = CheckActionMasks(segment, spec); !status.ok()) {
+  if (absl::Status status = CheckDiscreteActions(segment, spec); !status.ok()) {
     return status;
   }
   if (AnyBoth(segment.terminated, segment.truncated)) {
