@@ -237,6 +237,114 @@ TEST(PythonEnvTest, AVectorOfThemResumesExactlyOrRestartsItsEpisodes) {
   }
 }
 
+EnvOptions Kwargs(const std::string& json) {
+  EnvOptions options;
+  options.python_kwargs = json;
+  return options;
+}
+
+// Steps `envs` `steps` times pressing each env's first legal button (the
+// test env raises on an unlit one); the first error, if any.
+absl::Status PressLegalButtons(VectorEnv& envs, int steps) {
+  const int64_t n = envs.spec().action_size;
+  for (int t = 0; t < steps; ++t) {
+    std::vector<double> actions;
+    for (int e = 0; e < envs.size(); ++e) {
+      const auto begin = envs.action_masks().begin() + e * n;
+      actions.push_back(
+          static_cast<double>(std::find(begin, begin + n, 1) - begin));
+    }
+    if (absl::Status status = envs.Step(actions); !status.ok()) return status;
+  }
+  return absl::OkStatus();
+}
+
+// Gymnasium's two places for a mask: info["action_mask"] of every reset
+// and step, or an observation Dict of "observation" and "action_mask"; the
+// mask is the lit buttons' and only legal presses are made. Without a
+// mask the env is unmasked.
+TEST(PythonEnvTest, MasksComeFromTheInfoOrAnObservationKey) {
+  for (const std::string mask_in : {"info", "observation", "none"}) {
+    absl::StatusOr<std::unique_ptr<VectorEnv>> made = VectorEnv::Create(
+        "python:lit_buttons:make", 3, 4,
+        Kwargs(absl::StrCat(R"({"mask_in": ")", mask_in, R"("})")));
+    ASSERT_TRUE(made.ok()) << made.status();
+    VectorEnv& envs = **made;
+    EXPECT_EQ(envs.spec().observation_size, 16) << mask_in;
+    if (mask_in == "none") {
+      EXPECT_FALSE(envs.spec().action_masks);
+      EXPECT_TRUE(envs.action_masks().empty());
+      continue;
+    }
+    EXPECT_EQ(envs.spec().ActionString(), "discrete:8 masked");
+    ASSERT_TRUE(envs.Reset().ok());
+    for (int t = 0; t < 40; ++t) {
+      for (int e = 0; e < 3; ++e) {
+        for (int i = 0; i < 8; ++i) {
+          ASSERT_EQ(envs.action_masks()[e * 8 + i],
+                    envs.observations()[e * 16 + i])
+              << mask_in;
+        }
+      }
+      ASSERT_TRUE(PressLegalButtons(envs, 1).ok()) << mask_in;
+    }
+  }
+}
+
+// A mask of the wrong length, all zero, not boolean or missing is refused
+// naming the env, the call and what is wrong.
+TEST(PythonEnvTest, BadMasksAreRefusedByName) {
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"short",
+       "the action mask has 7 entries, expected 8 (step()'s "
+       "action_mask)"},
+      {"zeros",
+       "the action mask is all zero (no legal action) (step()'s "
+       "action_mask)"},
+      {"twos", "action mask entry "},
+      {"floats",
+       "step() gave an action_mask that is not a 1-D array of "
+       "booleans"},
+      {"missing",
+       "step()'s info has no action_mask (the first reset's had "
+       "one, so every reset and step must)"},
+  };
+  for (const auto& [bad, message] : cases) {
+    const std::string mask_in = bad == "floats" ? "observation" : "info";
+    absl::StatusOr<std::unique_ptr<VectorEnv>> made = VectorEnv::Create(
+        "python:lit_buttons:make", 1, 4,
+        Kwargs(absl::StrCat(R"({"mask_in": ")", mask_in, R"(", "bad_mask": ")",
+                            bad, R"(", "bad_after": 3})")));
+    ASSERT_TRUE(made.ok()) << made.status();
+    ASSERT_TRUE((*made)->Reset().ok());
+    const absl::Status status = PressLegalButtons(**made, 5);
+    EXPECT_THAT(status.message(), HasSubstr(message)) << bad;
+    EXPECT_THAT(status.message(), HasSubstr("python:lit_buttons:make")) << bad;
+  }
+}
+
+// A masked env with get_state resumes exactly, its masks too.
+TEST(PythonEnvTest, AMaskedEnvResumesWithItsMasks) {
+  const auto make = [] {
+    return *VectorEnv::Create("python:lit_buttons:make", 2, 4);
+  };
+  std::unique_ptr<VectorEnv> envs = make();
+  ASSERT_TRUE(envs->Reset().ok());
+  ASSERT_TRUE(PressLegalButtons(*envs, 5).ok());
+  absl::StatusOr<std::string> state = envs->SaveState();
+  ASSERT_TRUE(state.ok()) << state.status();
+  std::unique_ptr<VectorEnv> resumed = make();
+  ASSERT_TRUE(resumed->RestoreState(*state).ok());
+  EXPECT_EQ(resumed->action_masks(), envs->action_masks());
+  ASSERT_TRUE(PressLegalButtons(*envs, 3).ok());
+  ASSERT_TRUE(PressLegalButtons(*resumed, 3).ok());
+  EXPECT_EQ(std::vector<double>(resumed->observations().begin(),
+                                resumed->observations().end()),
+            std::vector<double>(envs->observations().begin(),
+                                envs->observations().end()));
+  EXPECT_EQ(resumed->action_masks(), envs->action_masks());
+}
+
 TEST(PythonEnvTest, RendersAnRgbFrameOfTheAskedSize) {
   std::unique_ptr<Environment> env = Make("python:cartpole:make");
   std::vector<double> observation(4);
