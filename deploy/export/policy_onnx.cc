@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "absl/strings/str_cat.h"
+#include "common/nn/distributions.h"
 #include "common/nn/networks.h"
 #include "common/nn/running_mean_std.h"
 
@@ -221,6 +222,24 @@ std::string ClipToBounds(GraphBuilder& g, const EnvSpec& spec,
               out("Mul", {above, g.Floats("has_high", at::tensor(has_high))})});
 }
 
+// Masked discrete actions: the logits with an illegal action's replaced by
+// kIllegalLogit, as vantage scores and acts, from the input `action_mask`
+// (1 legal, 0 illegal): logits * mask + (mask - 1) * 1e9.
+std::string AddMask(GraphBuilder& g, onnx::GraphProto& graph,
+                    const EnvSpec& spec, const std::string& logits) {
+  g.Value(graph.mutable_input(), "action_mask", onnx::TensorProto::FLOAT,
+          {-1, spec.action_size});
+  const auto out = [&](const std::string& op,
+                       const std::vector<std::string>& inputs) {
+    return GraphBuilder::Out(g.Node(op, inputs));
+  };
+  const std::string kept = out("Mul", {logits, "action_mask"});
+  const std::string illegal = out(
+      "Mul", {out("Sub", {"action_mask", g.Floats("one", at::tensor({1.0f}))}),
+              g.Floats("illegal", at::tensor({-kIllegalLogit}))});
+  return out("Add", {kept, illegal});
+}
+
 // The graph's outputs from the policy head's `output`.
 void AddOutputs(GraphBuilder& g, onnx::GraphProto& graph, const EnvSpec& spec,
                 PolicyNetworkImpl& policy, const std::string& output,
@@ -286,8 +305,9 @@ absl::StatusOr<std::string> PolicyToOnnx(const EnvSpec& spec,
   if (!policy.conv_torso().is_empty()) {
     x = AddConvTorso(g, policy.conv_torso(), spec.observation_shape, x);
   }
-  AddOutputs(g, graph, spec, policy, AddMlp(g, policy.body(), x),
-             options.distribution);
+  std::string output = AddMlp(g, policy.body(), x);
+  if (spec.action_masks) output = AddMask(g, graph, spec, output);
+  AddOutputs(g, graph, spec, policy, output, options.distribution);
   try {
     onnx::checker::check_model(model);
   } catch (const std::exception& error) {

@@ -8,8 +8,11 @@
 // networks take it, and the output `action`: the Gaussian mean clipped to
 // the action bounds (float [batch, k]) or the most likely action (int64
 // [batch]). With `distribution`, also the distribution's parameters:
-// `mean` and `log_std` (each [batch, k]) or `logits` [batch, n]. The model
-// passes ONNX's checker before it is returned.
+// `mean` and `log_std` (each [batch, k]) or `logits` [batch, n]. A policy
+// of masked discrete actions has a second input, `action_mask` (float
+// [batch, n], 1 for a legal action, 0 for an illegal one): the action is
+// the most likely legal one and an illegal action's logit is -1e9, as in
+// vantage. The model passes ONNX's checker before it is returned.
 
 #include <string>
 

@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "common/nn/distributions.h"
 #include "common/nn/networks.h"
 #include "common/nn/running_mean_std.h"
 #include "gmock/gmock.h"
@@ -28,16 +29,26 @@ namespace {
 constexpr int64_t kRows = 1000;
 constexpr double kClip = 5.0;
 
-// The model's outputs `names` for `observations` [kRows, obs] (float).
+// The model's outputs `names` for `observations` [kRows, obs] (float) and,
+// for masked actions, `masks` [kRows, n] (bool).
 std::vector<cv::Mat> RunOnOpenCv(const std::string& model,
                                  const at::Tensor& observations,
-                                 const std::vector<std::string>& names) {
+                                 const std::vector<std::string>& names,
+                                 const at::Tensor& masks = at::Tensor()) {
   cv::dnn::Net net =
       cv::dnn::readNetFromONNX(std::vector<uchar>(model.begin(), model.end()));
   const at::Tensor input = observations.to(at::kFloat).contiguous();
   cv::Mat blob(static_cast<int>(input.size(0)), static_cast<int>(input.size(1)),
                CV_32F, input.data_ptr<float>());
   net.setInput(blob, "observation");
+  const at::Tensor mask_values =
+      masks.defined() ? masks.to(at::kFloat).contiguous() : at::Tensor();
+  if (masks.defined()) {
+    net.setInput(cv::Mat(static_cast<int>(masks.size(0)),
+                         static_cast<int>(masks.size(1)), CV_32F,
+                         mask_values.data_ptr<float>()),
+                 "action_mask");
+  }
   std::vector<cv::Mat> outputs;
   net.forward(outputs, std::vector<cv::String>(names.begin(), names.end()));
   return outputs;
@@ -120,6 +131,29 @@ TEST(PolicyOnnxTest, ACategoricalMlpPolicyAgreesUnderOpenCv) {
   ASSERT_EQ(out.size(), 2u);
   ExpectClose(out[0], e.output.argmax(-1), "action");
   ExpectClose(out[1], e.output, "logits");
+}
+
+// Masked actions: the model takes the masks as a second input and acts,
+// and gives logits, as vantage does under them.
+TEST(PolicyOnnxTest, AMaskedCategoricalPolicyAgreesUnderOpenCv) {
+  at::manual_seed(4);
+  EnvSpec spec = VectorSpec(true, 11, 6);
+  spec.action_masks = true;
+  const Exported e = Export(spec, NetworkConfig());
+  at::Tensor masks = at::rand({kRows, 6}) < 0.3;
+  masks.select(1, 2).fill_(true);  // a legal action in every row
+  const at::Tensor masked = MaskLogits(e.output, masks);
+  const std::vector<cv::Mat> out =
+      RunOnOpenCv(e.model, e.observations, {"action", "logits"}, masks);
+  ASSERT_EQ(out.size(), 2u);
+  ExpectClose(out[0], masked.argmax(-1), "action");
+  ExpectClose(out[1], masked, "logits");
+  // The masks decide: the unmasked argmax is illegal in many rows.
+  EXPECT_GT(masks.gather(1, e.output.argmax(-1, true))
+                .logical_not()
+                .sum()
+                .item<int64_t>(),
+            kRows / 4);
 }
 
 TEST(PolicyOnnxTest, AConvolutionalPolicyOnBytesAgreesUnderOpenCv) {
