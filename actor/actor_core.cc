@@ -124,7 +124,7 @@ absl::Status ActorCore::SetWeights(const PolicyWeights& weights) {
 void ActorCore::Act(const at::Tensor& observations_row, float* actions,
                     float* log_probs) {
   const int64_t m = envs_->size();
-  const int64_t width = spec().discrete ? 1 : spec().action_size;
+  const int64_t width = spec().action_width();
   if (kernel_) {
     kernel_outputs_.resize(m * kernel_->output_size());
     kernel_->Forward(envs_->observations().data(), m, kernel_outputs_.data(),
@@ -205,8 +205,7 @@ absl::Status ActorCore::CollectSegments(SegmentSink& sink) {
         "the actor has no policy weights yet; SetWeights first");
   }
   Rollout rollout(config_.segment_length, envs_->size(),
-                  spec().observation_size,
-                  spec().discrete ? 1 : spec().action_size,
+                  spec().observation_size, spec().action_width(),
                   spec().byte_observations() ? at::kByte : at::kFloat);
 
   at::NoGradGuard no_grad;

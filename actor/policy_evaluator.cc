@@ -62,8 +62,15 @@ struct PolicyEvaluator::FastPolicy {
     if (!mask.empty()) {
       MaskLogitsInPlace(outputs.data(), mask.data(), 1, spec.action_size);
     }
-    return {static_cast<double>(
-        std::max_element(outputs.begin(), outputs.end()) - outputs.begin())};
+    // The most likely choice of each head.
+    std::vector<double> action;
+    auto head = outputs.begin();
+    for (int64_t choices : kernel.heads()) {
+      action.push_back(
+          static_cast<double>(std::max_element(head, head + choices) - head));
+      head += choices;
+    }
+    return action;
   }
 };
 

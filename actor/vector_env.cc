@@ -57,7 +57,7 @@ VectorEnv::VectorEnv(std::vector<std::unique_ptr<Environment>> envs,
     : envs_(std::move(envs)), seeds_(seed) {
   const EnvSpec& s = spec();
   observation_size_ = s.observation_size;
-  action_width_ = s.discrete ? 1 : s.action_size;
+  action_width_ = s.action_width();
   const size_t m = envs_.size();
   observations_.resize(m * observation_size_);
   final_observations_.resize(m * observation_size_);
@@ -93,18 +93,24 @@ absl::Status VectorEnv::ReadMask(int index) {
   return status;
 }
 
-absl::Status VectorEnv::CheckLegal(int index, double action) const {
-  if (action_masks_.empty() || !(action >= 0) ||
-      action >= static_cast<double>(spec().action_size)) {
-    return absl::OkStatus();  // the env's own CheckAction names a bad index
+absl::Status VectorEnv::CheckLegal(int index,
+                                   absl::Span<const double> action) const {
+  if (action_masks_.empty()) return absl::OkStatus();
+  const std::vector<int64_t> heads = spec().action_heads();
+  const uint8_t* mask = action_masks_.data() + index * spec().action_size;
+  for (size_t h = 0; h < heads.size(); mask += heads[h], ++h) {
+    // The env's own CheckAction names a value out of range.
+    if (!(action[h] >= 0) || action[h] >= static_cast<double>(heads[h])) {
+      continue;
+    }
+    if (!mask[static_cast<int64_t>(action[h])]) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          spec().name, ": action ",
+          heads.size() > 1 ? absl::StrCat("value ", h, " ") : "", action[h],
+          " is illegal in this state (its action mask is 0)"));
+    }
   }
-  const int64_t n = spec().action_size;
-  if (action_masks_[index * n + static_cast<int64_t>(action)]) {
-    return absl::OkStatus();
-  }
-  return absl::InvalidArgumentError(
-      absl::StrCat(spec().name, ": action ", action,
-                   " is illegal in this state (its action mask is 0)"));
+  return absl::OkStatus();
 }
 
 absl::Status VectorEnv::Reset() {
@@ -118,7 +124,7 @@ absl::Status VectorEnv::Reset() {
 absl::StatusOr<StepResult> VectorEnv::StepOne(int index,
                                               absl::Span<const double> action,
                                               absl::Span<double> observation) {
-  if (absl::Status legal = CheckLegal(index, action[0]); !legal.ok()) {
+  if (absl::Status legal = CheckLegal(index, action); !legal.ok()) {
     return legal;
   }
   absl::StatusOr<StepResult> result = envs_[index]->Step(action, observation);

@@ -91,7 +91,7 @@ class VectorEnv {
   // Env `index`'s mask for its current state, checked (masked actions only).
   absl::Status ReadMask(int index);
   // Env `index`'s action is legal in its current state (or none are masked).
-  absl::Status CheckLegal(int index, double action) const;
+  absl::Status CheckLegal(int index, absl::Span<const double> action) const;
 
   std::vector<std::unique_ptr<Environment>> envs_;
   std::mt19937_64 seeds_;

@@ -304,7 +304,7 @@ absl::StatusOr<Segment> SegmentFromProto(const pb::Segment& proto,
 int64_t MaxSegmentMessageBytes(const EnvSpec& spec, int64_t max_steps,
                                int64_t core_state_size) {
   const int64_t t = std::max<int64_t>(1, max_steps);
-  const int64_t act = spec.discrete ? 1 : spec.action_size;
+  const int64_t act = spec.action_width();
   // observations [T+1, obs] and at most T final observations, float32 or
   // uint8; actions [T, act], rewards and log-probs [T] float32; two bool
   // [T] and masked actions' bool [T, actions]; at most T episodes of a double
@@ -380,6 +380,8 @@ void EnvSpecToProto(const EnvSpec& spec, pb::EnvSpec* proto) {
                                           spec.observation_shape.end());
   proto->set_observation_high(spec.observation_high);
   proto->set_action_masks(spec.action_masks);
+  proto->mutable_action_nvec()->Add(spec.action_nvec.begin(),
+                                    spec.action_nvec.end());
 }
 
 absl::StatusOr<EnvSpec> EnvSpecFromProto(const pb::EnvSpec& proto,
@@ -405,6 +407,11 @@ absl::StatusOr<EnvSpec> EnvSpecFromProto(const pb::EnvSpec& proto,
                    absl::StrCat(proto.max_episode_steps(),
                                 ", expected <= ", limits.max_episode_steps));
   }
+  if (proto.action_nvec_size() > limits.max_action_size) {
+    return Invalid("spec.action_nvec", absl::StrCat(proto.action_nvec_size(),
+                                                    " values, expected <= ",
+                                                    limits.max_action_size));
+  }
   if (proto.observation_shape_size() > 3) {
     return Invalid("spec.observation_shape",
                    absl::StrCat(proto.observation_shape_size(),
@@ -424,6 +431,8 @@ absl::StatusOr<EnvSpec> EnvSpecFromProto(const pb::EnvSpec& proto,
                                 proto.observation_shape().end());
   spec.observation_high = proto.observation_high();
   spec.action_masks = proto.action_masks();
+  spec.action_nvec.assign(proto.action_nvec().begin(),
+                          proto.action_nvec().end());
 
   if (spec.name.empty()) return Invalid("spec.name", "empty");
   if (spec.observation_size < 1) {
@@ -436,6 +445,9 @@ absl::StatusOr<EnvSpec> EnvSpecFromProto(const pb::EnvSpec& proto,
   if (spec.action_size < 1) {
     return Invalid("spec.action_size",
                    absl::StrCat(spec.action_size, ", expected >= 1"));
+  }
+  if (absl::Status status = CheckActionLayout(spec); !status.ok()) {
+    return status;
   }
   if (spec.action_masks && !spec.discrete) {
     return Invalid("spec.action_masks",
@@ -502,6 +514,13 @@ absl::Status CheckSameSpec(const EnvSpec& expected, const EnvSpec& got) {
   if (expected.action_size != got.action_size) {
     return Differs("action_size", absl::StrCat(expected.action_size),
                    absl::StrCat(got.action_size));
+  }
+  if (expected.action_nvec != got.action_nvec) {
+    const auto text = [](const std::vector<int64_t>& nvec) {
+      return nvec.empty() ? std::string("none") : absl::StrJoin(nvec, "x");
+    };
+    return Differs("action_nvec", text(expected.action_nvec),
+                   text(got.action_nvec));
   }
   if (expected.action_masks != got.action_masks) {
     return Differs("action_masks", expected.action_masks ? "true" : "false",

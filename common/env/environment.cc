@@ -1,5 +1,6 @@
 #include "common/env/environment.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "absl/strings/str_cat.h"
@@ -8,8 +9,23 @@
 namespace vantage {
 
 std::string EnvSpec::ActionString() const {
-  return absl::StrCat(discrete ? "discrete:" : "continuous:", action_size,
-                      action_masks ? " masked" : "");
+  const std::string kind =
+      !discrete ? absl::StrCat("continuous:", action_size)
+      : action_nvec.empty()
+          ? absl::StrCat("discrete:", action_size)
+          : absl::StrCat("multidiscrete:", absl::StrJoin(action_nvec, "x"));
+  return absl::StrCat(kind, action_masks ? " masked" : "");
+}
+
+int64_t EnvSpec::action_width() const {
+  if (!discrete) return action_size;
+  return action_nvec.empty() ? 1 : static_cast<int64_t>(action_nvec.size());
+}
+
+std::vector<int64_t> EnvSpec::action_heads() const {
+  if (!discrete) return {};
+  if (action_nvec.empty()) return {action_size};
+  return action_nvec;
 }
 
 std::string EnvSpec::ObservationString() const {
@@ -39,7 +55,7 @@ absl::StatusOr<Frame> Environment::Render(int, int) {
 }
 
 absl::Status CheckAction(const EnvSpec& spec, absl::Span<const double> action) {
-  const size_t expected = spec.discrete ? 1 : spec.action_size;
+  const size_t expected = spec.action_width();
   if (action.size() != expected) {
     return absl::InvalidArgumentError(
         absl::StrCat(spec.name, ": action has ", action.size(),
@@ -51,11 +67,15 @@ absl::Status CheckAction(const EnvSpec& spec, absl::Span<const double> action) {
           spec.name, ": action[", i, "] is not finite (", action[i], ")"));
     }
   }
-  if (spec.discrete && (action[0] != std::floor(action[0]) || action[0] < 0 ||
-                        action[0] >= static_cast<double>(spec.action_size))) {
-    return absl::InvalidArgumentError(
-        absl::StrCat(spec.name, ": discrete action ", action[0],
-                     " is not an integer in [0, ", spec.action_size, ")"));
+  const std::vector<int64_t> heads = spec.action_heads();
+  for (size_t i = 0; i < heads.size(); ++i) {
+    if (action[i] != std::floor(action[i]) || action[i] < 0 ||
+        action[i] >= static_cast<double>(heads[i])) {
+      return absl::InvalidArgumentError(
+          absl::StrCat(spec.name, ": discrete action ",
+                       heads.size() > 1 ? absl::StrCat("value ", i, " ") : "",
+                       action[i], " is not an integer in [0, ", heads[i], ")"));
+    }
   }
   return absl::OkStatus();
 }
@@ -72,18 +92,22 @@ absl::Status CheckActionMask(const EnvSpec& spec,
         absl::StrCat(spec.name, ": the action mask has ", mask.size(),
                      " entries, expected ", spec.action_size));
   }
-  bool any_legal = false;
   for (size_t i = 0; i < mask.size(); ++i) {
     if (mask[i] > 1) {
       return absl::InvalidArgumentError(
           absl::StrCat(spec.name, ": action mask entry ", i, " is ",
                        static_cast<int>(mask[i]), ", expected 0 or 1"));
     }
-    any_legal = any_legal || mask[i] == 1;
   }
-  if (!any_legal) {
-    return absl::InvalidArgumentError(absl::StrCat(
-        spec.name, ": the action mask is all zero (no legal action)"));
+  const std::vector<int64_t> heads = spec.action_heads();
+  const uint8_t* head = mask.data();
+  for (size_t h = 0; h < heads.size(); head += heads[h], ++h) {
+    if (std::find(head, head + heads[h], 1) == head + heads[h]) {
+      return absl::InvalidArgumentError(
+          absl::StrCat(spec.name, ": the action mask is all zero",
+                       heads.size() > 1 ? absl::StrCat(" for value ", h) : "",
+                       " (no legal action)"));
+    }
   }
   return absl::OkStatus();
 }
@@ -113,6 +137,34 @@ absl::Status CheckStep(const EnvSpec& spec, bool needs_reset,
     return status;
   }
   return CheckObservationBuffer(spec, observation);
+}
+
+absl::Status CheckActionLayout(const EnvSpec& spec) {
+  if (spec.action_nvec.empty()) return absl::OkStatus();
+  const std::string nvec = absl::StrJoin(spec.action_nvec, "x");
+  if (!spec.discrete) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("spec.action_nvec: ", nvec,
+                     " for continuous actions, which have none"));
+  }
+  int64_t sum = 0;
+  for (int64_t choices : spec.action_nvec) {
+    // Each bounded before adding, so the sum cannot overflow.
+    if (choices < 1 || choices > spec.action_size) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          "spec.action_nvec: ", nvec, ", expected choices in [1, action_size ",
+          spec.action_size, "] each"));
+    }
+    sum += choices;
+    if (sum > spec.action_size) break;
+  }
+  if (sum != spec.action_size) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("spec.action_nvec: ", nvec, " sums to ",
+                     sum > spec.action_size ? "at least " : "", sum,
+                     ", expected action_size ", spec.action_size));
+  }
+  return absl::OkStatus();
 }
 
 absl::Status CheckObservationLayout(const EnvSpec& spec) {

@@ -34,17 +34,31 @@ struct EnvSpec {
   int64_t action_size = 0;
   std::vector<double> action_low;
   std::vector<double> action_high;
+  // Several discrete choices at once (Gymnasium's MultiDiscrete, and
+  // MultiBinary as choices of 2): the number of choices of each of the
+  // action's values, with discrete true and action_size their sum (the
+  // policy's logits, one categorical head per value). Empty for Discrete
+  // (one value of action_size choices) and continuous actions.
+  std::vector<int64_t> action_nvec;
   // Discrete only: at every step the environment says which actions are
-  // legal (Environment::ActionMask); actors sample only those and the
-  // learner scores the policy on them alone.
+  // legal (Environment::ActionMask, action_size entries: each head's
+  // choices in turn); actors sample only those and the learner scores the
+  // policy on them alone.
   bool action_masks = false;
   // Steps after which the time limit truncates an episode (0: none).
   int64_t max_episode_steps = 1000;
   // Simulated seconds per step (physics timestep x frame skip).
   double control_dt = 0.0;
 
-  // "continuous:6", "discrete:4" or "discrete:4 masked".
+  // "continuous:6", "discrete:4", "multidiscrete:3x2" or
+  // "discrete:4 masked".
   std::string ActionString() const;
+  // Values per action: 1 (Discrete), one per head (MultiDiscrete), or the
+  // continuous dimension.
+  int64_t action_width() const;
+  // The discrete heads' choices: {action_size} for Discrete, action_nvec
+  // for MultiDiscrete; empty for continuous actions.
+  std::vector<int64_t> action_heads() const;
   bool byte_observations() const { return observation_high > 0; }
   // "17" or "uint8 4x10x10".
   std::string ObservationString() const;
@@ -104,18 +118,24 @@ class Environment {
 };
 
 // Checks an action's size and finiteness against the spec (and, if
-// discrete, that it is an integer in range); the message names the entry.
+// discrete, that each value is an integer in its head's range); the
+// message names the entry.
 absl::Status CheckAction(const EnvSpec& spec, absl::Span<const double> action);
 
 // A mask as Environment::ActionMask must write it: action_size entries,
-// each 0 or 1, at least one 1, for a spec with action_masks. The message
-// names what is wrong.
+// each 0 or 1, at least one 1 in every head, for a spec with action_masks. The
+// message names what is wrong.
 absl::Status CheckActionMask(const EnvSpec& spec,
                              absl::Span<const uint8_t> mask);
 
 // `env`'s mask for its current state, checked (CheckActionMask); empty
 // when its spec has no action masks.
 absl::StatusOr<std::vector<uint8_t>> ReadActionMask(const Environment& env);
+
+// The action fields agree: action_nvec is empty, or belongs to discrete
+// actions with each value's choices >= 1 and their sum action_size. The
+// message names the field.
+absl::Status CheckActionLayout(const EnvSpec& spec);
 
 // The observation fields agree: observation_shape is empty or three
 // positive dimensions whose product is observation_size, and

@@ -44,6 +44,7 @@ absl::StatusOr<MlpPolicyKernel> MlpPolicyKernel::Create(
   kernel.spec_ = spec;
   kernel.widest_ = spec.observation_size;
   kernel.discrete_ = policy.discrete();
+  kernel.heads_ = spec.action_heads();
   kernel.clip_ = observation_clip;
   kernel.mean_ = DoubleVector(normalizer.mean());
   kernel.scale_ = DoubleVector(at::sqrt(normalizer.var() + 1e-8));
@@ -227,27 +228,37 @@ void MlpPolicyKernel::Act(const float* outputs, int64_t rows,
     }
     return;
   }
-  // Softmax per row, a categorical draw, and the log-softmax at it.
-  float* probabilities = GrowScratch(probabilities_, rows * n);
-  float* maxima = GrowScratch(row_max_, rows);
-  float* log_sums = GrowScratch(row_log_sum_, rows);
-  for (int64_t r = 0; r < rows; ++r) {
-    const float* logits = outputs + r * n;
-    const float top = *std::max_element(logits, logits + n);
-    float sum = 0.0f;
-    for (int64_t i = 0; i < n; ++i) {
-      probabilities[r * n + i] = std::exp(logits[i] - top);
-      sum += probabilities[r * n + i];
+  // Head by head (one for Discrete), as PolicyNetworkImpl::Act draws:
+  // softmax per row, a categorical draw, and the log-softmax at it, the
+  // heads' log-probabilities summed.
+  const int64_t width = action_width();
+  std::fill(log_probs, log_probs + rows, 0.0f);
+  int64_t offset = 0;
+  for (int64_t h = 0; h < width; offset += heads_[h], ++h) {
+    const int64_t choices = heads_[h];
+    float* probabilities = GrowScratch(probabilities_, rows * choices);
+    float* maxima = GrowScratch(row_max_, rows);
+    float* log_sums = GrowScratch(row_log_sum_, rows);
+    for (int64_t r = 0; r < rows; ++r) {
+      const float* logits = outputs + r * n + offset;
+      float* p = probabilities + r * choices;
+      const float top = *std::max_element(logits, logits + choices);
+      float sum = 0.0f;
+      for (int64_t i = 0; i < choices; ++i) {
+        p[i] = std::exp(logits[i] - top);
+        sum += p[i];
+      }
+      for (int64_t i = 0; i < choices; ++i) p[i] /= sum;
+      maxima[r] = top;
+      log_sums[r] = std::log(sum);
     }
-    for (int64_t i = 0; i < n; ++i) probabilities[r * n + i] /= sum;
-    maxima[r] = top;
-    log_sums[r] = std::log(sum);
-  }
-  int64_t* indices = GrowScratch(indices_, rows);
-  SampleCategorical(generator, probabilities, rows, n, indices);
-  for (int64_t r = 0; r < rows; ++r) {
-    actions[r] = static_cast<float>(indices[r]);
-    log_probs[r] = outputs[r * n + indices[r]] - maxima[r] - log_sums[r];
+    int64_t* indices = GrowScratch(indices_, rows);
+    SampleCategorical(generator, probabilities, rows, choices, indices);
+    for (int64_t r = 0; r < rows; ++r) {
+      actions[r * width + h] = static_cast<float>(indices[r]);
+      log_probs[r] +=
+          outputs[r * n + offset + indices[r]] - maxima[r] - log_sums[r];
+    }
   }
 }
 

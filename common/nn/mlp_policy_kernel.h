@@ -42,8 +42,12 @@ class MlpPolicyKernel {
 
   // Means (continuous) or logits (discrete) per row.
   int64_t output_size() const { return output_size_; }
-  // k action values per row, or 1 (the index, as a float) when discrete.
-  int64_t action_width() const { return discrete_ ? 1 : output_size_; }
+  // k action values per row, or one index (as a float) per discrete head.
+  int64_t action_width() const {
+    return discrete_ ? static_cast<int64_t>(heads_.size()) : output_size_;
+  }
+  // The discrete heads' choices (EnvSpec::action_heads).
+  const std::vector<int64_t>& heads() const { return heads_; }
 
   // Floats per row of a recurrent policy's state; 0 for a feed-forward one.
   int64_t state_size() const {
@@ -83,6 +87,7 @@ class MlpPolicyKernel {
 
   EnvSpec spec_;
   bool discrete_ = false;
+  std::vector<int64_t> heads_;  // discrete only
   int64_t output_size_ = 0;
   double clip_ = 0.0;
   std::vector<double> mean_;   // the normaliser's, [observation_size]

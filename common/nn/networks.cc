@@ -76,7 +76,7 @@ at::Tensor ObservationsForNetwork(const EnvSpec& spec,
 
 PolicyNetworkImpl::PolicyNetworkImpl(const EnvSpec& spec,
                                      const NetworkConfig& config)
-    : spec_(spec), discrete_(spec.discrete) {
+    : spec_(spec), discrete_(spec.discrete), heads_(spec.action_heads()) {
   if (config.recurrent()) {
     trunk_ = register_module("trunk", RecurrentTrunk(spec, config));
     body_ = register_module("body",
@@ -112,33 +112,65 @@ at::Tensor PolicyNetworkImpl::Unroll(const at::Tensor& observations,
   return Head(trunk_->Unroll(observations, starts, state));
 }
 
+std::vector<at::Tensor> PolicyNetworkImpl::Heads(
+    const at::Tensor& output) const {
+  if (heads_.size() == 1) return {output};
+  return output.split_with_sizes(heads_, -1);
+}
+
 at::Tensor PolicyNetworkImpl::LogProb(const at::Tensor& output,
                                       const at::Tensor& actions) {
-  if (discrete_) return CategoricalLogProb(output, actions.reshape({-1}));
-  return DiagGaussianLogProb(output, log_std_, actions);
+  if (!discrete_) return DiagGaussianLogProb(output, log_std_, actions);
+  if (heads_.size() == 1) {
+    return CategoricalLogProb(output, actions.reshape({-1}));
+  }
+  // Independent heads: the action's log-probability is their sum.
+  const std::vector<at::Tensor> heads = Heads(output);
+  const at::Tensor values = actions.reshape({-1, HeadCount()});
+  at::Tensor sum = CategoricalLogProb(heads[0], values.select(1, 0));
+  for (int64_t h = 1; h < HeadCount(); ++h) {
+    sum = sum + CategoricalLogProb(heads[h], values.select(1, h));
+  }
+  return sum;
 }
 
 at::Tensor PolicyNetworkImpl::Entropy(const at::Tensor& output) {
-  if (discrete_) return CategoricalEntropy(output);
-  return DiagGaussianEntropy(output, log_std_);
+  if (!discrete_) return DiagGaussianEntropy(output, log_std_);
+  const std::vector<at::Tensor> heads = Heads(output);
+  at::Tensor sum = CategoricalEntropy(heads[0]);
+  for (int64_t h = 1; h < HeadCount(); ++h) {
+    sum = sum + CategoricalEntropy(heads[h]);
+  }
+  return sum;
 }
 
 at::Tensor PolicyNetworkImpl::Kl(const at::Tensor& old_output,
                                  const at::Tensor& old_log_std,
                                  const at::Tensor& output) {
-  if (discrete_) return CategoricalKl(old_output, output);
-  return DiagGaussianKl(old_output, old_log_std, output, log_std_);
+  if (!discrete_) {
+    return DiagGaussianKl(old_output, old_log_std, output, log_std_);
+  }
+  const std::vector<at::Tensor> old_heads = Heads(old_output);
+  const std::vector<at::Tensor> heads = Heads(output);
+  at::Tensor sum = CategoricalKl(old_heads[0], heads[0]);
+  for (int64_t h = 1; h < HeadCount(); ++h) {
+    sum = sum + CategoricalKl(old_heads[h], heads[h]);
+  }
+  return sum;
 }
 
 at::Tensor PolicyNetworkImpl::Act(const at::Tensor& output, bool deterministic,
                                   at::Generator generator) {
   if (discrete_) {
-    const at::Tensor index =
-        deterministic
-            ? output.argmax(-1)
-            : at::multinomial(at::softmax(output, -1), 1, false, generator)
-                  .squeeze(-1);
-    return index.to(output.scalar_type()).unsqueeze(-1);
+    // Head by head, each over every row: the order MlpPolicyKernel draws in.
+    std::vector<at::Tensor> indices;
+    for (const at::Tensor& head : Heads(output)) {
+      indices.push_back(deterministic ? head.argmax(-1)
+                                      : at::multinomial(at::softmax(head, -1),
+                                                        1, false, generator)
+                                            .squeeze(-1));
+    }
+    return at::stack(indices, -1).to(output.scalar_type());
   }
   if (deterministic) return output;
   return output + at::exp(log_std_) * at::normal(0.0, 1.0, output.sizes(),

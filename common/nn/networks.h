@@ -67,18 +67,24 @@ class PolicyNetworkImpl : public torch::nn::Module {
                     const at::Tensor& state);
 
   // From forward()'s output: per-sample log-probabilities and entropies
-  // [B]. Discrete actions are indices stored as floats [B, 1] or [B].
+  // [B]. Discrete actions are indices stored as floats [B, heads] (or [B]
+  // for one head); MultiDiscrete heads are independent categoricals over
+  // their slices of the logits, whose log-probabilities, entropies and KL
+  // divergences sum.
   at::Tensor LogProb(const at::Tensor& output, const at::Tensor& actions);
   at::Tensor Entropy(const at::Tensor& output);
   // KL(old || this) per sample from both policies' outputs.
   at::Tensor Kl(const at::Tensor& old_output, const at::Tensor& old_log_std,
                 const at::Tensor& output);
-  // A sampled action [B, k] ([B, 1] indices as floats when discrete), or
-  // the mode when `deterministic`.
+  // A sampled action [B, k] ([B, heads] indices as floats when discrete),
+  // or the mode when `deterministic`.
   at::Tensor Act(const at::Tensor& output, bool deterministic,
                  at::Generator generator);
 
   bool discrete() const { return discrete_; }
+  // The discrete heads' choices (EnvSpec::action_heads).
+  const std::vector<int64_t>& heads() const { return heads_; }
+  int64_t HeadCount() const { return static_cast<int64_t>(heads_.size()); }
   const EnvSpec& spec() const { return spec_; }
   // Undefined for discrete policies.
   const at::Tensor& log_std() const { return log_std_; }
@@ -88,8 +94,12 @@ class PolicyNetworkImpl : public torch::nn::Module {
   const TanhMlp& body() const { return body_; }
 
  private:
+  // Each head's slice of a discrete policy's logits.
+  std::vector<at::Tensor> Heads(const at::Tensor& output) const;
+
   EnvSpec spec_;
   bool discrete_;
+  std::vector<int64_t> heads_;
   RecurrentTrunk trunk_{nullptr};  // recurrent only
   ConvTorso conv_{nullptr};        // images only
   TanhMlp body_{nullptr};

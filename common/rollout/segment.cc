@@ -192,20 +192,24 @@ absl::Status CheckActionMasks(const Segment& segment, const EnvSpec& spec) {
   }
   const at::Tensor masks = segment.action_masks.contiguous();
   const at::Tensor actions = segment.actions.contiguous();
-  const bool* mask = masks.data_ptr<bool>();
+  const std::vector<int64_t> heads = spec.action_heads();
+  const bool* row = masks.data_ptr<bool>();
   const float* action = actions.data_ptr<float>();
-  for (int64_t t = 0; t < steps; ++t, mask += spec.action_size) {
-    if (std::none_of(mask, mask + spec.action_size,
-                     [](bool legal) { return legal; })) {
-      return absl::InvalidArgumentError(
-          absl::StrCat("segment field action_masks is all zero at step ", t,
-                       " (no legal action)"));
-    }
-    const int64_t taken = static_cast<int64_t>(action[t]);
-    if (!mask[taken]) {
-      return absl::InvalidArgumentError(
-          absl::StrCat("segment field actions holds ", taken, " at step ", t,
-                       ", which that step's action mask makes illegal"));
+  for (int64_t t = 0; t < steps; ++t) {
+    for (size_t h = 0; h < heads.size(); row += heads[h], ++h, ++action) {
+      const std::string value =
+          heads.size() > 1 ? absl::StrCat(" (value ", h, ")") : "";
+      if (std::none_of(row, row + heads[h], [](bool legal) { return legal; })) {
+        return absl::InvalidArgumentError(
+            absl::StrCat("segment field action_masks is all zero at step ", t,
+                         value, " (no legal action)"));
+      }
+      const int64_t taken = static_cast<int64_t>(*action);
+      if (!row[taken]) {
+        return absl::InvalidArgumentError(absl::StrCat(
+            "segment field actions holds ", taken, " at step ", t, value,
+            ", which that step's action mask makes illegal"));
+      }
     }
   }
   return absl::OkStatus();
@@ -216,12 +220,14 @@ absl::Status CheckActionMasks(const Segment& segment, const EnvSpec& spec) {
 absl::Status CheckDiscreteActions(const Segment& segment, const EnvSpec& spec) {
   if (spec.discrete) {
     const at::Tensor a = segment.actions;
+    const at::Tensor choices =
+        at::tensor(spec.action_heads(), at::kLong).to(a.scalar_type());
     if (!(a == a.floor()).all().item<bool>() || (a < 0).any().item<bool>() ||
-        (a >= static_cast<double>(spec.action_size)).any().item<bool>()) {
+        (a >= choices).any().item<bool>()) {
       return absl::InvalidArgumentError(absl::StrCat(
           "segment field actions holds values that are not action indices "
           "in [0, ",
-          spec.action_size, ")"));
+          absl::StrJoin(spec.action_heads(), "), [0, "), ")"));
     }
   }
   return CheckActionMasks(segment, spec);
@@ -243,7 +249,7 @@ absl::Status ValidateSegment(const Segment& segment, const EnvSpec& spec,
   const double max_abs_observation =
       spec.byte_observations() ? static_cast<double>(spec.observation_high)
                                : limits.max_abs_observation;
-  const int64_t act = spec.discrete ? 1 : spec.action_size;
+  const int64_t act = spec.action_width();
   const int64_t truncations =
       segment.truncated.defined() && segment.truncated.numel() == steps &&
               segment.truncated.scalar_type() == at::kBool

@@ -200,7 +200,7 @@ class RolloutActions {
         trained_(trained),
         deterministic_(!request.stochastic),
         rng_(request.seed),
-        action_(spec.discrete ? 1 : spec.action_size) {}
+        action_(spec.action_width()) {}
 
   void StartEpisode() {
     if (trained_.has_value()) trained_->StartEpisode();
@@ -212,13 +212,18 @@ class RolloutActions {
     if (trained_.has_value()) {
       action_ = trained_->Act(observation, deterministic_, mask);
     } else if (spec_.discrete) {
-      std::vector<int64_t> legal;
-      for (int64_t i = 0; i < spec_.action_size; ++i) {
-        if (mask.empty() || mask[i]) legal.push_back(i);
+      // Uniform over each head's legal choices.
+      const std::vector<int64_t> heads = spec_.action_heads();
+      int64_t offset = 0;
+      for (size_t h = 0; h < heads.size(); offset += heads[h], ++h) {
+        std::vector<int64_t> legal;
+        for (int64_t i = 0; i < heads[h]; ++i) {
+          if (mask.empty() || mask[offset + i]) legal.push_back(i);
+        }
+        action_[h] =
+            static_cast<double>(legal[std::uniform_int_distribution<size_t>(
+                0, legal.size() - 1)(rng_)]);
       }
-      action_[0] =
-          static_cast<double>(legal[std::uniform_int_distribution<size_t>(
-              0, legal.size() - 1)(rng_)]);
     } else {
       for (size_t i = 0; i < action_.size(); ++i) {
         // Unbounded actuators get actions in [-1, 1].

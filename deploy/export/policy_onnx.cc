@@ -240,16 +240,41 @@ std::string AddMask(GraphBuilder& g, onnx::GraphProto& graph,
   return out("Add", {kept, illegal});
 }
 
+// The most likely action: int64 [batch] for Discrete, [batch, heads] for
+// MultiDiscrete (each head's slice of the logits in turn).
+void AddDiscreteAction(GraphBuilder& g, onnx::GraphProto& graph,
+                       const EnvSpec& spec, const std::string& output) {
+  if (spec.action_nvec.empty()) {
+    onnx::NodeProto& argmax = g.Node("ArgMax", {output}, "action");
+    GraphBuilder::Ints(argmax, "axis", {1});
+    GraphBuilder::Ints(argmax, "keepdims", {0});
+    g.Value(graph.mutable_output(), "action", onnx::TensorProto::INT64, {-1});
+    return;
+  }
+  std::vector<std::string> choices;
+  int64_t offset = 0;
+  for (int64_t n : spec.action_nvec) {
+    const std::string head = GraphBuilder::Out(g.Node(
+        "Slice", {output, g.Int64s("starts", {offset}),
+                  g.Int64s("ends", {offset + n}), g.Int64s("axes", {1})}));
+    onnx::NodeProto& argmax = g.Node("ArgMax", {head});
+    GraphBuilder::Ints(argmax, "axis", {1});
+    GraphBuilder::Ints(argmax, "keepdims", {1});
+    choices.push_back(GraphBuilder::Out(argmax));
+    offset += n;
+  }
+  GraphBuilder::Ints(g.Node("Concat", choices, "action"), "axis", {1});
+  g.Value(graph.mutable_output(), "action", onnx::TensorProto::INT64,
+          {-1, static_cast<int64_t>(spec.action_nvec.size())});
+}
+
 // The graph's outputs from the policy head's `output`.
 void AddOutputs(GraphBuilder& g, onnx::GraphProto& graph, const EnvSpec& spec,
                 PolicyNetworkImpl& policy, const std::string& output,
                 bool distribution) {
   const int64_t k = spec.action_size;
   if (spec.discrete) {
-    onnx::NodeProto& argmax = g.Node("ArgMax", {output}, "action");
-    GraphBuilder::Ints(argmax, "axis", {1});
-    GraphBuilder::Ints(argmax, "keepdims", {0});
-    g.Value(graph.mutable_output(), "action", onnx::TensorProto::INT64, {-1});
+    AddDiscreteAction(g, graph, spec, output);
     if (distribution) {
       g.Node("Identity", {output}, "logits");
       g.Value(graph.mutable_output(), "logits", onnx::TensorProto::FLOAT,

@@ -32,6 +32,7 @@ absl::StatusOr<FlatActorCritic> FlatActorCritic::Create(
   FlatActorCritic flat;
   flat.spec_ = policy.spec();
   flat.discrete_ = policy.discrete();
+  flat.heads_ = policy.heads();
   absl::StatusOr<int64_t> size = flat.TakeParameters(std::move(parameters));
   if (!size.ok()) return size.status();
   if (absl::Status status = flat.LayOutNetworks(policy, value); !status.ok()) {
@@ -312,33 +313,43 @@ void FlatActorCritic::GaussianHead(const float* actions, int64_t rows) {
 void FlatActorCritic::CategoricalHead(const float* actions,
                                       const uint8_t* masks, int64_t rows) {
   const int64_t n = spec_.action_size;
+  const int64_t width = static_cast<int64_t>(heads_.size());
   // The policy layer's outputs are not read again by Backward (no tanh
   // after it), so the masked logits replace them; an illegal action's
   // probability is then 0 and so is every gradient through its logit.
   float* logits = policy_.outputs.back().data();
   if (masks != nullptr) MaskLogitsInPlace(logits, masks, rows, n);
   float* log_p = GrowScratch(head_, rows * n);
-  float* entropies = GrowScratch(entropies_, rows);
+  float* entropies = GrowScratch(entropies_, rows * width);
   double entropy_sum = 0.0;
   for (int64_t r = 0; r < rows; ++r) {
-    const float* row = logits + r * n;
-    const float max = *std::max_element(row, row + n);
-    float sum = 0.0f;
-    for (int64_t j = 0; j < n; ++j) sum += std::exp(row[j] - max);
-    const float log_sum = std::log(sum) + max;
-    float entropy = 0.0f;
-    for (int64_t j = 0; j < n; ++j) {
-      log_p[r * n + j] = row[j] - log_sum;
-      entropy -= std::exp(log_p[r * n + j]) * log_p[r * n + j];
+    float log_prob = 0.0f;
+    int64_t offset = 0;
+    // Independent heads (one for Discrete): log-probabilities and
+    // entropies sum over them.
+    for (int64_t h = 0; h < width; offset += heads_[h], ++h) {
+      const int64_t choices = heads_[h];
+      const float* row = logits + r * n + offset;
+      float* out = log_p + r * n + offset;
+      const float max = *std::max_element(row, row + choices);
+      float sum = 0.0f;
+      for (int64_t j = 0; j < choices; ++j) sum += std::exp(row[j] - max);
+      const float log_sum = std::log(sum) + max;
+      float entropy = 0.0f;
+      for (int64_t j = 0; j < choices; ++j) {
+        out[j] = row[j] - log_sum;
+        entropy -= std::exp(out[j]) * out[j];
+      }
+      entropies[r * width + h] = entropy;
+      entropy_sum += entropy;
+      // Ingest refuses such actions; should one slip through, the update's
+      // loss turns non-finite and the learner's guard undoes it.
+      const int64_t action = static_cast<int64_t>(actions[r * width + h]);
+      log_prob += action >= 0 && action < choices
+                      ? out[action]
+                      : std::numeric_limits<float>::quiet_NaN();
     }
-    entropies[r] = entropy;
-    entropy_sum += entropy;
-    // Ingest refuses such actions; should one slip through, the update's
-    // loss turns non-finite and the learner's guard undoes it.
-    const int64_t action = static_cast<int64_t>(actions[r]);
-    log_probs_[r] = action >= 0 && action < n
-                        ? log_p[r * n + action]
-                        : std::numeric_limits<float>::quiet_NaN();
+    log_probs_[r] = log_prob;
   }
   mean_entropy_ = entropy_sum / static_cast<double>(std::max<int64_t>(rows, 1));
 }
@@ -350,16 +361,23 @@ void FlatActorCritic::Backward(const float* d_log_probs, double entropy_weight,
   float* d_output = GrowScratch(policy_gradient_, rows * k);
   if (discrete_) {
     const float* log_p = head_.data();
-    // d entropy_r / d logit_j = -p_j (log p_j + entropy_r).
+    const int64_t width = static_cast<int64_t>(heads_.size());
+    // In head h: d entropy_rh / d logit_j = -p_j (log p_j + entropy_rh),
+    // and d log_prob_r / d logit_j = [j is the head's action] - p_j.
     const float per_row = static_cast<float>(
         entropy_weight / static_cast<double>(std::max<int64_t>(rows, 1)));
     for (int64_t r = 0; r < rows; ++r) {
-      const int64_t action = static_cast<int64_t>(actions_[r]);
-      for (int64_t j = 0; j < k; ++j) {
-        const int64_t i = r * k + j;
-        const float p = std::exp(log_p[i]);
-        d_output[i] = d_log_probs[r] * ((j == action ? 1.0f : 0.0f) - p) -
-                      per_row * p * (log_p[i] + entropies_[r]);
+      int64_t offset = 0;
+      for (int64_t h = 0; h < width; offset += heads_[h], ++h) {
+        const int64_t action =
+            offset + static_cast<int64_t>(actions_[r * width + h]);
+        const float entropy = entropies_[r * width + h];
+        for (int64_t j = offset; j < offset + heads_[h]; ++j) {
+          const int64_t i = r * k + j;
+          const float p = std::exp(log_p[i]);
+          d_output[i] = d_log_probs[r] * ((j == action ? 1.0f : 0.0f) - p) -
+                        per_row * p * (log_p[i] + entropy);
+        }
       }
     }
   } else {

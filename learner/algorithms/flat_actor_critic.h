@@ -43,7 +43,9 @@ class FlatActorCritic {
   // Where each parameter tensor's values begin in the flat arrays.
   const std::vector<int64_t>& offsets() const { return offsets_; }
   int64_t observation_size() const { return spec_.observation_size; }
-  int64_t action_width() const { return discrete_ ? 1 : spec_.action_size; }
+  int64_t action_width() const {
+    return discrete_ ? static_cast<int64_t>(heads_.size()) : spec_.action_size;
+  }
 
   // The modules' parameters into the flat array, and back.
   void Pull();
@@ -133,6 +135,7 @@ class FlatActorCritic {
 
   EnvSpec spec_;
   bool discrete_ = false;
+  std::vector<int64_t> heads_;  // discrete: each head's choices
   std::vector<at::Tensor> tensors_;
   std::vector<int64_t> offsets_;
   std::vector<float> parameters_;
@@ -154,7 +157,7 @@ class FlatActorCritic {
   // Per row and action: z = (action - mean) / std (Gaussian), or the
   // log-softmax of the logits (categorical).
   std::vector<float> head_;
-  std::vector<float> entropies_;  // per row (categorical)
+  std::vector<float> entropies_;  // per row and head (categorical)
   std::vector<float> policy_gradient_, value_gradient_, scratch_;
 };
 

@@ -85,9 +85,15 @@ at::Tensor Ex2Bonus::Inputs(const std::vector<Rollout>& rollouts) const {
     }
     at::Tensor actions = rollout.actions;
     if (spec_.discrete) {
-      actions =
-          at::one_hot(actions.reshape({-1}).to(at::kLong), spec_.action_size)
-              .to(at::kFloat);
+      // One one-hot per head, side by side: action_size values in all.
+      std::vector<at::Tensor> hots;
+      const std::vector<int64_t> heads = spec_.action_heads();
+      for (size_t h = 0; h < heads.size(); ++h) {
+        hots.push_back(at::one_hot(
+            actions.select(1, static_cast<int64_t>(h)).to(at::kLong),
+            heads[h]));
+      }
+      actions = at::cat(hots, 1).to(at::kFloat);
     } else {
       // What the environment executes, scaled to [-1, 1]: a policy sample
       // beyond the bounds (the actor stores it unclipped, for its

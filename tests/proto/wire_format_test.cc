@@ -708,7 +708,11 @@ TEST(EnvSpecWireTest, RoundTrips) {
   EnvSpec masked = discrete;
   masked.name = "Masked";
   masked.action_masks = true;
-  for (const EnvSpec& spec : {continuous, discrete, pixels, masked}) {
+  EnvSpec multi = masked;
+  multi.name = "Multi";
+  multi.action_size = 7;
+  multi.action_nvec = {3, 4};
+  for (const EnvSpec& spec : {continuous, discrete, pixels, masked, multi}) {
     absl::StatusOr<EnvSpec> back = SpecOverWire(spec);
     ASSERT_TRUE(back.ok()) << back.status();
     EXPECT_TRUE(CheckSameSpec(spec, *back).ok()) << CheckSameSpec(spec, *back);
@@ -719,6 +723,7 @@ TEST(EnvSpecWireTest, RoundTrips) {
     EXPECT_EQ(back->observation_shape, spec.observation_shape);
     EXPECT_EQ(back->observation_high, spec.observation_high);
     EXPECT_EQ(back->action_masks, spec.action_masks);
+    EXPECT_EQ(back->action_nvec, spec.action_nvec);
   }
 }
 
@@ -739,6 +744,15 @@ TEST(EnvSpecWireTest, RefusesImpossibleSpecs) {
        "spec.action_high: 7 values, expected 6 for continuous:6"},
       {[](EnvSpec& s) { s.action_masks = true; },
        "spec.action_masks: true for continuous actions, which take no masks"},
+      {[](EnvSpec& s) {
+         s.discrete = true;
+         s.action_low.clear();
+         s.action_high.clear();
+         s.action_nvec = {2, 5};
+       },
+       "spec.action_nvec: 2x5 sums to at least 7, expected action_size 6"},
+      {[](EnvSpec& s) { s.action_nvec = {6}; },
+       "spec.action_nvec: 6 for continuous actions, which have none"},
       {[](EnvSpec& s) {
          s.discrete = true;
          s.action_high.clear();
@@ -850,6 +864,10 @@ TEST(EnvSpecWireTest, CheckSameSpecNamesTheFirstDifference) {
        "env spec differs in observation_high: expected 0, got 1"},
       {[](EnvSpec& s) { s.action_masks = true; },
        "env spec differs in action_masks: expected false, got true"},
+      {[](EnvSpec& s) {
+         s.action_nvec = {2, 4};
+       },
+       "env spec differs in action_nvec: expected none, got 2x4"},
       // Several differences: the first in declaration order is named.
       {[](EnvSpec& s) {
          s.control_dt = 0.01;

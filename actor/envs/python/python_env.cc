@@ -345,6 +345,26 @@ class PythonEnv final : public Environment {
   }
 
   absl::Status DescribeActions(const py::tuple& space) {
+    if (space[0].cast<std::string>() == "multidiscrete") {
+      spec_.discrete = true;
+      spec_.action_nvec = space[4].cast<std::vector<int64_t>>();
+      action_shape_ = space[2].cast<std::vector<int64_t>>();
+      action_dtype_ = py::dtype(space[3].cast<std::string>());
+      spec_.action_size = 0;
+      for (int64_t choices : spec_.action_nvec) {
+        if (choices < 1) {
+          return absl::InvalidArgumentError(
+              absl::StrCat(spec_.name, ": the action space has a value of ",
+                           choices, " choices"));
+        }
+        spec_.action_size += choices;
+      }
+      if (spec_.action_nvec.empty()) {
+        return absl::InvalidArgumentError(
+            absl::StrCat(spec_.name, ": the action space has no values"));
+      }
+      return absl::OkStatus();
+    }
     if (space[0].cast<std::string>() == "discrete") {
       spec_.discrete = true;
       spec_.action_size = space[1].cast<int64_t>();
@@ -474,6 +494,13 @@ class PythonEnv final : public Environment {
   // The action as the env takes it: an int, or an array of the space's
   // shape and dtype, clipped to its bounds (GIL held).
   py::object Action(absl::Span<const double> action) const {
+    if (!spec_.action_nvec.empty()) {
+      py::array_t<int64_t> values(action_shape_);
+      for (size_t i = 0; i < action.size(); ++i) {
+        values.mutable_data()[i] = static_cast<int64_t>(action[i]);
+      }
+      return values.attr("astype")(action_dtype_);
+    }
     if (spec_.discrete) return py::int_(static_cast<int64_t>(action[0]));
     py::array out(action_dtype_, action_shape_);
     const size_t n = action.size();

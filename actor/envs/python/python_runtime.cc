@@ -83,6 +83,21 @@ def describe_space(space, what):
             "discrete space: flatten it (gymnasium.wrappers."
             "FlattenObservation, or one Box of the concatenated parts)")
     shape = getattr(space, "shape", None)
+    if hasattr(space, "nvec") and what == "action":
+        start = np.asarray(getattr(space, "start", 0))
+        if np.any(start != 0):
+            raise TypeError(f"the {what} space is MultiDiscrete with a start; "
+                            "vantage's discrete actions start at 0")
+        nvec = np.asarray(space.nvec, dtype=np.int64)
+        return ("multidiscrete", int(nvec.size), tuple(nvec.shape),
+                np.dtype(space.dtype).str, nvec.ravel().tolist(), [])
+    if (hasattr(space, "n") and shape is not None and tuple(shape) != ()
+            and not hasattr(space, "low") and what == "action"):
+        # MultiBinary: n choices of 2 (n may be a shape).
+        shape = tuple(int(d) for d in shape)
+        size = int(np.prod(shape))
+        return ("multidiscrete", size, shape,
+                np.dtype(getattr(space, "dtype", np.int8)).str, [2] * size, [])
     if hasattr(space, "n") and (shape is None or tuple(shape) == ()):
         start = int(getattr(space, "start", 0))
         if start != 0:

@@ -52,6 +52,7 @@ struct Case {
   int64_t observation_high;
   std::vector<int64_t> hidden;
   int64_t actions;
+  std::vector<int64_t> nvec = {};  // MultiDiscrete heads (sum: actions)
 };
 
 // Several steps of acting at each batch size, from generators that start
@@ -60,6 +61,7 @@ struct Case {
 void CompareWithLibTorch(const Case& c) {
   EnvSpec spec = VectorSpec(c.discrete, 7, c.actions);
   spec.observation_high = c.observation_high;
+  spec.action_nvec = c.nvec;
   NetworkConfig config;
   config.hidden = c.hidden;
   PolicyNetwork policy(spec, config);
@@ -103,7 +105,8 @@ void CompareWithLibTorch(const Case& c) {
 // rows zeroed on both sides where an episode starts, and the outputs,
 // actions and log-probabilities agree.
 void CompareRecurrentWithLibTorch(Core core, const Case& c) {
-  const EnvSpec spec = VectorSpec(c.discrete, 7, c.actions);
+  EnvSpec spec = VectorSpec(c.discrete, 7, c.actions);
+  spec.action_nvec = c.nvec;
   NetworkConfig config;
   config.hidden = c.hidden;
   config.core = core;
@@ -177,6 +180,13 @@ TEST(MlpPolicyKernelTest, LinearGaussianAgreesWithLibTorch) {
 
 TEST(MlpPolicyKernelTest, CategoricalAgreesWithLibTorch) {
   CompareWithLibTorch({true, 0, {64, 64}, 5});
+}
+
+// MultiDiscrete: head by head, each over every row, the same draws as
+// LibTorch's; log-probabilities summed over the heads.
+TEST(MlpPolicyKernelTest, MultiDiscreteAgreesWithLibTorch) {
+  CompareWithLibTorch({true, 0, {32}, 9, {2, 4, 3}});
+  CompareRecurrentWithLibTorch(Core::kGru, {true, 0, {16}, 7, {5, 2}});
 }
 
 TEST(MlpPolicyKernelTest, ByteObservationsAgreeWithLibTorch) {

@@ -93,6 +93,30 @@ TEST(SegmentTest, MaskedActionsNeedMasksThatAllowWhatWasTaken) {
                         "(discrete:4) take no masks"));
 }
 
+// MultiDiscrete: one index per head in its range, and with masks a legal
+// choice in every head.
+TEST(SegmentTest, MultiDiscreteActionsAreCheckedHeadByHead) {
+  EnvSpec spec = MaskedSpec();
+  spec.action_nvec = {2, 3};
+  spec.action_size = 5;
+  Segment s = ValidSegment();
+  s.actions = at::tensor({0, 2, 1, 0, 1, 1, 0, 2}, at::kFloat).reshape({4, 2});
+  s.action_masks = at::ones({4, 5}, at::kBool);
+  EXPECT_TRUE(ValidateSegment(s, spec, 128).ok())
+      << ValidateSegment(s, spec, 128);
+  s.actions[2][1] = 3.0f;
+  EXPECT_THAT(ValidateSegment(s, spec, 128).message(),
+              HasSubstr("not action indices in [0, 2), [0, 3)"));
+  s.actions[2][1] = 1.0f;
+  s.action_masks[3][4] = false;  // step 3 took 2 in head 1
+  EXPECT_THAT(ValidateSegment(s, spec, 128).message(),
+              HasSubstr("actions holds 2 at step 3 (value 1), which that "
+                        "step's action mask makes illegal"));
+  s.action_masks[1].slice(0, 0, 2).fill_(false);
+  EXPECT_THAT(ValidateSegment(s, spec, 128).message(),
+              HasSubstr("action_masks is all zero at step 1 (value 0)"));
+}
+
 TEST(SegmentTest, EveryDefectIsNamed) {
   Segment s = ValidSegment();
   s.observations = at::zeros({4, 3});

@@ -156,6 +156,24 @@ TEST(PolicyOnnxTest, AMaskedCategoricalPolicyAgreesUnderOpenCv) {
             kRows / 4);
 }
 
+// MultiDiscrete (3 heads of 4, 2 and 5 choices): each head's most likely
+// choice, side by side, as vantage's deterministic action.
+TEST(PolicyOnnxTest, AMultiDiscretePolicyAgreesUnderOpenCv) {
+  at::manual_seed(5);
+  EnvSpec spec = VectorSpec(true, 9, 11);
+  spec.action_nvec = {4, 2, 5};
+  const Exported e = Export(spec, NetworkConfig());
+  const std::vector<cv::Mat> out =
+      RunOnOpenCv(e.model, e.observations, {"action", "logits"});
+  ASSERT_EQ(out.size(), 2u);
+  const at::Tensor heads = at::stack(
+      {e.output.slice(1, 0, 4).argmax(1), e.output.slice(1, 4, 6).argmax(1),
+       e.output.slice(1, 6, 11).argmax(1)},
+      1);
+  ExpectClose(out[0], heads, "action");
+  ExpectClose(out[1], e.output, "logits");
+}
+
 TEST(PolicyOnnxTest, AConvolutionalPolicyOnBytesAgreesUnderOpenCv) {
   at::manual_seed(3);
   EnvSpec spec = VectorSpec(true, 4 * 10 * 10, 3);

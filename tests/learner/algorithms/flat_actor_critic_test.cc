@@ -17,11 +17,25 @@
 namespace vantage {
 namespace {
 
-// Random masks [rows, n] as uint8 under which each row's action (indices
-// as floats [rows, 1]) is legal.
-at::Tensor MasksAllowing(const at::Tensor& actions, int64_t n) {
-  at::Tensor masks = at::rand({actions.size(0), n}) < 0.4;
-  masks.scatter_(1, actions.to(at::kLong), true);
+// Random actions [rows, heads] (indices as floats) of `spec`'s heads.
+at::Tensor RandomActions(const EnvSpec& spec, int64_t rows) {
+  std::vector<at::Tensor> values;
+  for (int64_t choices : spec.action_heads()) {
+    values.push_back(at::randint(0, choices, {rows}));
+  }
+  return at::stack(values, 1).to(at::kFloat);
+}
+
+// Random masks [rows, action_size] as uint8 under which each row's action
+// ([rows, heads]) is legal in every head.
+at::Tensor MasksAllowing(const EnvSpec& spec, const at::Tensor& actions) {
+  at::Tensor masks = at::rand({actions.size(0), spec.action_size}) < 0.4;
+  int64_t offset = 0;
+  const std::vector<int64_t> heads = spec.action_heads();
+  for (size_t h = 0; h < heads.size(); offset += heads[h], ++h) {
+    masks.scatter_(1, actions.select(1, h).to(at::kLong).unsqueeze(1) + offset,
+                   true);
+  }
   return masks.to(at::kByte).contiguous();
 }
 
@@ -81,7 +95,8 @@ struct Case {
   int64_t actions;
   std::vector<int64_t> hidden;
   bool bytes;
-  bool masked = false;  // discrete only: action masks
+  bool masked = false;             // discrete only: action masks
+  std::vector<int64_t> nvec = {};  // MultiDiscrete heads (sum: actions)
 };
 
 class FlatActorCriticTest : public ::testing::TestWithParam<Case> {};
@@ -90,6 +105,7 @@ TEST_P(FlatActorCriticTest, ForwardAndGradientsAreAutograds) {
   const Case& c = GetParam();
   at::manual_seed(3);
   EnvSpec spec = VectorSpec(c.discrete, c.observations, c.actions);
+  spec.action_nvec = c.nvec;
   if (c.bytes) {
     spec.observation_shape = {c.observations};
     spec.observation_high = 7;
@@ -109,14 +125,13 @@ TEST_P(FlatActorCriticTest, ForwardAndGradientsAreAutograds) {
       c.bytes ? at::randint(0, 8, {kRows, c.observations}, at::kByte)
               : at::randn({kRows, c.observations}) * 2.0;
   const at::Tensor actions =
-      c.discrete ? at::randint(0, c.actions, {kRows, 1}).to(at::kFloat)
-                 : at::randn({kRows, c.actions});
+      c.discrete ? RandomActions(spec, kRows) : at::randn({kRows, c.actions});
   const at::Tensor d_log_probs = at::randn({kRows});
   const at::Tensor d_values = at::randn({kRows});
   const double entropy_weight = -0.37;
 
   const at::Tensor masks =
-      c.masked ? MasksAllowing(actions, c.actions) : at::Tensor();
+      c.masked ? MasksAllowing(spec, actions) : at::Tensor();
 
   const at::Tensor inputs = flat->Inputs(observations);
   flat->Forward(inputs.data_ptr<float>(), actions.data_ptr<float>(), kRows,
@@ -139,13 +154,16 @@ INSTANTIATE_TEST_SUITE_P(
                       Case{false, 3, 1, {}, false},
                       Case{true, 9, 4, {16, 8}, true},
                       Case{true, 11, 5, {32}, false, true},
-                      Case{true, 9, 4, {16, 8}, true, true}));
+                      Case{true, 9, 4, {16, 8}, true, true},
+                      Case{true, 8, 9, {16}, false, false, {2, 4, 3}},
+                      Case{true, 8, 7, {}, false, true, {3, 4}}));
 
 struct RecurrentCase {
   Core core;
   bool discrete;
   std::vector<int64_t> hidden;
   bool masked = false;  // discrete only: action masks
+  bool multi = false;   // MultiDiscrete heads of 2 and 3 choices
 };
 
 class FlatRecurrentTest : public ::testing::TestWithParam<RecurrentCase> {};
@@ -157,7 +175,11 @@ class FlatRecurrentTest : public ::testing::TestWithParam<RecurrentCase> {};
 TEST_P(FlatRecurrentTest, SequencesAndGradientsThroughTimeAreAutograds) {
   const RecurrentCase& c = GetParam();
   at::manual_seed(5);
-  const EnvSpec spec = VectorSpec(c.discrete, 6, 3);
+  EnvSpec spec = VectorSpec(c.discrete, 6, 3);
+  if (c.multi) {
+    spec.action_size = 5;
+    spec.action_nvec = {2, 3};
+  }
   NetworkConfig config;
   config.hidden = c.hidden;
   config.core = c.core;
@@ -176,16 +198,16 @@ TEST_P(FlatRecurrentTest, SequencesAndGradientsThroughTimeAreAutograds) {
   constexpr int64_t kChunks = 5;
   constexpr int64_t kRows = kSteps * kChunks;
   const at::Tensor observations = at::randn({kRows, 6}) * 2.0;
-  const at::Tensor actions = c.discrete
-                                 ? at::randint(0, 3, {kRows, 1}).to(at::kFloat)
-                                 : at::randn({kRows, 3});
+  const at::Tensor actions =
+      c.discrete ? RandomActions(spec, kRows) : at::randn({kRows, 3});
   const at::Tensor starts = at::rand({kSteps, kChunks}) < 0.2;
   const at::Tensor states = at::randn({kChunks, flat->state_size()}) * 0.5;
   const at::Tensor start_bytes = starts.to(at::kByte).reshape({-1});
   const at::Tensor d_log_probs = at::randn({kRows});
   const at::Tensor d_values = at::randn({kRows});
   const double entropy_weight = -0.37;
-  const at::Tensor masks = c.masked ? MasksAllowing(actions, 3) : at::Tensor();
+  const at::Tensor masks =
+      c.masked ? MasksAllowing(spec, actions) : at::Tensor();
 
   const at::Tensor inputs = flat->Inputs(observations);
   flat->ForwardSequences(inputs.data_ptr<float>(), actions.data_ptr<float>(),
@@ -211,7 +233,8 @@ INSTANTIATE_TEST_SUITE_P(
                       RecurrentCase{Core::kGru, true, {}},
                       RecurrentCase{Core::kLstm, false, {16}},
                       RecurrentCase{Core::kLstm, true, {8, 8}},
-                      RecurrentCase{Core::kGru, true, {16}, true}));
+                      RecurrentCase{Core::kGru, true, {16}, true},
+                      RecurrentCase{Core::kLstm, true, {8}, true, true}));
 
 TEST(FlatActorCriticTest, PushWritesTheModulesAndPullReadsThem) {
   at::manual_seed(4);
