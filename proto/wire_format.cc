@@ -124,6 +124,56 @@ absl::Status SameBounds(absl::string_view field,
   return absl::OkStatus();
 }
 
+// A Dict observation's entries, bounded before anything is copied.
+absl::Status CheckKeyLimits(const pb::EnvSpec& proto,
+                            const SpecLimits& limits) {
+  if (proto.observation_keys_size() > limits.max_observation_size) {
+    return Invalid(
+        "spec.observation_keys",
+        absl::StrCat(proto.observation_keys_size(),
+                     " entries, expected <= ", limits.max_observation_size));
+  }
+  for (int i = 0; i < proto.observation_keys_size(); ++i) {
+    const pb::ObservationKey& key = proto.observation_keys(i);
+    if (static_cast<int64_t>(key.name().size()) > limits.max_name_bytes ||
+        key.shape_size() > 3) {
+      return Invalid(
+          absl::StrCat("spec.observation_keys[", i, "]"),
+          absl::StrCat("a name of ", key.name().size(), " bytes and ",
+                       key.shape_size(), " dimensions, expected at most ",
+                       limits.max_name_bytes, " and 3"));
+    }
+  }
+  return absl::OkStatus();
+}
+
+std::string KeyText(const ObservationKey& key) {
+  return absl::StrCat(
+      "\"", key.name, "\" of ",
+      key.image() ? absl::StrCat("uint8 ", absl::StrJoin(key.shape, "x"),
+                                 " (high ", key.high, ")")
+                  : absl::StrCat(key.size, " values"));
+}
+
+absl::Status SameKeys(const std::vector<ObservationKey>& expected,
+                      const std::vector<ObservationKey>& got) {
+  if (expected.size() != got.size()) {
+    return Differs("observation_keys",
+                   absl::StrCat(expected.size(), " entries"),
+                   absl::StrCat(got.size()));
+  }
+  for (size_t i = 0; i < expected.size(); ++i) {
+    const ObservationKey& a = expected[i];
+    const ObservationKey& b = got[i];
+    if (a.name != b.name || a.size != b.size || a.shape != b.shape ||
+        a.high != b.high) {
+      return Differs(absl::StrCat("observation_keys[", i, "]"), KeyText(a),
+                     KeyText(b));
+    }
+  }
+  return absl::OkStatus();
+}
+
 }  // namespace
 
 void TensorToProto(const at::Tensor& tensor, pb::Tensor* proto) {
@@ -382,6 +432,13 @@ void EnvSpecToProto(const EnvSpec& spec, pb::EnvSpec* proto) {
   proto->set_action_masks(spec.action_masks);
   proto->mutable_action_nvec()->Add(spec.action_nvec.begin(),
                                     spec.action_nvec.end());
+  for (const ObservationKey& key : spec.observation_keys) {
+    pb::ObservationKey* entry = proto->add_observation_keys();
+    entry->set_name(key.name);
+    entry->set_size(key.size);
+    entry->mutable_shape()->Add(key.shape.begin(), key.shape.end());
+    entry->set_high(key.high);
+  }
 }
 
 absl::StatusOr<EnvSpec> EnvSpecFromProto(const pb::EnvSpec& proto,
@@ -412,6 +469,9 @@ absl::StatusOr<EnvSpec> EnvSpecFromProto(const pb::EnvSpec& proto,
                                                     " values, expected <= ",
                                                     limits.max_action_size));
   }
+  if (absl::Status status = CheckKeyLimits(proto, limits); !status.ok()) {
+    return status;
+  }
   if (proto.observation_shape_size() > 3) {
     return Invalid("spec.observation_shape",
                    absl::StrCat(proto.observation_shape_size(),
@@ -433,6 +493,12 @@ absl::StatusOr<EnvSpec> EnvSpecFromProto(const pb::EnvSpec& proto,
   spec.action_masks = proto.action_masks();
   spec.action_nvec.assign(proto.action_nvec().begin(),
                           proto.action_nvec().end());
+  for (const pb::ObservationKey& entry : proto.observation_keys()) {
+    spec.observation_keys.push_back(
+        {entry.name(), entry.size(),
+         std::vector<int64_t>(entry.shape().begin(), entry.shape().end()),
+         entry.high()});
+  }
 
   if (spec.name.empty()) return Invalid("spec.name", "empty");
   if (spec.observation_size < 1) {
@@ -502,6 +568,11 @@ absl::Status CheckSameSpec(const EnvSpec& expected, const EnvSpec& got) {
     };
     return Differs("observation_shape", text(expected.observation_shape),
                    text(got.observation_shape));
+  }
+  if (absl::Status status =
+          SameKeys(expected.observation_keys, got.observation_keys);
+      !status.ok()) {
+    return status;
   }
   if (expected.observation_high != got.observation_high) {
     return Differs("observation_high", absl::StrCat(expected.observation_high),

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <set>
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_join.h"
@@ -29,6 +30,16 @@ std::vector<int64_t> EnvSpec::action_heads() const {
 }
 
 std::string EnvSpec::ObservationString() const {
+  if (!observation_keys.empty()) {
+    std::vector<std::string> entries;
+    for (const ObservationKey& key : observation_keys) {
+      entries.push_back(absl::StrCat(
+          key.name, ": ",
+          key.image() ? absl::StrCat("uint8 ", absl::StrJoin(key.shape, "x"))
+                      : absl::StrCat(key.size)));
+    }
+    return absl::StrCat("dict(", absl::StrJoin(entries, ", "), ")");
+  }
   if (observation_shape.empty()) return absl::StrCat(observation_size);
   return absl::StrCat(byte_observations() ? "uint8 " : "",
                       absl::StrJoin(observation_shape, "x"));
@@ -167,7 +178,83 @@ absl::Status CheckActionLayout(const EnvSpec& spec) {
   return absl::OkStatus();
 }
 
+namespace {
+
+// One Dict entry's fields, named by its position and key.
+absl::Status CheckObservationKey(const ObservationKey& key, size_t index,
+                                 int64_t observation_size) {
+  const std::string field =
+      absl::StrCat("spec.observation_keys[", index, "] (\"", key.name, "\")");
+  if (key.name.empty()) {
+    return absl::InvalidArgumentError(absl::StrCat(field, ": an empty name"));
+  }
+  if (key.size < 1 || key.size > observation_size) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        field, ": size ", key.size, ", expected 1..", observation_size));
+  }
+  if (!key.image()) {
+    if (key.high == 0) return absl::OkStatus();
+    return absl::InvalidArgumentError(
+        absl::StrCat(field, ": high ", key.high, " for a vector"));
+  }
+  if (key.high < 1 || key.high > 255) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        field, ": high ", key.high, ", expected 1..255 for an image"));
+  }
+  int64_t product = 1;
+  for (int64_t dimension : key.shape) {
+    if (key.shape.size() != 3 || dimension < 1 || dimension > key.size) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          field, ": shape ", absl::StrJoin(key.shape, "x"),
+          ", expected [channels, height, width] holding its size ", key.size));
+    }
+    product *= dimension;
+    if (product > key.size) break;
+  }
+  if (product != key.size) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(field, ": shape ", absl::StrJoin(key.shape, "x"),
+                     " does not hold its size ", key.size));
+  }
+  return absl::OkStatus();
+}
+
+absl::Status CheckObservationKeys(const EnvSpec& spec) {
+  if (!spec.observation_shape.empty() || spec.observation_high != 0) {
+    return absl::InvalidArgumentError(
+        "spec.observation_keys: a Dict observation is a float row; its "
+        "images are described by its entries, not by observation_shape or "
+        "observation_high");
+  }
+  std::set<std::string> names;
+  int64_t sum = 0;
+  for (size_t i = 0; i < spec.observation_keys.size(); ++i) {
+    const ObservationKey& key = spec.observation_keys[i];
+    if (absl::Status status =
+            CheckObservationKey(key, i, spec.observation_size);
+        !status.ok()) {
+      return status;
+    }
+    if (!names.insert(key.name).second) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          "spec.observation_keys: \"", key.name, "\" appears twice"));
+    }
+    sum += key.size;
+    if (sum > spec.observation_size) break;
+  }
+  if (sum != spec.observation_size) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("spec.observation_keys: sizes sum to ",
+                     sum > spec.observation_size ? "at least " : "", sum,
+                     ", expected observation_size ", spec.observation_size));
+  }
+  return absl::OkStatus();
+}
+
+}  // namespace
+
 absl::Status CheckObservationLayout(const EnvSpec& spec) {
+  if (!spec.observation_keys.empty()) return CheckObservationKeys(spec);
   if (spec.observation_high < 0 || spec.observation_high > 255) {
     return absl::InvalidArgumentError(
         absl::StrCat("spec.observation_high: ", spec.observation_high,

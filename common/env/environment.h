@@ -16,9 +16,28 @@
 
 namespace vantage {
 
+// One entry of a Dict (or Tuple) observation, in the flat row every
+// observation is: the entries side by side in the spec's order.
+struct ObservationKey {
+  std::string name;  // the Dict's key ("0", "1", ... of a Tuple)
+  int64_t size = 0;  // values in the row
+  // An image: [channels, height, width] (product: size) of integers in
+  // [0, high], which enter the networks divided by high through a
+  // convolutional torso of its own. Empty (and high 0): a vector, which is
+  // normalised like every vector observation.
+  std::vector<int64_t> shape;
+  int64_t high = 0;
+  bool image() const { return !shape.empty(); }
+};
+
 struct EnvSpec {
   std::string name;
   int64_t observation_size = 0;  // observations are flat [observation_size]
+  // A Dict or Tuple observation: its entries, whose sizes sum to
+  // observation_size (then observation_shape is empty and
+  // observation_high 0: the row is float32 on the wire). Empty: one
+  // vector or image observation as below.
+  std::vector<ObservationKey> observation_keys;
   // Images (pixels, MinAtar's grids): [channels, height, width], whose
   // product is observation_size, for convolutional torsos; empty for
   // vectors.
@@ -60,7 +79,7 @@ struct EnvSpec {
   // for MultiDiscrete; empty for continuous actions.
   std::vector<int64_t> action_heads() const;
   bool byte_observations() const { return observation_high > 0; }
-  // "17" or "uint8 4x10x10".
+  // "17", "uint8 4x10x10" or "dict(camera: uint8 3x8x8, joints: 7)".
   std::string ObservationString() const;
 };
 
@@ -139,7 +158,10 @@ absl::Status CheckActionLayout(const EnvSpec& spec);
 
 // The observation fields agree: observation_shape is empty or three
 // positive dimensions whose product is observation_size, and
-// observation_high is in [0, 255]. The message names the field.
+// observation_high is in [0, 255]; Dict entries have distinct non-empty
+// names, sizes summing to observation_size, and images of three positive
+// dimensions with high in [1, 255] (vectors: none, high 0). The message
+// names the field.
 absl::Status CheckObservationLayout(const EnvSpec& spec);
 
 // The observation buffer a Reset or Step writes holds the spec's size.

@@ -41,6 +41,12 @@ absl::StatusOr<std::unique_ptr<Environment>> FrameStack::Wrap(
         absl::StrCat("frame_stack: ", frames, " frames, expected 2..",
                      kMaxFrameStack, " (1: no stacking)"));
   }
+  if (!inner->spec().observation_keys.empty()) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "frame_stack: ", inner->spec().name,
+        " has a Dict observation, which vantage does not stack (stack "
+        "inside the environment, or use a recurrent --core)"));
+  }
   return std::unique_ptr<Environment>(new FrameStack(std::move(inner), frames));
 }
 

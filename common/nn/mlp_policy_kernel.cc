@@ -31,9 +31,10 @@ std::vector<double> DoubleVector(const at::Tensor& tensor) {
 absl::StatusOr<MlpPolicyKernel> MlpPolicyKernel::Create(
     const EnvSpec& spec, PolicyNetworkImpl& policy,
     const RunningMeanStd& normalizer, double observation_clip) {
-  if (!policy.conv_torso().is_empty()) {
+  if (!policy.conv_torso().is_empty() || !policy.dict_torso().is_empty()) {
     return absl::UnimplementedError(
-        "the policy has a convolutional torso, which only LibTorch runs");
+        "the policy has a convolutional or Dict torso, which only LibTorch "
+        "runs");
   }
   if (normalizer.size() != spec.observation_size) {
     return absl::InvalidArgumentError(

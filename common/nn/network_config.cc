@@ -102,8 +102,60 @@ absl::StatusOr<Torso> ResolveTorso(Torso torso, const EnvSpec& spec) {
   return torso;
 }
 
+namespace {
+
+// The spec of one image entry alone, for the torso rules of one image.
+EnvSpec ImageSpec(const EnvSpec& spec, const ObservationKey& key) {
+  EnvSpec image;
+  image.name = absl::StrCat(spec.name, "[", key.name, "]");
+  image.observation_size = key.size;
+  image.observation_shape = key.shape;
+  image.observation_high = key.high;
+  return image;
+}
+
+}  // namespace
+
+absl::StatusOr<Torso> DictImageTorso(const EnvSpec& spec,
+                                     const ObservationKey& key) {
+  const EnvSpec image = ImageSpec(spec, key);
+  absl::StatusOr<Torso> torso = ResolveTorso(Torso::kAuto, image);
+  if (!torso.ok()) return torso.status();
+  // Auto picks by size alone; the smallest torso must still fit.
+  return ResolveTorso(*torso, image);
+}
+
+absl::Status CheckDictNetwork(const NetworkConfig& config,
+                              const EnvSpec& spec) {
+  if (spec.observation_keys.empty()) return absl::OkStatus();
+  const std::string what = absl::StrCat(spec.name, " has a Dict observation, ");
+  if (config.torso != Torso::kAuto) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        what,
+        "whose images each get the torso --torso=auto picks for them; "
+        "--torso=",
+        TorsoName(config.torso), " does not apply"));
+  }
+  if (config.shared_torso) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(what, "whose torsos are not shared (--shared_torso)"));
+  }
+  if (config.recurrent()) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(what, "which a recurrent --core does not take yet"));
+  }
+  for (const ObservationKey& key : spec.observation_keys) {
+    if (!key.image()) continue;
+    if (absl::StatusOr<Torso> torso = DictImageTorso(spec, key); !torso.ok()) {
+      return torso.status();
+    }
+  }
+  return absl::OkStatus();
+}
+
 absl::Status CheckNetworkConfig(const NetworkConfig& config,
                                 const EnvSpec& spec) {
+  if (!spec.observation_keys.empty()) return CheckDictNetwork(config, spec);
   const absl::StatusOr<Torso> torso = ResolveTorso(config.torso, spec);
   if (!torso.ok()) return torso.status();
   if (config.shared_torso && *torso == Torso::kMlp) {

@@ -21,8 +21,14 @@ namespace {
 // convolutions instead of new ones.
 TanhMlp MakeBody(torch::nn::Module& network, const EnvSpec& spec,
                  const NetworkConfig& config, int64_t outputs,
-                 double output_gain, ConvTorso& conv,
+                 double output_gain, ConvTorso& conv, DictTorso& dict,
                  ConvTorso shared = nullptr) {
+  if (!spec.observation_keys.empty()) {
+    // The entries' features, then the MLP's hidden layers.
+    dict = network.register_module("dict", DictTorso(spec));
+    return network.register_module(
+        "body", TanhMlp(dict->features(), config.hidden, outputs, output_gain));
+  }
   if (shared.is_empty()) {
     const Torso torso = ResolveTorso(config.torso, spec).value();
     if (torso == Torso::kMlp) {
@@ -38,10 +44,11 @@ TanhMlp MakeBody(torch::nn::Module& network, const EnvSpec& spec,
       TanhMlp(conv->features(), std::vector<int64_t>{}, outputs, output_gain));
 }
 
-at::Tensor Forward(const EnvSpec& spec, ConvTorso& conv, TanhMlp& body,
-                   const at::Tensor& observations) {
+at::Tensor Forward(const EnvSpec& spec, ConvTorso& conv, DictTorso& dict,
+                   TanhMlp& body, const at::Tensor& observations) {
   at::Tensor inputs = NetworkInputs(spec, observations);
   if (!conv.is_empty()) inputs = conv->forward(inputs);
+  if (!dict.is_empty()) inputs = dict->forward(inputs);
   return body->forward(inputs);
 }
 
@@ -71,7 +78,20 @@ at::Tensor ObservationsForNetwork(const EnvSpec& spec,
                                   const RunningMeanStd& normalizer,
                                   const at::Tensor& observations, double clip) {
   if (spec.byte_observations()) return observations;
-  return normalizer.Normalize(observations, clip);
+  const at::Tensor normalized = normalizer.Normalize(observations, clip);
+  if (spec.observation_keys.empty()) return normalized;
+  // A Dict's images are not normalised: they enter divided by their high.
+  std::vector<at::Tensor> parts;
+  int64_t offset = 0;
+  for (const ObservationKey& key : spec.observation_keys) {
+    parts.push_back(key.image()
+                        ? observations.slice(1, offset, offset + key.size)
+                                  .to(normalized.scalar_type()) /
+                              static_cast<double>(key.high)
+                        : normalized.slice(1, offset, offset + key.size));
+    offset += key.size;
+  }
+  return at::cat(parts, 1);
 }
 
 PolicyNetworkImpl::PolicyNetworkImpl(const EnvSpec& spec,
@@ -84,7 +104,7 @@ PolicyNetworkImpl::PolicyNetworkImpl(const EnvSpec& spec,
                                     spec.action_size, /*output_gain=*/0.01));
   } else {
     body_ = MakeBody(*this, spec, config, spec.action_size,
-                     /*output_gain=*/0.01, conv_);
+                     /*output_gain=*/0.01, conv_, dict_);
   }
   if (!discrete_) {
     log_std_ = register_parameter("log_std", at::zeros({spec.action_size}));
@@ -93,7 +113,7 @@ PolicyNetworkImpl::PolicyNetworkImpl(const EnvSpec& spec,
 
 at::Tensor PolicyNetworkImpl::forward(const at::Tensor& observations) {
   TORCH_CHECK(!recurrent(), "a recurrent policy acts with its state");
-  return Forward(spec_, conv_, body_, observations);
+  return Forward(spec_, conv_, dict_, body_, observations);
 }
 
 at::Tensor PolicyNetworkImpl::Head(const at::Tensor& features) {
@@ -180,13 +200,13 @@ at::Tensor PolicyNetworkImpl::Act(const at::Tensor& output, bool deterministic,
 ValueNetworkImpl::ValueNetworkImpl(const EnvSpec& spec,
                                    const NetworkConfig& config)
     : spec_(spec) {
-  body_ = MakeBody(*this, spec, config, 1, /*output_gain=*/1.0, conv_);
+  body_ = MakeBody(*this, spec, config, 1, /*output_gain=*/1.0, conv_, dict_);
 }
 
 ValueNetworkImpl::ValueNetworkImpl(const EnvSpec& spec, ConvTorso shared)
     : spec_(spec) {
   body_ = MakeBody(*this, spec, NetworkConfig(), 1, /*output_gain=*/1.0, conv_,
-                   std::move(shared));
+                   dict_, std::move(shared));
 }
 
 ValueNetworkImpl::ValueNetworkImpl(const EnvSpec& spec, RecurrentTrunk shared)
@@ -203,7 +223,7 @@ ValueNetworkImpl::ValueNetworkImpl(int64_t observation_size,
 
 at::Tensor ValueNetworkImpl::forward(const at::Tensor& observations) {
   TORCH_CHECK(!recurrent(), "a recurrent value network needs its state");
-  return Forward(spec_, conv_, body_, observations).squeeze(-1);
+  return Forward(spec_, conv_, dict_, body_, observations).squeeze(-1);
 }
 
 at::Tensor ValueNetworkImpl::Head(const at::Tensor& features) {

@@ -20,6 +20,7 @@
 
 #include "absl/status/status.h"
 #include "common/env/environment.h"
+#include "common/nn/dict_torso.h"
 #include "common/nn/network_config.h"
 #include "common/nn/recurrent_trunk.h"
 #include "common/nn/running_mean_std.h"
@@ -90,6 +91,8 @@ class PolicyNetworkImpl : public torch::nn::Module {
   const at::Tensor& log_std() const { return log_std_; }
   // Empty for the MLP torso and for recurrent policies (their trunk's).
   const ConvTorso& conv_torso() const { return conv_; }
+  // A Dict observation's torso; empty otherwise.
+  const DictTorso& dict_torso() const { return dict_; }
   // The MLP (for images or a recurrent trunk, only the output layer).
   const TanhMlp& body() const { return body_; }
 
@@ -102,6 +105,7 @@ class PolicyNetworkImpl : public torch::nn::Module {
   std::vector<int64_t> heads_;
   RecurrentTrunk trunk_{nullptr};  // recurrent only
   ConvTorso conv_{nullptr};        // images only
+  DictTorso dict_{nullptr};        // Dict observations only
   TanhMlp body_{nullptr};
   at::Tensor log_std_;
 };
@@ -125,6 +129,7 @@ class ValueNetworkImpl : public torch::nn::Module {
   at::Tensor Head(const at::Tensor& features);
   // Empty for the MLP torso; a shared torso is the policy's.
   const ConvTorso& conv_torso() const { return conv_; }
+  const DictTorso& dict_torso() const { return dict_; }
   // The MLP (for images, only the output layer after the torso).
   const TanhMlp& body() const { return body_; }
 
@@ -132,6 +137,7 @@ class ValueNetworkImpl : public torch::nn::Module {
   EnvSpec spec_;
   RecurrentTrunk trunk_{nullptr};
   ConvTorso conv_{nullptr};
+  DictTorso dict_{nullptr};
   TanhMlp body_{nullptr};
 };
 TORCH_MODULE(ValueNetwork);

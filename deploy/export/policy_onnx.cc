@@ -130,8 +130,10 @@ std::string AddMlp(GraphBuilder& g, const TanhMlp& mlp, std::string x) {
 // each, on flat rows reshaped to [batch, C, H, W].
 std::string AddConvTorso(GraphBuilder& g, const ConvTorso& torso,
                          const std::vector<int64_t>& shape, std::string x) {
+  // 0: the batch as it comes (a -1 would be inferred, which OpenCV's
+  // importer gets wrong before a Concat with another entry's features).
   x = GraphBuilder::Out(g.Node(
-      "Reshape", {x, g.Int64s("shape", {-1, shape[0], shape[1], shape[2]})}));
+      "Reshape", {x, g.Int64s("shape", {0, shape[0], shape[1], shape[2]})}));
   for (const auto& module : torso->layers()->children()) {
     if (const auto* conv = module->as<torch::nn::Conv2dImpl>()) {
       onnx::NodeProto& node =
@@ -181,6 +183,46 @@ std::string AddInputs(GraphBuilder& g, const EnvSpec& spec,
   GraphBuilder::Floats(clipped, "min", static_cast<float>(-clip));
   GraphBuilder::Floats(clipped, "max", static_cast<float>(clip));
   return GraphBuilder::Out(clipped);
+}
+
+// A Dict observation's torso: each entry's slice of the row, vectors
+// normalised and clipped with their slice of the normaliser, images divided
+// by their high and through their own convolutional torso; the features
+// side by side.
+std::string AddDictTorso(GraphBuilder& g, const DictTorso& torso,
+                         const RunningMeanStd& normalizer, double clip,
+                         const std::string& x) {
+  const at::Tensor mean = normalizer.mean();
+  const at::Tensor std = at::sqrt(normalizer.var() + 1e-8);
+  std::vector<std::string> features;
+  int64_t offset = 0;
+  for (size_t i = 0; i < torso->keys().size(); ++i) {
+    const ObservationKey& key = torso->keys()[i];
+    const int64_t end = offset + key.size;
+    std::string part = GraphBuilder::Out(
+        g.Node("Slice", {x, g.Int64s("starts", {offset}),
+                         g.Int64s("ends", {end}), g.Int64s("axes", {1})}));
+    if (key.image()) {
+      part = GraphBuilder::Out(g.Node(
+          "Mul",
+          {part, g.Floats("inverse_high", at::tensor({1.0f / key.high}))}));
+      part = AddConvTorso(g, torso->convs()[i], key.shape, part);
+    } else {
+      part = GraphBuilder::Out(
+          g.Node("Sub", {part, g.Floats("mean", mean.slice(0, offset, end))}));
+      part = GraphBuilder::Out(
+          g.Node("Div", {part, g.Floats("std", std.slice(0, offset, end))}));
+      onnx::NodeProto& clipped = g.Node("Clip", {part});
+      GraphBuilder::Floats(clipped, "min", static_cast<float>(-clip));
+      GraphBuilder::Floats(clipped, "max", static_cast<float>(clip));
+      part = GraphBuilder::Out(clipped);
+    }
+    features.push_back(part);
+    offset = end;
+  }
+  onnx::NodeProto& concat = g.Node("Concat", features);
+  GraphBuilder::Ints(concat, "axis", {1});
+  return GraphBuilder::Out(concat);
 }
 
 // `x` clipped to the action bounds, dimension by dimension (an unbounded
@@ -326,7 +368,10 @@ absl::StatusOr<std::string> PolicyToOnnx(const EnvSpec& spec,
   g.Value(graph.mutable_input(), "observation", onnx::TensorProto::FLOAT,
           {-1, spec.observation_size});
   std::string x =
-      AddInputs(g, spec, normalizer, observation_clip, "observation");
+      policy.dict_torso().is_empty()
+          ? AddInputs(g, spec, normalizer, observation_clip, "observation")
+          : AddDictTorso(g, policy.dict_torso(), normalizer, observation_clip,
+                         "observation");
   if (!policy.conv_torso().is_empty()) {
     x = AddConvTorso(g, policy.conv_torso(), spec.observation_shape, x);
   }

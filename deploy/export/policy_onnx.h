@@ -4,7 +4,8 @@
 // A trained policy as an ONNX model (opset 10), for programs and runtimes
 // outside vantage: one input `observation` [batch, observation size]
 // (float: the values the environment gives; byte observations as their
-// values), the observation normaliser inside the graph exactly as the
+// values; a Dict's entries side by side in the spec's order, images
+// channels first), the observation normaliser inside the graph exactly as the
 // networks take it, and the output `action`: the Gaussian mean clipped to
 // the action bounds (float [batch, k]) or the most likely action (int64
 // [batch]). With `distribution`, also the distribution's parameters:

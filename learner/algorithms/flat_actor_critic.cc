@@ -20,9 +20,11 @@ namespace vantage {
 absl::StatusOr<FlatActorCritic> FlatActorCritic::Create(
     PolicyNetworkImpl& policy, ValueNetworkImpl& value,
     std::vector<at::Tensor> parameters) {
-  if (!policy.conv_torso().is_empty() || !value.conv_torso().is_empty()) {
+  if (!policy.conv_torso().is_empty() || !value.conv_torso().is_empty() ||
+      !policy.dict_torso().is_empty()) {
     return absl::UnimplementedError(
-        "the networks have a convolutional torso, which only autograd trains");
+        "the networks have a convolutional or Dict torso, which only "
+        "autograd trains");
   }
   if (policy.recurrent() && !policy.trunk()->conv_torso().is_empty()) {
     return absl::UnimplementedError(

@@ -23,6 +23,7 @@
 #include "common/util/state_bytes.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
+#include "tests/fakes/random_discrete_action.h"
 
 namespace vantage {
 namespace {
@@ -79,14 +80,17 @@ void ExpectBitIdentical(const std::vector<double>& expected,
   }
 }
 
+// `masks`: masked actions' legal choices, action_size bytes per env (null:
+// all are legal).
 std::vector<double> RandomActions(const EnvSpec& spec, int count,
-                                  std::mt19937_64& rng) {
+                                  std::mt19937_64& rng,
+                                  const uint8_t* masks = nullptr) {
   std::vector<double> actions;
   for (int n = 0; n < count; ++n) {
     if (spec.discrete) {
-      actions.push_back(
-          static_cast<double>(std::uniform_int_distribution<int64_t>(
-              0, spec.action_size - 1)(rng)));
+      const std::vector<double> action = RandomDiscreteAction(
+          spec, masks == nullptr ? nullptr : masks + n * spec.action_size, rng);
+      actions.insert(actions.end(), action.begin(), action.end());
       continue;
     }
     for (int64_t i = 0; i < spec.action_size; ++i) {
@@ -123,8 +127,11 @@ struct Driver {
         trace.insert(trace.end(), observation.begin(), observation.end());
         needs_reset = false;
       }
+      const absl::StatusOr<std::vector<uint8_t>> mask = ReadActionMask(env);
       absl::StatusOr<StepResult> result = env.Step(
-          RandomActions(env.spec(), 1, actions), absl::MakeSpan(observation));
+          RandomActions(env.spec(), 1, actions,
+                        mask.ok() && !mask->empty() ? mask->data() : nullptr),
+          absl::MakeSpan(observation));
       EXPECT_TRUE(result.ok()) << result.status();
       if (!result.ok()) break;
       last = *result;
@@ -538,8 +545,9 @@ struct VectorTrace {
 VectorTrace RunVector(VectorEnv& envs, std::mt19937_64& rng, int steps) {
   VectorTrace trace;
   for (int t = 0; t < steps; ++t) {
-    const absl::Status status =
-        envs.Step(RandomActions(envs.spec(), envs.size(), rng));
+    const absl::Status status = envs.Step(RandomActions(
+        envs.spec(), envs.size(), rng,
+        envs.action_masks().empty() ? nullptr : envs.action_masks().data()));
     EXPECT_TRUE(status.ok()) << status;
     auto& v = trace.values;
     v.insert(v.end(), envs.observations().begin(), envs.observations().end());

@@ -345,6 +345,32 @@ TEST(PythonEnvTest, AMaskedEnvResumesWithItsMasks) {
   EXPECT_EQ(resumed->action_masks(), envs->action_masks());
 }
 
+// A Dict (or Tuple) of a 5x5 camera image and a 2-value vector: entries
+// side by side in the row, the image channels first, described in the
+// spec for the networks.
+TEST(PythonEnvTest, DictAndTupleObservationsAreEntriesSideBySide) {
+  for (const std::string kwargs : {"", R"({"tuple": 1})"}) {
+    std::unique_ptr<Environment> env = Make("python:lit_pixel:make", kwargs);
+    const EnvSpec& spec = env->spec();
+    const std::string camera = kwargs.empty() ? "camera" : "0";
+    const std::string mirror = kwargs.empty() ? "mirror" : "1";
+    EXPECT_EQ(spec.ObservationString(),
+              absl::StrCat("dict(", camera, ": uint8 1x5x5, ", mirror, ": 2)"));
+    ASSERT_TRUE(CheckObservationLayout(spec).ok());
+    ASSERT_EQ(spec.observation_size, 27);
+    EXPECT_EQ(spec.observation_keys[0].high, 255);
+    std::vector<double> observation(27);
+    ASSERT_TRUE(env->Reset(3, absl::MakeSpan(observation)).ok());
+    for (int step = 0; step < 3; ++step) {
+      int lit = 0;
+      for (int i = 0; i < 25; ++i) lit += observation[i] == 255.0;
+      EXPECT_EQ(lit, 1);
+      EXPECT_EQ(observation[25] + observation[26], 1.0);
+      ASSERT_TRUE(env->Step({0.0}, absl::MakeSpan(observation)).ok());
+    }
+  }
+}
+
 TEST(PythonEnvTest, RendersAnRgbFrameOfTheAskedSize) {
   std::unique_ptr<Environment> env = Make("python:cartpole:make");
   std::vector<double> observation(4);
@@ -390,8 +416,12 @@ TEST(PythonEnvTest, EveryErrorNamesTheEnvTheCallAndTheCause) {
                         "truncated, info) as Gymnasium does; it returned a "
                         "tuple of 4"));
   EXPECT_THAT(Error("python:broken_envs:dict_observations"),
-              HasSubstr("the observation space is a Dict space; vantage takes "
-                        "a box or a discrete space: flatten it"));
+              HasSubstr("reset() returned an observation without its dict "
+                        "entry 'a', which its space has"));
+  EXPECT_THAT(Error("python:broken_envs:nested_dict"),
+              HasSubstr("its spaces: TypeError: observation['a'] is a Dict "
+                        "space inside the Dict space; vantage takes one level "
+                        "of Dict or Tuple"));
   EXPECT_THAT(Error("python:cartpole"), HasSubstr("names no factory"));
   EXPECT_THAT(Error("gym:"), HasSubstr("gym: needs an id"));
   EXPECT_THAT(Error("python:cartpole:make", "[1, 2]"),

@@ -284,8 +284,9 @@ TEST(PythonEnvTrainingTest, ARunResumesExactlyOrWithItsEpisodesRestarted) {
   EXPECT_EQ(DeterministicProgress(pendulum).size(), 1u + 6);
 }
 
-// MultiDiscrete and MultiBinary actions, and masks in the info or as an
-// observation key, resume exactly too (their envs have get_state).
+// MultiDiscrete and MultiBinary actions, masks in the info or as an
+// observation key, and a Dict observation resume exactly too (their envs
+// have get_state).
 TEST(PythonEnvTrainingTest, StructuredAndMaskedActionsResumeExactly) {
   at::set_num_threads(1);
   const std::vector<std::pair<std::string, std::string>> envs = {
@@ -293,6 +294,7 @@ TEST(PythonEnvTrainingTest, StructuredAndMaskedActionsResumeExactly) {
       {"python:match_targets:make", R"({"binary": 5})"},
       {"python:lit_buttons:make", ""},
       {"python:lit_buttons:make", R"({"mask_in": "observation"})"},
+      {"python:lit_pixel:make", ""},
   };
   for (size_t i = 0; i < envs.size(); ++i) {
     const auto& [env, kwargs] = envs[i];
@@ -323,6 +325,23 @@ TEST(PythonEnvTrainingTest, PpoLearnsMultiDiscreteAndMultiBinaryActions) {
     ASSERT_EQ(outcome.exit_code, 0) << outcome.err;
     EXPECT_GE(BestMeanReturn(run), 11.5) << kwargs;
   }
+}
+
+// LitPixel (tests/python_envs/lit_pixel.py): a Dict of a 5x5 camera image
+// with one lit pixel and a 2-value "mirror" vector; the answer is the lit
+// column, mirrored when the vector says so, so a policy needs both (the
+// camera through its own convolutional torso, the vector normalised, both
+// into the MLP). A uniformly random policy scores 1.6 of 8. Seed 1, 48k
+// steps: 7.75, as a Dict and as a Tuple (2026-12-06).
+TEST(PythonEnvTrainingTest, PpoLearnsADictOfAnImageAndAVector) {
+  const std::string run = FreshDirectory("python_lit_pixel");
+  const Outcome outcome = RunVantage(
+      "train --mode=local --env=python:lit_pixel:make --steps=49152 --seed=1 "
+      "--run_dir=" +
+      run);
+  ASSERT_EQ(outcome.exit_code, 0) << outcome.err;
+  EXPECT_THAT(outcome.err, HasSubstr("acting on LibTorch"));
+  EXPECT_GE(BestMeanReturn(run), 6.0);
 }
 
 }  // namespace

@@ -712,7 +712,13 @@ TEST(EnvSpecWireTest, RoundTrips) {
   multi.name = "Multi";
   multi.action_size = 7;
   multi.action_nvec = {3, 4};
-  for (const EnvSpec& spec : {continuous, discrete, pixels, masked, multi}) {
+  EnvSpec dict = discrete;
+  dict.name = "Dict";
+  dict.observation_size = 22;
+  dict.observation_keys = {{"camera", 18, {2, 3, 3}, 255},
+                           {"joints", 4, {}, 0}};
+  for (const EnvSpec& spec :
+       {continuous, discrete, pixels, masked, multi, dict}) {
     absl::StatusOr<EnvSpec> back = SpecOverWire(spec);
     ASSERT_TRUE(back.ok()) << back.status();
     EXPECT_TRUE(CheckSameSpec(spec, *back).ok()) << CheckSameSpec(spec, *back);
@@ -724,6 +730,12 @@ TEST(EnvSpecWireTest, RoundTrips) {
     EXPECT_EQ(back->observation_high, spec.observation_high);
     EXPECT_EQ(back->action_masks, spec.action_masks);
     EXPECT_EQ(back->action_nvec, spec.action_nvec);
+    ASSERT_EQ(back->observation_keys.size(), spec.observation_keys.size());
+    for (size_t i = 0; i < spec.observation_keys.size(); ++i) {
+      EXPECT_EQ(back->observation_keys[i].name, spec.observation_keys[i].name);
+      EXPECT_EQ(back->observation_keys[i].shape,
+                spec.observation_keys[i].shape);
+    }
   }
 }
 
@@ -753,6 +765,11 @@ TEST(EnvSpecWireTest, RefusesImpossibleSpecs) {
        "spec.action_nvec: 2x5 sums to at least 7, expected action_size 6"},
       {[](EnvSpec& s) { s.action_nvec = {6}; },
        "spec.action_nvec: 6 for continuous actions, which have none"},
+      {[](EnvSpec& s) {
+         s.observation_keys = {{"joints", 16, {}, 0}};
+       },
+       "spec.observation_keys: sizes sum to 16, expected observation_size "
+       "17"},
       {[](EnvSpec& s) {
          s.discrete = true;
          s.action_high.clear();
@@ -868,6 +885,10 @@ TEST(EnvSpecWireTest, CheckSameSpecNamesTheFirstDifference) {
          s.action_nvec = {2, 4};
        },
        "env spec differs in action_nvec: expected none, got 2x4"},
+      {[](EnvSpec& s) {
+         s.observation_keys = {{"joints", 17, {}, 0}};
+       },
+       "env spec differs in observation_keys: expected 0 entries, got 1"},
       // Several differences: the first in declaration order is named.
       {[](EnvSpec& s) {
          s.control_dt = 0.01;

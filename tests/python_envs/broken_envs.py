@@ -66,9 +66,18 @@ class OldGymApi(CartPole):
 
 
 class DictObservations(CartPole):
+    """A Dict space whose env returns a plain array."""
+
     def __init__(self):
         super().__init__()
         self.observation_space = Dict({"a": Box(-1, 1, shape=(2,))})
+
+
+class NestedDict(CartPole):
+    def __init__(self):
+        super().__init__()
+        self.observation_space = Dict(
+            {"a": Dict({"b": Box(-1, 1, shape=(2,))})})
 
 
 def raises_in_step():
@@ -101,6 +110,10 @@ def old_gym_api():
 
 def dict_observations():
     return DictObservations()
+
+
+def nested_dict():
+    return NestedDict()
 
 
 not_callable = 3

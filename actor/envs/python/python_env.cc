@@ -16,6 +16,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_join.h"
 #include "absl/strings/strip.h"
+#include "actor/envs/python/python_observations.h"
 #include "actor/envs/python/python_runtime.h"
 #include "common/util/call_watch.h"
 #include "common/util/state_bytes.h"
@@ -27,20 +28,6 @@ namespace {
 
 constexpr char kStateKind[] = "python_env";
 constexpr uint32_t kStateVersion = 1;
-
-std::string ShapeText(const std::vector<int64_t>& shape) {
-  return shape.size() == 1 ? absl::StrCat("(", shape[0], ",)")
-                           : absl::StrCat("(", absl::StrJoin(shape, ", "), ")");
-}
-
-// What an observation must look like, from the observation space.
-struct ObservationLayout {
-  std::vector<int64_t> shape;  // as the environment gives it
-  char kind = 'f';             // numpy's kind of the space's dtype
-  // uint8 with three dimensions: an image, height x width x channels as
-  // Gymnasium's image spaces are, sent channels first.
-  bool image = false;
-};
 
 // Runs `body` (which uses Python) with the GIL held; a Python exception
 // becomes the caller's error naming the env `name` and its `call`, any
@@ -277,24 +264,23 @@ class PythonEnv final : public Environment {
   // The spec from the spaces (GIL held).
   absl::StatusOr<bool> Describe() {
     py::module_& bridge = PythonBridge();
-    py::object observation_space = env_.attr("observation_space");
-    py::object inner =
-        bridge.attr("masked_observation_space")(observation_space);
-    if (!inner.is_none()) {
-      masks_ = MaskSource::kObservationKey;
-      observation_space = inner;
-    }
-    py::tuple observation =
-        bridge.attr("describe_space")(observation_space, "observation");
-    if (observation[0].cast<std::string>() != "box") {
+    py::tuple entries =
+        bridge.attr("observation_entries")(env_.attr("observation_space"));
+    py::list boxes = entries[1].cast<py::list>();
+    if (py::len(boxes) == 1 && boxes[0].cast<py::tuple>()[1]
+                                       .cast<py::tuple>()[0]
+                                       .cast<std::string>() != "box") {
       return absl::InvalidArgumentError(
           absl::StrCat(spec_.name,
                        ": the observation space is Discrete; vantage takes box "
                        "observations (one-hot encode it into a Box)"));
     }
-    if (absl::Status status = DescribeObservations(observation); !status.ok()) {
-      return status;
-    }
+    bool mask_key = false;
+    absl::StatusOr<PythonObservations> observations =
+        PythonObservations::Describe(entries, spec_, mask_key);
+    if (!observations.ok()) return observations.status();
+    observations_ = *std::move(observations);
+    if (mask_key) masks_ = MaskSource::kObservationKey;
     py::tuple action =
         bridge.attr("describe_space")(env_.attr("action_space"), "action");
     if (absl::Status status = DescribeActions(action); !status.ok()) {
@@ -311,37 +297,6 @@ class PythonEnv final : public Environment {
       if (fps > 0) spec_.control_dt = 1.0 / fps;
     }
     return true;
-  }
-
-  absl::Status DescribeObservations(const py::tuple& space) {
-    layout_.shape = space[2].cast<std::vector<int64_t>>();
-    const std::string dtype = space[3].cast<std::string>();
-    layout_.kind = dtype.size() > 1 ? dtype[1] : '?';
-    if (std::string("fiub").find(layout_.kind) == std::string::npos) {
-      return absl::InvalidArgumentError(absl::StrCat(
-          spec_.name, ": observations of dtype ", dtype,
-          " are not numbers; vantage takes float, int, uint or bool boxes"));
-    }
-    int64_t size = 1;
-    for (int64_t d : layout_.shape) {
-      if (d < 1) {
-        return absl::InvalidArgumentError(
-            absl::StrCat(spec_.name, ": the observation shape ",
-                         ShapeText(layout_.shape), " has an empty dimension"));
-      }
-      size *= d;
-    }
-    spec_.observation_size = size;
-    layout_.image = dtype == "|u1" && layout_.shape.size() == 3;
-    if (layout_.image) {
-      spec_.observation_shape = {layout_.shape[2], layout_.shape[0],
-                                 layout_.shape[1]};
-      const std::vector<double> high = space[5].cast<std::vector<double>>();
-      const double top = *std::max_element(high.begin(), high.end());
-      spec_.observation_high =
-          static_cast<int64_t>(std::clamp(top, 1.0, 255.0));
-    }
-    return absl::OkStatus();
   }
 
   absl::Status DescribeActions(const py::tuple& space) {
@@ -434,23 +389,22 @@ class PythonEnv final : public Environment {
       if (!py::isinstance<py::dict>(value)) {
         return absl::InvalidArgumentError(absl::StrCat(
             spec_.name, ": ", call,
-            " returned an observation that is not a dict of observation and "
-            "action_mask, as its space says"));
+            " returned an observation that is not a dict, as its space "
+            "says"));
       }
       py::dict parts = py::reinterpret_borrow<py::dict>(value);
-      if (!parts.contains("observation") || !parts.contains("action_mask")) {
+      if (!parts.contains("action_mask")) {
         return absl::InvalidArgumentError(
             absl::StrCat(spec_.name, ": ", call,
-                         " returned an observation without the observation and "
-                         "action_mask keys"));
+                         " returned an observation without the action_mask "
+                         "key its space has"));
       }
-      observation = parts["observation"];
       mask = parts["action_mask"];
     } else if (masks_ == MaskSource::kInfo && py::isinstance<py::dict>(info) &&
                py::reinterpret_borrow<py::dict>(info).contains("action_mask")) {
       mask = py::reinterpret_borrow<py::dict>(info)["action_mask"];
     }
-    if (absl::Status status = WriteObservation(observation, call, out);
+    if (absl::Status status = observations_.Write(observation, call, out);
         !status.ok()) {
       return status;
     }
@@ -527,70 +481,6 @@ class PythonEnv final : public Environment {
     return std::move(out);
   }
 
-  // Checks an observation against the space and writes it flat (images
-  // channels first) into `out` (GIL held).
-  absl::Status WriteObservation(py::handle value, const char* call,
-                                absl::Span<double> out) const {
-    py::array array = py::array::ensure(value);
-    if (!array) {
-      return absl::InvalidArgumentError(
-          absl::StrCat(spec_.name, ": ", call,
-                       " returned an observation that is not an array"));
-    }
-    std::vector<int64_t> shape(array.shape(), array.shape() + array.ndim());
-    if (shape != layout_.shape) {
-      return absl::InvalidArgumentError(absl::StrCat(
-          spec_.name, ": ", call, " returned an observation of shape ",
-          ShapeText(shape), "; the observation space's is ",
-          ShapeText(layout_.shape)));
-    }
-    const char kind = array.dtype().kind();
-    const bool fits = layout_.image ? array.dtype().is(py::dtype::of<uint8_t>())
-                                    : kind == layout_.kind;
-    if (!fits) {
-      return absl::InvalidArgumentError(absl::StrCat(
-          spec_.name, ": ", call, " returned an observation of dtype ",
-          py::str(array.dtype()).cast<std::string>(),
-          "; the observation space's is ", layout_.image ? "uint8" : "of kind ",
-          layout_.image ? "" : std::string(1, layout_.kind)));
-    }
-    if (layout_.image) {
-      auto pixels = py::array_t<uint8_t, py::array::c_style>::ensure(array);
-      const int64_t h = shape[0], w = shape[1], c = shape[2];
-      const uint8_t* in = pixels.data();
-      for (int64_t y = 0; y < h; ++y) {
-        for (int64_t x = 0; x < w; ++x) {
-          for (int64_t k = 0; k < c; ++k) {
-            out[(k * h + y) * w + x] = in[(y * w + x) * c + k];
-          }
-        }
-      }
-      return absl::OkStatus();
-    }
-    // float32 and float64 (nearly every env) are read where they lie;
-    // other dtypes and strided arrays through one converted copy.
-    const bool packed = array.flags() & py::array::c_style;
-    if (packed && array.dtype().is(py::dtype::of<float>())) {
-      const float* in = static_cast<const float*>(array.data());
-      std::copy(in, in + out.size(), out.begin());
-    } else if (packed && array.dtype().is(py::dtype::of<double>())) {
-      std::memcpy(out.data(), array.data(), out.size() * sizeof(double));
-    } else {
-      auto values =
-          py::array_t<double,
-                      py::array::c_style | py::array::forcecast>::ensure(array);
-      std::memcpy(out.data(), values.data(), out.size() * sizeof(double));
-    }
-    for (size_t i = 0; i < out.size(); ++i) {
-      if (!std::isfinite(out[i])) {
-        return absl::InvalidArgumentError(absl::StrCat(
-            spec_.name, ": ", call, " returned an observation whose value ", i,
-            " is ", out[i], ", which is not finite"));
-      }
-    }
-    return absl::OkStatus();
-  }
-
   // `pixels` (height x width x 3) scaled to width x height, nearest pixel.
   static Frame Resized(const py::array_t<uint8_t, py::array::c_style>& pixels,
                        int width, int height) {
@@ -612,7 +502,7 @@ class PythonEnv final : public Environment {
   }
 
   EnvSpec spec_;
-  ObservationLayout layout_;
+  PythonObservations observations_;
   py::dtype action_dtype_ = py::dtype::of<float>();
   std::vector<int64_t> action_shape_;
   py::object env_;

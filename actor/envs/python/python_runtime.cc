@@ -60,14 +60,37 @@ def make(target, kwargs_json):
     return factory(**kwargs)
 
 
-def masked_observation_space(space):
-    # PettingZoo's convention for masks in the observation: a Dict of the
-    # observation and the mask.
+def observation_entries(space):
+    # ("single", [("", box)], False), or a Dict's or Tuple's entries in order
+    # as ("dict" | "tuple", [(key, box), ...], whether a Dict holds an
+    # "action_mask" key, which is the action mask, not an entry).
     spaces = getattr(space, "spaces", None)
-    if isinstance(spaces, dict) and set(spaces) == {"observation",
-                                                    "action_mask"}:
-        return spaces["observation"]
-    return None
+    if spaces is None:
+        return ("single", [("", describe_space(space, "observation"))], False)
+    kind = type(space).__name__
+    if isinstance(spaces, dict):
+        container, items = "dict", list(spaces.items())
+    else:
+        container, items = "tuple", [(str(i), s) for i, s in enumerate(spaces)]
+    has_mask = container == "dict" and "action_mask" in spaces
+    entries = []
+    for key, sub in items:
+        if has_mask and key == "action_mask":
+            continue
+        path = f"observation[{key!r}]"
+        if hasattr(sub, "spaces"):
+            raise TypeError(f"{path} is a {type(sub).__name__} space inside the "
+                            f"{kind} space; vantage takes one level of Dict or "
+                            "Tuple (flatten the inner one)")
+        described = describe_space(sub, path)
+        if described[0] != "box":
+            raise TypeError(f"{path} is a {type(sub).__name__} space; vantage "
+                            "takes box entries (one-hot encode it into a Box)")
+        entries.append((str(key), described))
+    if not entries:
+        raise TypeError(f"the observation space is a {kind} space without "
+                        "entries")
+    return (container, entries, has_mask)
 
 
 def first_info_has_action_mask(env):

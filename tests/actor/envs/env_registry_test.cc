@@ -13,6 +13,7 @@
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
 #include "tests/fakes/box_model.h"
+#include "tests/fakes/random_discrete_action.h"
 
 namespace vantage {
 namespace {
@@ -25,11 +26,9 @@ std::unique_ptr<Environment> Make(const std::string& name) {
   return env.ok() ? std::move(*env) : nullptr;
 }
 
-std::vector<double> RandomAction(const EnvSpec& spec, std::mt19937_64& rng) {
-  if (spec.discrete) {
-    return {static_cast<double>(
-        std::uniform_int_distribution<int64_t>(0, spec.action_size - 1)(rng))};
-  }
+std::vector<double> RandomAction(const Environment& env, std::mt19937_64& rng) {
+  const EnvSpec& spec = env.spec();
+  if (spec.discrete) return RandomDiscreteAction(env, rng);
   std::vector<double> action(spec.action_size);
   for (int64_t i = 0; i < spec.action_size; ++i) {
     action[i] = std::uniform_real_distribution<double>(
@@ -47,7 +46,7 @@ std::vector<std::vector<double>> Episode(Environment& env, uint64_t seed,
   std::vector<std::vector<double>> seen = {observation};
   for (int t = 0; t < max_steps; ++t) {
     absl::StatusOr<StepResult> result =
-        env.Step(RandomAction(env.spec(), rng), absl::MakeSpan(observation));
+        env.Step(RandomAction(env, rng), absl::MakeSpan(observation));
     EXPECT_TRUE(result.ok()) << result.status();
     if (!result.ok()) break;
     seen.push_back(observation);
@@ -265,7 +264,7 @@ TEST(EnvRegistryTest, SparseHalfCheetahIsSilentNearTheStart) {
   ASSERT_TRUE(env->Reset(1, absl::MakeSpan(observation)).ok());
   for (int t = 0; t < 200; ++t) {
     absl::StatusOr<StepResult> result =
-        env->Step(RandomAction(env->spec(), rng), absl::MakeSpan(observation));
+        env->Step(RandomAction(*env, rng), absl::MakeSpan(observation));
     ASSERT_TRUE(result.ok());
     EXPECT_EQ(result->reward, 0.0);
   }

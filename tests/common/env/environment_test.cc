@@ -4,6 +4,8 @@
 
 #include "common/env/environment.h"
 
+#include <functional>
+#include <string>
 #include <vector>
 
 #include "gmock/gmock.h"
@@ -94,6 +96,53 @@ TEST(EnvironmentTest, AMultiDiscreteLayoutSumsToTheLogits) {
   spec.discrete = false;
   EXPECT_THAT(CheckActionLayout(spec).message(),
               HasSubstr("for continuous actions"));
+}
+
+// A camera image of 2x3x3 bytes and 4 joint values.
+EnvSpec DictSpec() {
+  EnvSpec spec;
+  spec.name = "dict";
+  spec.observation_size = 22;
+  spec.observation_keys = {{"camera", 18, {2, 3, 3}, 255},
+                           {"joints", 4, {}, 0}};
+  spec.action_size = 1;
+  return spec;
+}
+
+TEST(EnvironmentTest, DictEntriesFillTheRowAndNameEveryDefect) {
+  EXPECT_TRUE(CheckObservationLayout(DictSpec()).ok());
+  EXPECT_EQ(DictSpec().ObservationString(),
+            "dict(camera: uint8 2x3x3, joints: 4)");
+  struct Case {
+    std::function<void(EnvSpec&)> change;
+    std::string message;
+  };
+  const std::vector<Case> cases = {
+      {[](EnvSpec& s) { s.observation_size = 23; },
+       "sizes sum to 22, expected observation_size 23"},
+      {[](EnvSpec& s) { s.observation_keys[1].name = "camera"; },
+       "\"camera\" appears twice"},
+      {[](EnvSpec& s) { s.observation_keys[0].name.clear(); },
+       "observation_keys[0] (\"\"): an empty name"},
+      {[](EnvSpec& s) { s.observation_keys[0].high = 0; },
+       "(\"camera\"): high 0, expected 1..255 for an image"},
+      {[](EnvSpec& s) { s.observation_keys[1].high = 3; },
+       "(\"joints\"): high 3 for a vector"},
+      {[](EnvSpec& s) {
+         s.observation_keys[0].shape = {2, 3, 2};
+       },
+       "shape 2x3x2 does not hold its size 18"},
+      {[](EnvSpec& s) { s.observation_keys[0].shape = {18}; },
+       "expected [channels, height, width]"},
+      {[](EnvSpec& s) { s.observation_high = 255; },
+       "a Dict observation is a float row"},
+  };
+  for (const Case& c : cases) {
+    EnvSpec spec = DictSpec();
+    c.change(spec);
+    EXPECT_THAT(CheckObservationLayout(spec).message(), HasSubstr(c.message))
+        << c.message;
+  }
 }
 
 }  // namespace

@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "common/nn/distributions.h"
+#include "gmock/gmock.h"
 #include "gtest/gtest.h"
 
 namespace vantage {
@@ -246,6 +247,51 @@ TEST(TorsoTest, ByteObservationsAreScaledByTheirHigh) {
   EXPECT_TRUE(
       at::equal(ObservationTensor(reals, written, 2),
                 at::tensor({0, 1, 1, 255, 0, 7}, at::kFloat).reshape({2, 3})));
+}
+
+// A Dict of a 1x6x6 camera and 3 joint values: the camera through a
+// MinAtar torso of its own, the joints as they are, then the MLP; only the
+// joints are normalised, the camera enters divided by its high.
+TEST(TorsoTest, ADictObservationGetsATorsoPerImageAndNormalisedVectors) {
+  EnvSpec spec;
+  spec.name = "dict";
+  spec.observation_size = 39;
+  spec.observation_keys = {{"camera", 36, {1, 6, 6}, 255},
+                           {"joints", 3, {}, 0}};
+  spec.discrete = true;
+  spec.action_size = 4;
+  ASSERT_TRUE(CheckNetworkConfig(NetworkConfig{{16}}, spec).ok());
+  at::manual_seed(4);
+  PolicyNetwork policy(spec, NetworkConfig{{16}});
+  ValueNetwork value(spec, NetworkConfig{{16}});
+  ASSERT_FALSE(policy->dict_torso().is_empty());
+  ASSERT_EQ(policy->dict_torso()->convs().size(), 2u);
+  EXPECT_FALSE(policy->dict_torso()->convs()[0].is_empty());
+  EXPECT_TRUE(policy->dict_torso()->convs()[1].is_empty());
+  // MinAtar's torso gives 128 features; the joints add 3.
+  EXPECT_EQ(policy->dict_torso()->features(), 128 + 3);
+  const at::Tensor row = at::cat(
+      {at::randint(0, 256, {5, 36}).to(at::kFloat), at::randn({5, 3})}, 1);
+  EXPECT_EQ(policy->forward(row).sizes(), at::IntArrayRef({5, 4}));
+  EXPECT_EQ(value->forward(row).sizes(), at::IntArrayRef({5}));
+
+  RunningMeanStd normalizer(39);
+  ASSERT_TRUE(normalizer.Update(at::randn({20, 39}) * 3 + 1).ok());
+  const at::Tensor inputs = ObservationsForNetwork(spec, normalizer, row, 10);
+  EXPECT_TRUE(at::allclose(inputs.slice(1, 0, 36), row.slice(1, 0, 36) / 255));
+  EXPECT_TRUE(at::allclose(inputs.slice(1, 36, 39),
+                           normalizer.Normalize(row, 10).slice(1, 36, 39)));
+
+  EXPECT_THAT(
+      CheckNetworkConfig(NetworkConfig{{16}, Torso::kNature}, spec).message(),
+      ::testing::HasSubstr("--torso=nature does not apply"));
+  NetworkConfig recurrent{{16}};
+  recurrent.core = Core::kGru;
+  recurrent.core_size = 8;
+  EXPECT_THAT(CheckNetworkConfig(recurrent, spec).message(),
+              ::testing::HasSubstr("which a recurrent --core does not take"));
+  spec.observation_keys[0].shape = {9, 2, 2};  // below 3x3
+  EXPECT_FALSE(CheckNetworkConfig(NetworkConfig{{16}}, spec).ok());
 }
 
 }  // namespace

@@ -174,6 +174,29 @@ TEST(PolicyOnnxTest, AMultiDiscretePolicyAgreesUnderOpenCv) {
   ExpectClose(out[1], e.output, "logits");
 }
 
+// A Dict of a 2x6x6 camera and 5 joint values: the camera's slice of the
+// row through its convolutional torso, the joints normalised.
+TEST(PolicyOnnxTest, ADictPolicyAgreesUnderOpenCv) {
+  at::manual_seed(6);
+  EnvSpec spec = VectorSpec(true, 77, 4);
+  spec.observation_keys = {{"camera", 72, {2, 6, 6}, 255},
+                           {"joints", 5, {}, 0}};
+  Exported e = Export(spec, NetworkConfig());
+  // The camera's entries as an environment gives them: bytes.
+  e.observations.slice(1, 0, 72).copy_(
+      at::randint(0, 256, {kRows, 72}, at::kDouble));
+  at::NoGradGuard no_grad;
+  const at::Tensor output = e.policy->forward(ObservationsForNetwork(
+      spec, e.normalizer,
+      ObservationTensor(spec, e.observations.data_ptr<double>(), kRows),
+      kClip));
+  const std::vector<cv::Mat> out =
+      RunOnOpenCv(e.model, e.observations, {"action", "logits"});
+  ASSERT_EQ(out.size(), 2u);
+  ExpectClose(out[0], output.argmax(-1), "action");
+  ExpectClose(out[1], output, "logits");
+}
+
 TEST(PolicyOnnxTest, AConvolutionalPolicyOnBytesAgreesUnderOpenCv) {
   at::manual_seed(3);
   EnvSpec spec = VectorSpec(true, 4 * 10 * 10, 3);
