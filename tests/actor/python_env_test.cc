@@ -422,6 +422,9 @@ TEST(PythonEnvTest, EveryErrorNamesTheEnvTheCallAndTheCause) {
               HasSubstr("its spaces: TypeError: observation['a'] is a Dict "
                         "space inside the Dict space; vantage takes one level "
                         "of Dict or Tuple"));
+  EXPECT_THAT(Error("python:broken_envs:text_entry"),
+              HasSubstr("TypeError: the observation['note'] space is a Text "
+                        "space; vantage takes a box"));
   EXPECT_THAT(Error("python:cartpole"), HasSubstr("names no factory"));
   EXPECT_THAT(Error("gym:"), HasSubstr("gym: needs an id"));
   EXPECT_THAT(Error("python:cartpole:make", "[1, 2]"),

@@ -39,8 +39,9 @@ std::string FreshDirectory(const std::string& name) {
 
 // `name`: an algorithm, or "ex2", optionally with a recurrent core
 // ("ppo_gru": PPO with a GRU of 16 units), evaluations ("ppo_eval": of
-// 3 episodes every 2 updates) or masked actions ("ppo_masked": on
-// LitButtons instead of Hopper).
+// 3 episodes every 2 updates), masked actions ("ppo_masked": on
+// LitButtons instead of Hopper) or a Dict observation ("ppo_dict": on
+// LitButtons:dict=true).
 RunPlan SmallRun(const std::string& name, uint64_t seed,
                  const std::string& run_dir) {
   const std::vector<std::string> parts = absl::StrSplit(name, '_');
@@ -53,6 +54,8 @@ RunPlan SmallRun(const std::string& name, uint64_t seed,
     run.mutable_evaluation()->set_eval_episodes(3);
   } else if (parts.size() > 1 && parts[1] == "masked") {
     training.set_env("LitButtons");
+  } else if (parts.size() > 1 && parts[1] == "dict") {
+    training.set_env("LitButtons:dict=true");
   } else if (parts.size() > 1) {
     training.set_core(parts[1]);
     training.set_core_size(16);
@@ -217,7 +220,7 @@ INSTANTIATE_TEST_SUITE_P(Algorithms, ResumeTest,
                          ::testing::Values("ppo", "a2c", "trpo", "ex2",
                                            "ppo_gru", "a2c_lstm", "ppo_eval",
                                            "ppo_masked", "a2c_masked",
-                                           "trpo_masked"));
+                                           "trpo_masked", "ppo_dict"));
 
 // Every second version is evaluated before its row, which holds the
 // evaluation; checkpoints/best.pt is the version whose evaluation was best

@@ -116,4 +116,23 @@ def nested_dict():
     return NestedDict()
 
 
+class Text:
+    """Gymnasium's Text space as vantage sees it: no box, no choices."""
+
+    def __init__(self, max_length):
+        self.max_length = max_length
+        self.dtype = str
+
+
+class TextEntry(CartPole):
+    def __init__(self):
+        super().__init__()
+        self.observation_space = Dict(
+            {"joints": Box(-1, 1, shape=(2,)), "note": Text(8)})
+
+
+def text_entry():
+    return TextEntry()
+
+
 not_callable = 3

@@ -23,6 +23,7 @@ struct LitButtonsTask {
   int64_t lit = 3;
   int64_t steps = 16;
   bool masked = true;
+  bool dict = false;
 };
 
 std::vector<EnvOption> Options(LitButtonsTask& task) {
@@ -32,7 +33,11 @@ std::vector<EnvOption> Options(LitButtonsTask& task) {
           {"masked",
            "action masks allow the lit buttons only (false: an unlit press "
            "costs 1)",
-           &task.masked}};
+           &task.masked},
+          {"dict",
+           "the observation as a Dict of its two halves, \"lit\" and "
+           "\"values\"",
+           &task.dict}};
 }
 
 class LitButtons final : public Environment {
@@ -41,6 +46,10 @@ class LitButtons final : public Environment {
       : task_(task), values_(task.buttons) {
     spec_.name = std::move(name);
     spec_.observation_size = 2 * task.buttons;
+    if (task.dict) {
+      spec_.observation_keys = {{"lit", task.buttons, {}, 0},
+                                {"values", task.buttons, {}, 0}};
+    }
     spec_.discrete = true;
     spec_.action_size = task.buttons;
     spec_.action_masks = task.masked;

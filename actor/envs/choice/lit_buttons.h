@@ -16,7 +16,9 @@
 //
 // Options (`LitButtons:buttons=16,lit=2,masked=false`): buttons (>= 2,
 // default 32), lit (>= 1, at most buttons, default 3), steps (>= 1,
-// default 16) and masked (default true).
+// default 16), masked (default true) and dict (default false: the same
+// values as a Dict observation of "lit" and "values", the native form of a
+// structured observation).
 
 #include <memory>
 #include <vector>

@@ -122,6 +122,17 @@ TEST(LitButtonsTest, SavedStateRestoresThePanelAndItsMask) {
                         "here"));
 }
 
+TEST(LitButtonsTest, ItsDictFormIsTheSameRowDescribedByItsHalves) {
+  std::unique_ptr<Environment> plain = Make("LitButtons:buttons=4");
+  std::unique_ptr<Environment> dict = Make("LitButtons:buttons=4,dict=true");
+  EXPECT_EQ(dict->spec().ObservationString(), "dict(lit: 4, values: 4)");
+  EXPECT_TRUE(CheckObservationLayout(dict->spec()).ok());
+  std::vector<double> a(8), b(8);
+  ASSERT_TRUE(plain->Reset(2, absl::MakeSpan(a)).ok());
+  ASSERT_TRUE(dict->Reset(2, absl::MakeSpan(b)).ok());
+  EXPECT_EQ(a, b);
+}
+
 TEST(LitButtonsTest, OptionsAreChecked) {
   EXPECT_THAT(MakeEnvironment("LitButtons:lit=5,buttons=4").status().message(),
               HasSubstr("lit=5 exceeds buttons=4"));
