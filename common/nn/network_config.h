@@ -57,17 +57,6 @@ const ConvTorsoDesign* FindConvTorsoDesign(Torso torso);
 // (< 1: the input is too small).
 int64_t ConvOutputSide(const ConvTorsoDesign& design, int64_t size);
 
-// Dict observations (EnvSpec::observation_keys, common/nn/dict_torso.h):
-// why a network cannot take `spec`'s with `config` (a torso other than
-// auto, a shared torso, a recurrent core, or an image too small for any
-// convolutional torso); OK for a spec without entries.
-struct NetworkConfig;
-absl::Status CheckDictNetwork(const NetworkConfig& config, const EnvSpec& spec);
-// The convolutional torso an image entry gets: --torso=auto's choice for
-// that image alone.
-absl::StatusOr<Torso> DictImageTorso(const EnvSpec& spec,
-                                     const ObservationKey& key);
-
 // A recurrent core after the torso: the policy then acts on what it has
 // seen in its episode so far, not only on the current observation.
 enum class Core {
@@ -112,6 +101,16 @@ struct NetworkConfig {
 // fewer than one unit.
 absl::Status CheckNetworkConfig(const NetworkConfig& config,
                                 const EnvSpec& spec);
+
+// Dict observations (EnvSpec::observation_keys, common/nn/dict_torso.h):
+// why a network cannot take `spec`'s with `config` (a torso other than
+// auto, a shared torso, a recurrent core, or an image too small for any
+// convolutional torso); OK for a spec without entries.
+absl::Status CheckDictNetwork(const NetworkConfig& config, const EnvSpec& spec);
+// The convolutional torso an image entry gets: --torso=auto's choice for
+// that image alone.
+absl::StatusOr<Torso> DictImageTorso(const EnvSpec& spec,
+                                     const ObservationKey& key);
 
 }  // namespace vantage
 
