@@ -66,7 +66,10 @@ VectorEnv::VectorEnv(std::vector<std::unique_ptr<Environment>> envs,
   truncated_.resize(m);
   episode_returns_.resize(m);
   episode_lengths_.resize(m);
-  if (s.action_masks) action_masks_.resize(m * s.action_size);
+  if (s.action_masks) {
+    action_masks_.resize(m * s.action_size);
+    action_heads_ = s.action_heads();
+  }
 }
 
 absl::Status VectorEnv::ResetOne(int index) {
@@ -96,7 +99,7 @@ absl::Status VectorEnv::ReadMask(int index) {
 absl::Status VectorEnv::CheckLegal(int index,
                                    absl::Span<const double> action) const {
   if (action_masks_.empty()) return absl::OkStatus();
-  const std::vector<int64_t> heads = spec().action_heads();
+  const std::vector<int64_t>& heads = action_heads_;
   const uint8_t* mask = action_masks_.data() + index * spec().action_size;
   for (size_t h = 0; h < heads.size(); mask += heads[h], ++h) {
     // The env's own CheckAction names a value out of range.

@@ -103,6 +103,9 @@ class VectorEnv {
   std::vector<uint8_t> terminated_;
   std::vector<uint8_t> truncated_;
   std::vector<uint8_t> action_masks_;
+  // Masked actions' heads (EnvSpec::action_heads), read once: stepping
+  // checks every action against them.
+  std::vector<int64_t> action_heads_;
   std::vector<double> episode_returns_;
   std::vector<int64_t> episode_lengths_;
   std::vector<FinishedEpisode> finished_;
