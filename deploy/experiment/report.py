@@ -83,6 +83,12 @@ flags:
       the settings that are not the comparison's (rho, ensemble): e.g.
       --baseline=order:2 --match=rho tests each order statistic against
       the 2nd order at the same rho
+  --baseline_set=""
+      FLAG=VALUE[,FLAG=VALUE...]: the baseline is the --baseline
+      estimator's group whose cells set these flags to these values, and a
+      group may differ from it in them: e.g. --baseline_set=exploration=none
+      tests every group (EX2 alone, max and min over EX2) against plain
+      TRPO (gae without exploration)
   --threshold=""
       ENV=RETURN[,ENV=RETURN...]: the returns whose first crossing is
       reported (empty: the experiment's report.thresholds)
@@ -109,6 +115,7 @@ def parse_arguments(argv):
   parser.add_argument("--baseline", default="")
   parser.add_argument("--threshold", default="")
   parser.add_argument("--match", default="")
+  parser.add_argument("--baseline_set", default="")
   parser.add_argument("--no_figures", action="store_true")
   args = parser.parse_args(argv)
   if not args.exp_dir:
@@ -118,6 +125,16 @@ def parse_arguments(argv):
   for field in args.match - {"rho", "ensemble"}:
     raise ReportError(f"--match={field}: only rho and ensemble can be "
                       f"matched (the other settings always are)")
+  entries, args.baseline_set = args.baseline_set.split(","), {}
+  for entry in filter(None, entries):
+    flag, equals, value = entry.partition("=")
+    if not flag or not equals or not value:
+      raise ReportError(f"--baseline_set entry '{entry}' is not FLAG=VALUE")
+    if flag in NOT_MATCHED:
+      raise ReportError(f"--baseline_set={entry}: {flag} is not a setting "
+                        f"to fix (--baseline names the estimator; env, "
+                        f"seed, steps, rho and ensemble are never matched)")
+    args.baseline_set[flag] = value
   args.thresholds = {}
   for entry in filter(None, args.threshold.split(",")):
     env, _, value = entry.partition("=")
@@ -221,15 +238,36 @@ class RunResult:
     return None
 
 
-def group_key(cell, matched=frozenset()):
+def group_key(cell, matched=frozenset(), ignored=frozenset()):
   """What a group's baseline must share with it."""
   flags = cell.get("flags", {})
-  return tuple(sorted((k, v) for k, v in flags.items()
-                      if k not in NOT_MATCHED - matched))
+  skipped = (NOT_MATCHED - matched) | ignored
+  return tuple(sorted((k, v) for k, v in flags.items() if k not in skipped))
 
 
 def estimator_of(cell):
   return cell["config"].get("advantage", {}).get("estimator", "gae")
+
+
+class Baseline:
+  """What every group is compared with: an estimator's group, and with
+  --baseline_set one whose cells set those flags so (in which the other
+  groups may differ from it)."""
+
+  def __init__(self, estimator, settings=None):
+    self.estimator = estimator
+    self.settings = dict(settings or {})
+
+  def holds(self, cell):
+    flags = cell.get("flags", {})
+    return estimator_of(cell) == self.estimator and all(
+        flags.get(k) == v for k, v in self.settings.items())
+
+  def label(self):
+    if not self.settings:
+      return self.estimator
+    fixed = ", ".join(f"{k}={v}" for k, v in sorted(self.settings.items()))
+    return f"{self.estimator} ({fixed})"
 
 
 def mean_sd(values):
@@ -446,9 +484,10 @@ class EnvResults:
   """An env's groups of cells, their finished runs and their comparisons
   with the baseline (adjusted later, with the whole report's family)."""
 
-  def __init__(self, env, results, baseline_name, matched=frozenset()):
-    self.env, self.baseline_name = env, baseline_name
+  def __init__(self, env, results, baseline, matched=frozenset()):
+    self.env, self.baseline = env, baseline
     self.matched = frozenset(matched)
+    self.ignored = frozenset(baseline.settings)
     self.groups = {}
     for result in results:
       self.groups.setdefault(result.cell["group"], []).append(result)
@@ -458,10 +497,10 @@ class EnvResults:
     self.baselines = {}
     for group, runs in self.groups.items():
       cell = runs[0].cell
-      if estimator_of(cell) == baseline_name:
-        self.baselines.setdefault(group_key(cell, self.matched), group)
-    self.order = sorted(self.groups, key=lambda g: (estimator_of(
-        self.groups[g][0].cell) != baseline_name, g))
+      if baseline.holds(cell):
+        self.baselines.setdefault(self.key(cell), group)
+    self.order = sorted(self.groups, key=lambda g: (
+        not baseline.holds(self.groups[g][0].cell), g))
     self.comparisons = {}
     for group in self.order:
       base = self.base_of(group)
@@ -470,9 +509,11 @@ class EnvResults:
         self.comparisons[group] = Comparison(
             group, base, self.finished[group], self.finished[base])
 
+  def key(self, cell):
+    return group_key(cell, self.matched, self.ignored)
+
   def base_of(self, group):
-    return self.baselines.get(
-        group_key(self.groups[group][0].cell, self.matched))
+    return self.baselines.get(self.key(self.groups[group][0].cell))
 
   def runs(self):
     return sum(len(r) for r in self.finished.values())
@@ -486,7 +527,7 @@ def env_section(results, threshold, figure, figure_problem):
     lines += [f"![learning curves on {env}]({figure})", ""]
   elif figure_problem:
     lines += [f"(No figure: {figure_problem}.)", ""]
-  lines += table_header(results.baseline_name, threshold)
+  lines += table_header(results.baseline.label(), threshold)
   for group in results.order:
     runs = results.finished[group]
     row = group_row(group, runs, len(results.groups[group]), threshold)
@@ -572,11 +613,16 @@ def main(argv):
   args = parse_arguments(argv)
   experiment = read_experiment(args.exp_dir)
   report = experiment.get("report", {})
-  baseline_name = args.baseline or report.get("baseline") or "gae"
+  baseline = Baseline(args.baseline or report.get("baseline") or "gae",
+                      args.baseline_set)
   estimators = sorted({estimator_of(c) for c in experiment["cells"]})
   if args.baseline and args.baseline not in estimators:
     raise ReportError(f"--baseline={args.baseline}: no cell uses that "
                       f"estimator (the experiment's: {', '.join(estimators)})")
+  if baseline.settings and not any(baseline.holds(c)
+                                   for c in experiment["cells"]):
+    raise ReportError(f"--baseline_set: no {baseline.estimator} cell sets "
+                      f"{baseline.label()[len(baseline.estimator) + 2:-1]}")
   thresholds = dict(report.get("thresholds", {}))
   thresholds.update(args.thresholds)
   out = args.out or os.path.join(args.exp_dir, "report.md")
@@ -603,7 +649,7 @@ def main(argv):
             f"(every cell's steps x {budget:g}); "
             f"{len(experiment['cells'])} cells. Final return: the last "
             f"100 episodes' mean at the end of a run. Groups are compared "
-            f"with `{baseline_name}` by a 95% percentile bootstrap over "
+            f"with `{baseline.label()}` by a 95% percentile bootstrap over "
             f"seeds and Welch's t-test; the report's tests are one family, "
             f"their p-values adjusted by Holm's method; \"with "
             f"confidence\" means the interval excludes 0 and the adjusted "
@@ -614,7 +660,7 @@ def main(argv):
             f"than {MIN_SEEDS} seeds gets no test. Comparisons of groups "
             f"run on different CPU models (or unrecorded ones) are "
             f"flagged.", ""]
-  results = {env: EnvResults(env, by_env[env], baseline_name, args.match)
+  results = {env: EnvResults(env, by_env[env], baseline, args.match)
              for env in sorted(by_env)}
   adjust_family([c for r in results.values() for c in r.comparisons.values()])
   sections = []
@@ -634,7 +680,7 @@ def main(argv):
   runs_total = sum(r.runs() for r in results.values())
   lines += summary_section(
       {env: list(r.comparisons.values()) for env, r in results.items()},
-      baseline_name) + sections
+      baseline.label()) + sections
   with open(out, "w", encoding="utf-8") as f:
     f.write("\n".join(lines))
   print(f"wrote {out}: {len(by_env)} envs, {groups_total} groups, "

@@ -412,27 +412,23 @@ class ReportTest(unittest.TestCase):
       self.assertIn(f"{progress} {message}", result.stderr)
       self.assertEqual(result.stderr.count("\n"), 1, result.stderr)
 
-  def test_a_matched_baseline_shares_the_rho(self):
-    # order:4 and order:2 at two rhos: with --match=rho each order:4 group
-    # is compared with the order:2 group of its own rho.
-    exp = os.path.join(self.root, "matched")
+  def write_finals(self, name, groups):
+    """An experiment of one-row runs on Hopper: group -> (flags besides
+    env and seed, final returns by seed)."""
+    exp = os.path.join(self.root, name)
     shutil.rmtree(exp, ignore_errors=True)
-    finals = {("order:2", "0.2"): [100, 110, 120],
-              ("order:2", "0.8"): [200, 210, 220],
-              ("order:4", "0.2"): [110, 120, 130],
-              ("order:4", "0.8"): [250, 260, 270]}
     cells = []
-    for (estimator, rho), values in finals.items():
-      group = f"order{estimator[-1]}-rho{rho}"
+    for group, (flags, values) in groups.items():
       for seed, final in enumerate(values):
         directory = f"Hopper/{group}/seed-{seed}"
         config = {"training": {"env": "Hopper", "seed": str(seed),
                                "steps": "1000"},
-                  "advantage": {"estimator": estimator, "rho": float(rho)}}
+                  "advantage": {"estimator": flags["estimator"]}}
+        if "rho" in flags:
+          config["advantage"]["rho"] = float(flags["rho"])
         cells.append({"dir": directory, "env": "Hopper", "group": group,
                       "seed": str(seed), "config": config,
-                      "flags": {"env": "Hopper", "seed": str(seed),
-                                "estimator": estimator, "rho": rho}})
+                      "flags": dict(flags, env="Hopper", seed=str(seed))})
         os.makedirs(os.path.join(exp, directory))
         with open(os.path.join(exp, directory, "config.json"), "w") as f:
           json.dump(config, f)
@@ -440,24 +436,74 @@ class ReportTest(unittest.TestCase):
           f.write(f"env_steps,updates,mean_return,elapsed_s,sps\n"
                   f"1000,1,{final},1,1\n")
     with open(os.path.join(exp, "experiment.json"), "w") as f:
-      json.dump({"name": "matched", "cells": cells}, f)
+      json.dump({"name": name, "cells": cells}, f)
+    return exp
+
+  def report_rows(self, exp, *flags):
     result = subprocess.run([VANTAGE, "experiment", "report", exp,
-                             "--baseline=order:2", "--match=rho",
-                             "--no_figures"],
+                             "--no_figures", *flags],
                             capture_output=True, text=True, timeout=60)
     self.assertEqual(result.returncode, 0, result.stderr)
     with open(os.path.join(exp, "report.md")) as f:
-      _, rows = table_rows(f.read(), "Hopper")
+      return table_rows(f.read(), "Hopper")
+
+  def refused(self, exp, flag, message):
+    bad = subprocess.run([VANTAGE, "experiment", "report", exp, flag],
+                         capture_output=True, text=True, timeout=60)
+    self.assertEqual(bad.returncode, 2, bad.stderr)
+    self.assertIn(message, bad.stderr)
+    self.assertEqual(bad.stderr.count("\n"), 1, bad.stderr)
+
+  def test_a_matched_baseline_shares_the_rho(self):
+    # order:4 and order:2 at two rhos: with --match=rho each order:4 group
+    # is compared with the order:2 group of its own rho.
+    exp = self.write_finals("matched", {
+        f"order{estimator[-1]}-rho{rho}": (
+            {"estimator": estimator, "rho": rho}, values)
+        for (estimator, rho), values in {
+            ("order:2", "0.2"): [100, 110, 120],
+            ("order:2", "0.8"): [200, 210, 220],
+            ("order:4", "0.2"): [110, 120, 130],
+            ("order:4", "0.8"): [250, 260, 270]}.items()})
+    _, rows = self.report_rows(exp, "--baseline=order:2", "--match=rho")
     self.assertTrue(rows["order4-rho0.2"][3].startswith("+10.0 ["),
                     rows["order4-rho0.2"])
     self.assertTrue(rows["order4-rho0.8"][3].startswith("+50.0 ["),
                     rows["order4-rho0.8"])
-    bad = subprocess.run([VANTAGE, "experiment", "report", exp,
-                          "--match=env"],
-                         capture_output=True, text=True, timeout=60)
-    self.assertEqual(bad.returncode, 2, bad.stderr)
-    self.assertIn("--match=env: only rho and ensemble can be matched",
-                  bad.stderr)
+    self.refused(exp, "--match=env",
+                 "--match=env: only rho and ensemble can be matched")
+
+  def test_a_baseline_set_by_a_flag_other_groups_lack(self):
+    # EX2 alone (gae), plain TRPO (gae, exploration=none) and max over EX2:
+    # by default max is compared with EX2 alone and plain TRPO has no
+    # baseline of its own settings; against exploration=none both EX2
+    # groups are compared with plain TRPO.
+    exp = self.write_finals("baseline_set", {
+        "gae": ({"estimator": "gae"}, [-130, -140, -150]),
+        "gae-exploration_none": (
+            {"estimator": "gae", "exploration": "none"}, [-180, -190, -200]),
+        "max": ({"estimator": "max"}, [-100, -110, -120])})
+    header, rows = self.report_rows(exp)
+    self.assertIn("final - gae [95% CI]", header)
+    self.assertTrue(rows["max"][3].startswith("+30.0 ["), rows["max"])
+    self.assertEqual(rows["gae-exploration_none"][3], "—")
+    header, rows = self.report_rows(exp, "--baseline_set=exploration=none")
+    self.assertIn("final - gae (exploration=none) [95% CI]", header)
+    self.assertTrue(rows["gae"][3].startswith("+50.0 ["), rows["gae"])
+    self.assertTrue(rows["max"][3].startswith("+80.0 ["), rows["max"])
+    self.assertEqual(rows["gae-exploration_none"][3], "—")
+    # Two tests in the family: the larger p doubles at most.
+    p_gae, p_max = float(rows["gae"][4]), float(rows["max"][4])
+    self.assertAlmostEqual(float(rows["max"][5]),
+                           min(1, 2 * min(p_gae, p_max)), delta=2e-3)
+    for flag, message in [
+        ("--baseline_set=exploration", "--baseline_set entry 'exploration' "
+         "is not FLAG=VALUE"),
+        ("--baseline_set=rho=0.4", "--baseline_set=rho=0.4: rho is not a "
+         "setting to fix"),
+        ("--baseline_set=exploration=ex3", "--baseline_set: no gae cell "
+         "sets exploration=ex3")]:
+      self.refused(exp, flag, message)
 
   def test_a_damaged_machine_record_is_named(self):
     exp = os.path.join(self.root, "damaged_machine")
