@@ -2,7 +2,8 @@
 # Rewrites every report.md (and its figures) under bench/results from the
 # committed cells, with the binary given (default build/vantage); the order
 # grid also gets its pre-registered tests against the 2nd and 3rd order
-# statistics at the same rho. Usage: bench/results/regenerate.sh [VANTAGE]
+# statistics at the same rho, and the sparse grids their tests against
+# plain TRPO. Usage: bench/results/regenerate.sh [VANTAGE]
 set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
 vantage=${1:-$here/../../build/vantage}
@@ -13,4 +14,11 @@ done
 for order in 2 3; do
   "$vantage" experiment report "$here/order_rho" --baseline=order:$order \
     --match=rho --no_figures --out="$here/order_rho/report_vs_order$order.md"
+done
+# The sparse grids also test EX2 alone and max and min over EX2 against
+# plain TRPO (their `gae` group run without exploration).
+for experiment in $(grep -lE '"exploration": *"none"' "$here"/*/experiment.json); do
+  dir=$(dirname "$experiment")
+  "$vantage" experiment report "$dir" --baseline_set=exploration=none \
+    --no_figures --out="$dir/report_vs_trpo.md"
 done
