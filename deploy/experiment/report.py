@@ -10,6 +10,7 @@ Exit codes follow the vantage CLI: 0 done, 2 a usage error (flags, the
 directory and the files in it), 1 a failure while running.
 """
 
+import fnmatch
 import json
 import math
 import os
@@ -89,6 +90,12 @@ flags:
       group may differ from it in them: e.g. --baseline_set=exploration=none
       tests every group (EX2 alone, max and min over EX2) against plain
       TRPO (gae without exploration)
+  --groups=""
+      comma-separated shell patterns: only the groups whose name matches
+      one are tested (the others are listed, and their baselines still
+      serve), so the family holds just the comparisons of a claim: e.g.
+      --baseline=order:2 --match=rho --groups='order1-*,order4-*' tests
+      min and max against the 2nd order and nothing else
   --threshold=""
       ENV=RETURN[,ENV=RETURN...]: the returns whose first crossing is
       reported (empty: the experiment's report.thresholds)
@@ -116,6 +123,7 @@ def parse_arguments(argv):
   parser.add_argument("--threshold", default="")
   parser.add_argument("--match", default="")
   parser.add_argument("--baseline_set", default="")
+  parser.add_argument("--groups", default="")
   parser.add_argument("--no_figures", action="store_true")
   args = parser.parse_args(argv)
   if not args.exp_dir:
@@ -125,6 +133,7 @@ def parse_arguments(argv):
   for field in args.match - {"rho", "ensemble"}:
     raise ReportError(f"--match={field}: only rho and ensemble can be "
                       f"matched (the other settings always are)")
+  args.groups = [g for g in args.groups.split(",") if g]
   entries, args.baseline_set = args.baseline_set.split(","), {}
   for entry in filter(None, entries):
     flag, equals, value = entry.partition("=")
@@ -484,7 +493,8 @@ class EnvResults:
   """An env's groups of cells, their finished runs and their comparisons
   with the baseline (adjusted later, with the whole report's family)."""
 
-  def __init__(self, env, results, baseline, matched=frozenset()):
+  def __init__(self, env, results, baseline, matched=frozenset(),
+               tested=None):
     self.env, self.baseline = env, baseline
     self.matched = frozenset(matched)
     self.ignored = frozenset(baseline.settings)
@@ -501,11 +511,12 @@ class EnvResults:
         self.baselines.setdefault(self.key(cell), group)
     self.order = sorted(self.groups, key=lambda g: (
         not baseline.holds(self.groups[g][0].cell), g))
+    self.tested = tested or (lambda group: True)
     self.comparisons = {}
     for group in self.order:
       base = self.base_of(group)
-      if base is not None and base != group and self.finished[group] and \
-          self.finished[base]:
+      if base is not None and base != group and self.tested(group) and \
+          self.finished[group] and self.finished[base]:
         self.comparisons[group] = Comparison(
             group, base, self.finished[group], self.finished[base])
 
@@ -534,7 +545,9 @@ def env_section(results, threshold, figure, figure_problem):
     comparison = results.comparisons.get(group)
     if comparison is None:
       base = results.base_of(group)
-      row += ["—" if base == group else "no baseline"] + [""] * 6
+      row += ["—" if base == group else "no baseline" if base is None
+              else "not tested (--groups)" if not results.tested(group)
+              else "no finished runs"] + [""] * 6
     else:
       row += comparison.cells()
     lines.append("| " + " | ".join(row) + " |")
@@ -660,7 +673,14 @@ def main(argv):
             f"than {MIN_SEEDS} seeds gets no test. Comparisons of groups "
             f"run on different CPU models (or unrecorded ones) are "
             f"flagged.", ""]
-  results = {env: EnvResults(env, by_env[env], baseline, args.match)
+  groups = {c["group"] for c in experiment["cells"]}
+  for pattern in args.groups:
+    if not fnmatch.filter(groups, pattern):
+      raise ReportError(f"--groups: no group matches '{pattern}'")
+  tested = (lambda group: any(fnmatch.fnmatchcase(group, pattern)
+                              for pattern in args.groups)) \
+      if args.groups else None
+  results = {env: EnvResults(env, by_env[env], baseline, args.match, tested)
              for env in sorted(by_env)}
   adjust_family([c for r in results.values() for c in r.comparisons.values()])
   sections = []

@@ -473,6 +473,36 @@ class ReportTest(unittest.TestCase):
     self.refused(exp, "--match=env",
                  "--match=env: only rho and ensemble can be matched")
 
+  def test_groups_narrow_the_family_to_a_claim(self):
+    # order:3 beside order:4, both against order:2: --groups='order4-*'
+    # tests order:4 alone, so Holm adjusts over its 2 tests, not 4.
+    finals = {"order2": [100, 110, 120], "order3": [100, 115, 125],
+              "order4": [130, 140, 150]}
+    exp = self.write_finals("groups", {
+        f"{group}-rho{rho}": ({"estimator": f"order:{group[-1]}",
+                               "rho": rho}, [v + shift for v in values])
+        for group, values in finals.items()
+        for rho, shift in (("0.2", 0), ("0.8", 5))})
+    _, everything = self.report_rows(exp, "--baseline=order:2",
+                                     "--match=rho")
+    _, narrowed = self.report_rows(exp, "--baseline=order:2", "--match=rho",
+                                   "--groups=order4-*")
+    for rho in ("0.2", "0.8"):
+      self.assertEqual(narrowed[f"order3-rho{rho}"][3],
+                       "not tested (--groups)")
+      self.assertEqual(narrowed[f"order2-rho{rho}"][3], "—")
+      tested = narrowed[f"order4-rho{rho}"]
+      full = everything[f"order4-rho{rho}"]
+      self.assertEqual(tested[3:5], full[3:5])  # difference, interval, p
+      # Both order:4 groups are 30 above order:2 with the same spreads:
+      # equal p, each adjusted to 2p (4p among the 4 tests of everything).
+      p = float(tested[4])
+      self.assertLess(4 * p, 1)
+      self.assertAlmostEqual(float(tested[5]), 2 * p, delta=2e-3)
+      self.assertAlmostEqual(float(full[5]), 4 * p, delta=2e-3)
+    self.refused(exp, "--groups=order5-*",
+                 "--groups: no group matches 'order5-*'")
+
   def test_a_baseline_set_by_a_flag_other_groups_lack(self):
     # EX2 alone (gae), plain TRPO (gae, exploration=none) and max over EX2:
     # by default max is compared with EX2 alone and plain TRPO has no
