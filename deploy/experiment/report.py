@@ -272,11 +272,12 @@ class Baseline:
     return estimator_of(cell) == self.estimator and all(
         flags.get(k) == v for k, v in self.settings.items())
 
+  def fixed(self):
+    return ", ".join(f"{k}={v}" for k, v in sorted(self.settings.items()))
+
   def label(self):
-    if not self.settings:
-      return self.estimator
-    fixed = ", ".join(f"{k}={v}" for k, v in sorted(self.settings.items()))
-    return f"{self.estimator} ({fixed})"
+    return (f"{self.estimator} ({self.fixed()})" if self.settings
+            else self.estimator)
 
 
 def mean_sd(values):
@@ -635,7 +636,7 @@ def main(argv):
   if baseline.settings and not any(baseline.holds(c)
                                    for c in experiment["cells"]):
     raise ReportError(f"--baseline_set: no {baseline.estimator} cell sets "
-                      f"{baseline.label()[len(baseline.estimator) + 2:-1]}")
+                      f"{baseline.fixed()}")
   thresholds = dict(report.get("thresholds", {}))
   thresholds.update(args.thresholds)
   out = args.out or os.path.join(args.exp_dir, "report.md")
@@ -672,7 +673,9 @@ def main(argv):
             f"10% of the baseline's mean would need there. A group of fewer "
             f"than {MIN_SEEDS} seeds gets no test. Comparisons of groups "
             f"run on different CPU models (or unrecorded ones) are "
-            f"flagged.", ""]
+            f"flagged." + (f" Only the groups matching "
+                           f"{', '.join(args.groups)} are tested: the "
+                           f"family is theirs." if args.groups else ""), ""]
   groups = {c["group"] for c in experiment["cells"]}
   for pattern in args.groups:
     if not fnmatch.filter(groups, pattern):
