@@ -210,6 +210,9 @@ absl::Status ActorCore::CollectSegments(SegmentSink& sink) {
 
   at::NoGradGuard no_grad;
   StoreObservations(envs_->observations(), rollout.observations[0]);
+  for (int64_t i = 0; i < rollout.m; ++i) {
+    rollout.segments[i].first_episode_step = envs_->episode_lengths()[i];
+  }
   if (!core_states_.empty()) {
     rollout.core_states =
         at::from_blob(

@@ -61,6 +61,10 @@ class VectorEnv {
   const std::vector<uint8_t>& action_masks() const { return action_masks_; }
   // Episodes that ended during the last Step.
   const std::vector<FinishedEpisode>& finished() const { return finished_; }
+  // The steps each env's current episode has taken.
+  const std::vector<int64_t>& episode_lengths() const {
+    return episode_lengths_;
+  }
 
   // Every environment's state, the episode-seed generator, the running
   // episode returns and lengths, and what the accessors above return, so

@@ -1,8 +1,14 @@
 #include "learner/learner_config.h"
 
 #include "absl/strings/str_cat.h"
+#include "learner/algorithms/trpo/trpo_config.h"
 
 namespace vantage {
+
+bool LearnerConfig::linear_critic() const {
+  return algorithm.name == "trpo" &&
+         algorithm.Get<TrpoConfig>().linear_baseline;
+}
 
 absl::Status LearnerConfig::Validate() const {
   if (spec.observation_size < 1 || spec.action_size < 1) {
@@ -13,6 +19,14 @@ absl::Status LearnerConfig::Validate() const {
   }
   if (absl::Status status = CheckNetworkConfig(network, spec); !status.ok()) {
     return status;
+  }
+  if (linear_critic() &&
+      (spec.byte_observations() || !spec.observation_keys.empty())) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "--trpo_linear_baseline fits the observations' values and squares; ",
+        spec.name, "'s observations are ",
+        spec.byte_observations() ? "images (bytes)" : "a Dict or Tuple",
+        ": use the value network"));
   }
   return ValidateSettings();
 }

@@ -49,6 +49,9 @@ struct LearnerConfig {
   // A bonus added to the rewards before advantages (none by default).
   ExplorationConfig exploration;
 
+  // Whether the critic is the linear feature baseline (TRPO's
+  // --trpo_linear_baseline) rather than the value network.
+  bool linear_critic() const;
   // Everything, the spec and the network's fit to it included.
   absl::Status Validate() const;
   // Every rule that holds without the env's spec (what a run config

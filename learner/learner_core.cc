@@ -14,6 +14,7 @@
 #include <utility>
 
 #include "absl/strings/str_cat.h"
+#include "learner/batch/linear_critic.h"
 #include "learner/exploration/ex2_bonus.h"
 #include "learner/parallel/replica_reductions.h"
 #include "learner/update/update_guard.h"
@@ -75,9 +76,12 @@ LearnerCore::LearnerCore(const LearnerConfig& config,
       updater_(MakePolicyUpdater(config.algorithm, policy_, value_, replicas_)
                    .value()),
       exploration_(MakeExploration(config, replicas_)),
+      linear_critic_(config.linear_critic() ? std::make_unique<LinearCritic>(
+                                                  config.spec.observation_size)
+                                            : nullptr),
       intake_(config),
       preparer_(config_, *value_, normalizer_, reward_scaler_,
-                exploration_.get(), *replicas_),
+                exploration_.get(), *replicas_, linear_critic_.get()),
       rng_(ReplicaSeed(config.seed, replicas_->rank())) {}
 
 LearnerCore::~LearnerCore() = default;
@@ -101,7 +105,9 @@ absl::Status LearnerCore::SynchroniseReplicas() {
                            static_cast<double>(stale_steps_),
                            static_cast<double>(rolled_back_updates_)},
                           at::kDouble),
-               normalizer_.mean(), normalizer_.var()})};
+               normalizer_.mean(), normalizer_.var(),
+               linear_critic_ != nullptr ? linear_critic_->coefficients()
+                                         : at::zeros({0}, at::kDouble)})};
   try {
     replicas_->Broadcast(parameters, /*root=*/0);
     replicas_->Broadcast(state, /*root=*/0);
@@ -127,6 +133,13 @@ absl::Status LearnerCore::SynchroniseReplicas() {
   stale_segments_ = count(5);
   stale_steps_ = count(6);
   rolled_back_updates_ = count(7);
+  if (linear_critic_ != nullptr) {
+    if (absl::Status status =
+            linear_critic_->Restore(s.slice(0, 8 + 2 * size).clone());
+        !status.ok()) {
+      return status;
+    }
+  }
   return normalizer_.Restore(s[0].item<double>(), s.slice(0, 8, 8 + size),
                              s.slice(0, 8 + size, 8 + 2 * size));
 }
@@ -187,6 +200,25 @@ absl::Status LearnerCore::UpdateNormaliser(
     observations.push_back(rollout.observations.slice(0, 0, config_.horizon));
   }
   return UpdateAcrossReplicas(*replicas_, normalizer_, at::cat(observations));
+}
+
+void LearnerCore::FitLinearCritic(const PreparedBatch& prepared,
+                                  UpdateStats& stats) {
+  const TrainingBatch& batch = prepared.batch;
+  const int64_t rows = batch.observations.size(0) * batch.observations.size(1);
+  const at::Tensor features =
+      LinearCritic::Features(batch.observations.reshape({rows, -1}),
+                             batch.episode_steps.reshape({rows}));
+  absl::StatusOr<double> loss =
+      linear_critic_->Fit(features, prepared.update.returns, *replicas_);
+  if (loss.ok()) {
+    stats.algorithm.value_loss = *loss;
+    return;
+  }
+  std::fprintf(stderr,
+               "learner: warning: after the update to version %ld: %s\n",
+               static_cast<long>(version_),
+               std::string(loss.status().message()).c_str());
 }
 
 void LearnerCore::AddTotals(const UpdateSums& sums, UpdateStats& stats) {
@@ -282,6 +314,9 @@ absl::StatusOr<UpdateStats> LearnerCore::Optimise(
   if (absl::Status status = Commit(rollouts, sums, guard, stats);
       !status.ok()) {
     return status;
+  }
+  if (linear_critic_ != nullptr && !stats.rolled_back) {
+    FitLinearCritic(*prepared, stats);
   }
   stats.rollout_policy_lags = std::move(prepared->lags);
   CountFeeders(rollouts, stats);

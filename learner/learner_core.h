@@ -26,6 +26,7 @@
 namespace vantage {
 
 class Ex2Bonus;
+class LinearCritic;
 class UpdateGuard;
 
 // Consumes segments, stitches rollouts, evaluates the critic, estimates
@@ -103,6 +104,7 @@ class LearnerCore {
   // reward scaler, normaliser and exploration states; then the generator,
   // counters and recent returns.
   absl::Status LoadModels(torch::serialize::InputArchive& archive);
+  absl::Status LoadLinearCritic(torch::serialize::InputArchive& archive);
   absl::Status LoadCounters(torch::serialize::InputArchive& archive);
   // Rank 0's networks, normaliser and counters on every replica; an error
   // if this replica's version differs from rank 0's.
@@ -124,6 +126,10 @@ class LearnerCore {
                       UpdateStats& stats);
   // Absorbs a kept update's observations into the normaliser.
   absl::Status UpdateNormaliser(const std::vector<Rollout>& rollouts);
+  // Refits the linear critic to a kept update's value targets (its loss
+  // becomes the update's value_loss); a fit that fails keeps the old one
+  // and says so.
+  void FitLinearCritic(const PreparedBatch& prepared, UpdateStats& stats);
   void AddTotals(const UpdateSums& sums, UpdateStats& stats);
 
   const LearnerConfig config_;
@@ -136,6 +142,8 @@ class LearnerCore {
   // Created after the networks, from the same generator, so that a run
   // without it initialises exactly as before it existed.
   std::unique_ptr<Ex2Bonus> exploration_;
+  // TRPO's --trpo_linear_baseline: values the states instead of value_.
+  std::unique_ptr<LinearCritic> linear_critic_;
   SegmentIntake intake_;
   BatchPreparer preparer_;
   std::mt19937_64 rng_;

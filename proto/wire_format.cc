@@ -287,6 +287,7 @@ void SegmentToProto(const Segment& segment, pb::Segment* proto) {
                                         segment.episode_returns.end());
   proto->mutable_episode_lengths()->Add(segment.episode_lengths.begin(),
                                         segment.episode_lengths.end());
+  proto->set_first_episode_step(segment.first_episode_step);
 }
 
 absl::StatusOr<Segment> SegmentFromProto(const pb::Segment& proto,
@@ -348,6 +349,7 @@ absl::StatusOr<Segment> SegmentFromProto(const pb::Segment& proto,
                                  proto.episode_returns().end());
   segment.episode_lengths.assign(proto.episode_lengths().begin(),
                                  proto.episode_lengths().end());
+  segment.first_episode_step = proto.first_episode_step();
   return segment;
 }
 

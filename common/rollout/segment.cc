@@ -88,9 +88,29 @@ bool AnyBoth(const at::Tensor& a, const at::Tensor& b) {
   return false;
 }
 
+// Step 0's place in its episode, within the spec's time limit.
+absl::Status CheckFirstEpisodeStep(const Segment& segment,
+                                   const EnvSpec& spec) {
+  if (segment.first_episode_step < 0 ||
+      (spec.max_episode_steps > 0 &&
+       segment.first_episode_step >= spec.max_episode_steps)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("segment field first_episode_step is ",
+                     segment.first_episode_step, ", expected ",
+                     spec.max_episode_steps > 0
+                         ? absl::StrCat("0..", spec.max_episode_steps - 1)
+                         : std::string(">= 0")));
+  }
+  return absl::OkStatus();
+}
+
 // The episodes a segment reports against the episode ends it holds.
 absl::Status CheckEpisodes(const Segment& segment, const EnvSpec& spec,
                            const ValueLimits& limits) {
+  if (absl::Status status = CheckFirstEpisodeStep(segment, spec);
+      !status.ok()) {
+    return status;
+  }
   const size_t reported = segment.episode_returns.size();
   if (reported != segment.episode_lengths.size()) {
     return absl::InvalidArgumentError(

@@ -45,6 +45,9 @@ struct Segment {
   // Episodes that ended inside this segment.
   std::vector<double> episode_returns;
   std::vector<int64_t> episode_lengths;
+  // The step of its episode that step 0 is (0: an episode starts there);
+  // each later step counts on from it, and from 0 after an episode's end.
+  int64_t first_episode_step = 0;
 
   // 0 for a rewards tensor that is missing or has no time axis (which
   // ValidateSegment refuses).
@@ -64,7 +67,8 @@ struct Segment {
 // within max_abs_reward * length, and a core_state of exactly
 // `core_state_size` finite floats within max_abs_observation (none when 0;
 // with one, exactly max_steps steps), and for masked actions a mask
-// [T, actions] whose every row has a legal action, the one taken.
+// [T, actions] whose every row has a legal action, the one taken, and a
+// first_episode_step >= 0, below spec.max_episode_steps when it has one.
 // The message names the field.
 absl::Status ValidateSegment(const Segment& segment, const EnvSpec& spec,
                              int64_t max_steps, const ValueLimits& limits = {},

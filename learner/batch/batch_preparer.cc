@@ -8,6 +8,7 @@
 
 #include "common/nn/networks.h"
 #include "common/nn/running_mean_std.h"
+#include "learner/batch/linear_critic.h"
 #include "learner/batch/recurrent_critic.h"
 #include "learner/batch/reward_scaler.h"
 #include "learner/exploration/ex2_bonus.h"
@@ -19,13 +20,15 @@ BatchPreparer::BatchPreparer(const LearnerConfig& config,
                              ValueNetworkImpl& value,
                              const RunningMeanStd& normalizer,
                              RewardScaler& reward_scaler, Ex2Bonus* exploration,
-                             ReplicaGroup& replicas)
+                             ReplicaGroup& replicas,
+                             const LinearCritic* linear_critic)
     : config_(config),
       value_(value),
       normalizer_(normalizer),
       reward_scaler_(reward_scaler),
       exploration_(exploration),
-      replicas_(replicas) {}
+      replicas_(replicas),
+      linear_critic_(linear_critic) {}
 
 // The batch is normalised with the statistics the acting policy used
 // (shipped with its weights), so that in sync mode the first epoch's
@@ -49,6 +52,12 @@ at::Tensor BatchPreparer::Values(const std::vector<Rollout>& rollouts) const {
 
 absl::StatusOr<TrainingBatch> BatchPreparer::Assemble(
     const std::vector<Rollout>& rollouts) const {
+  if (linear_critic_ != nullptr) {
+    absl::StatusOr<at::Tensor> values = linear_critic_->Values(rollouts);
+    if (!values.ok()) return values.status();
+    return AssembleBatch(rollouts,
+                         [&](const std::vector<Rollout>&) { return *values; });
+  }
   if (!value_.recurrent()) {
     return AssembleBatch(
         rollouts, [&](const std::vector<Rollout>& r) { return Values(r); });

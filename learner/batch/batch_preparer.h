@@ -22,6 +22,7 @@
 namespace vantage {
 
 class Ex2Bonus;
+class LinearCritic;
 class ReplicaGroup;
 class RewardScaler;
 class RunningMeanStd;
@@ -43,10 +44,12 @@ class BatchPreparer {
  public:
   // Everything referenced belongs to the learner and must outlive this.
   // `exploration` may be null (a run without a bonus); the reward scaler
-  // is used only when the config scales rewards.
+  // is used only when the config scales rewards; a `linear_critic` values
+  // the states instead of `value` (null: the value network does).
   BatchPreparer(const LearnerConfig& config, ValueNetworkImpl& value,
                 const RunningMeanStd& normalizer, RewardScaler& reward_scaler,
-                Ex2Bonus* exploration, ReplicaGroup& replicas);
+                Ex2Bonus* exploration, ReplicaGroup& replicas,
+                const LinearCritic* linear_critic = nullptr);
 
   // The batch of `rollouts` for the policy at `version`; the rho masks
   // draw from `rng`. The reward scaler and the exploration model absorb
@@ -70,6 +73,7 @@ class BatchPreparer {
   RewardScaler& reward_scaler_;
   Ex2Bonus* exploration_;
   ReplicaGroup& replicas_;
+  const LinearCritic* linear_critic_;
 };
 
 }  // namespace vantage

@@ -2,6 +2,8 @@
 
 #include <ATen/ATen.h>
 
+#include <algorithm>
+
 #include "absl/strings/str_cat.h"
 
 namespace vantage {
@@ -65,6 +67,11 @@ absl::StatusOr<TrainingBatch> AssembleBatch(
       stack([](const Rollout& r) { return r.policy_versions; });
   if (rollouts[0].action_masks.defined()) {
     batch.action_masks = stack([](const Rollout& r) { return r.action_masks; });
+  }
+  if (std::all_of(rollouts.begin(), rollouts.end(),
+                  [](const Rollout& r) { return r.episode_steps.defined(); })) {
+    batch.episode_steps = stack(
+        [&](const Rollout& r) { return r.episode_steps.slice(0, 0, steps); });
   }
   return batch;
 }

@@ -30,6 +30,9 @@ struct TrainingBatch {
   at::Tensor starts;
   at::Tensor chunk_states;
   int64_t seq_len = 0;
+  // [T, N] int64: the step of its episode each observation is, where every
+  // rollout says (Rollout::episode_steps); undefined otherwise.
+  at::Tensor episode_steps;
 };
 
 // The critic's values of every observation the estimators need, in this

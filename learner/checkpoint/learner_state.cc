@@ -4,6 +4,7 @@
 #include <sstream>
 
 #include "absl/strings/str_cat.h"
+#include "learner/batch/linear_critic.h"
 #include "learner/checkpoint/archive_io.h"
 #include "learner/exploration/ex2_bonus.h"
 #include "learner/learner_core.h"
@@ -114,6 +115,11 @@ void LearnerCore::Save(torch::serialize::OutputArchive& archive) const {
   archive.write("updater", updater);
   archive.write("reward_scaler", scaler);
   if (exploration_ != nullptr) exploration_->Save(archive, "ex2");
+  if (linear_critic_ != nullptr) {
+    torch::serialize::OutputArchive critic;
+    linear_critic_->Save(critic);
+    archive.write("linear_critic", critic);
+  }
   WriteRunningMeanStd(archive, "normalizer", normalizer_);
   std::ostringstream rng;
   rng << rng_;
@@ -126,6 +132,21 @@ void LearnerCore::Save(torch::serialize::OutputArchive& archive) const {
                 at::tensor(std::vector<double>(recent_returns().begin(),
                                                recent_returns().end()),
                            at::kDouble));
+}
+
+absl::Status LearnerCore::LoadLinearCritic(
+    torch::serialize::InputArchive& archive) {
+  if (linear_critic_ == nullptr) return absl::OkStatus();
+  torch::serialize::InputArchive critic;
+  if (absl::Status status = CatchTorchErrors(
+          "checkpoint entry 'linear_critic' is missing (a checkpoint of a run "
+          "with the value network cannot continue with "
+          "--trpo_linear_baseline)",
+          [&] { archive.read("linear_critic", critic); });
+      !status.ok()) {
+    return status;
+  }
+  return linear_critic_->Load(critic);
 }
 
 absl::Status LearnerCore::LoadModels(torch::serialize::InputArchive& archive) {
@@ -145,6 +166,9 @@ absl::Status LearnerCore::LoadModels(torch::serialize::InputArchive& archive) {
         reward_scaler_.Load(scaler),
         ReadRunningMeanStd(archive, "normalizer", normalizer_)}) {
     if (!status.ok()) return status;
+  }
+  if (absl::Status status = LoadLinearCritic(archive); !status.ok()) {
+    return status;
   }
   if (exploration_ == nullptr) return absl::OkStatus();
   if (absl::Status status = exploration_->Load(archive, "ex2"); !status.ok()) {

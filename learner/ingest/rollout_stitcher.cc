@@ -8,6 +8,22 @@
 #include "absl/strings/str_cat.h"
 
 namespace vantage {
+namespace {
+
+// The step of its episode each of a segment's T + 1 observations is.
+at::Tensor EpisodeSteps(const Segment& segment) {
+  const int64_t steps = segment.steps();
+  at::Tensor out = at::empty({steps + 1}, at::kLong);
+  int64_t* step = out.data_ptr<int64_t>();
+  const at::Tensor ended =
+      at::logical_or(segment.terminated, segment.truncated).contiguous();
+  const bool* end = ended.data_ptr<bool>();
+  step[0] = segment.first_episode_step;
+  for (int64_t t = 0; t < steps; ++t) step[t + 1] = end[t] ? 0 : step[t] + 1;
+  return out;
+}
+
+}  // namespace
 
 RolloutStitcher::RolloutStitcher(int64_t horizon)
     : horizon_(horizon < 1 ? 1 : horizon) {}
@@ -48,9 +64,10 @@ absl::Status RolloutStitcher::Add(Segment segment) {
 Rollout RolloutStitcher::Cut(int64_t actor_id, int64_t env_slot,
                              Stream& stream) {
   std::vector<at::Tensor> observations, actions, rewards, terminated, truncated,
-      finals, log_probs, versions, masks;
+      finals, log_probs, versions, masks, episode_steps;
   int64_t needed = horizon_;
   at::Tensor next_observation;  // s_T: the observation after the last step
+  at::Tensor next_episode_step;
   // Recurrent runs take whole segments, so a rollout starts where one does.
   const at::Tensor core_state = stream.pieces.front().segment->core_state;
   while (needed > 0) {
@@ -74,6 +91,9 @@ Rollout RolloutStitcher::Cut(int64_t actor_id, int64_t env_slot,
     finals.push_back(s.final_observations.slice(0, before, before + count));
     // A slice shares the segment's storage, which outlives the piece.
     next_observation = s.observations.slice(0, e, e + 1);
+    const at::Tensor steps_of = EpisodeSteps(s);
+    episode_steps.push_back(steps_of.slice(0, b, e));
+    next_episode_step = steps_of.slice(0, e, e + 1);
     needed -= take;
     stream.steps -= take;
     buffered_ -= take;
@@ -81,6 +101,7 @@ Rollout RolloutStitcher::Cut(int64_t actor_id, int64_t env_slot,
     if (piece.begin == piece.end) stream.pieces.pop_front();
   }
   observations.push_back(next_observation);
+  episode_steps.push_back(next_episode_step);
   Rollout rollout;
   rollout.actor_id = actor_id;
   rollout.env_slot = env_slot;
@@ -94,6 +115,7 @@ Rollout RolloutStitcher::Cut(int64_t actor_id, int64_t env_slot,
   rollout.policy_versions = at::cat(versions);
   rollout.core_state = core_state;
   if (!masks.empty()) rollout.action_masks = at::cat(masks);
+  rollout.episode_steps = at::cat(episode_steps);
   return rollout;
 }
 

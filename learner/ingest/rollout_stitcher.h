@@ -34,6 +34,10 @@ struct Rollout {
   // Masked discrete actions: the legal actions at each step [T, actions]
   // bool; undefined otherwise.
   at::Tensor action_masks;
+  // [T + 1] int64: the step of its episode each observation is (0 where
+  // an episode starts); a truncated step's final observation is its
+  // step's + 1.
+  at::Tensor episode_steps;
 };
 
 struct StitcherStats {

@@ -71,6 +71,33 @@ TEST(ActorCoreTest, SegmentsAreValidAndNumberedPerSlot) {
   EXPECT_EQ(actor->env_steps(), 2 * 3 * 40);
 }
 
+// Each segment says which step of its episode its step 0 is: the first
+// episode ending in it is that many steps longer than the steps it has
+// there, and the next segment goes on from the last end.
+TEST(ActorCoreTest, SegmentsSayWhereInItsEpisodeTheyStart) {
+  auto actor = MakeActor();
+  std::vector<int64_t> expected(3, 0);  // every env starts an episode
+  for (int round = 0; round < 4; ++round) {
+    const std::vector<Segment> segments = Collect(*actor);
+    ASSERT_EQ(segments.size(), 3u);
+    for (int64_t i = 0; i < 3; ++i) {
+      const Segment& s = segments[i];
+      EXPECT_EQ(s.first_episode_step, expected[i]) << round << " " << i;
+      int64_t step = s.first_episode_step;
+      size_t episode = 0;
+      for (int64_t t = 0; t < s.steps(); ++t, ++step) {
+        if (!s.terminated[t].item<bool>() && !s.truncated[t].item<bool>()) {
+          continue;
+        }
+        ASSERT_LT(episode, s.episode_lengths.size());
+        EXPECT_EQ(s.episode_lengths[episode++], step + 1) << t;
+        step = -1;
+      }
+      expected[i] = step;
+    }
+  }
+}
+
 TEST(ActorCoreTest, BehaviourLogProbsAreThoseOfTheActingWeights) {
   auto actor = MakeActor();
   // Publish weights (version 7) with a shifted normaliser.

@@ -41,7 +41,7 @@ std::string FreshDirectory(const std::string& name) {
 // ("ppo_gru": PPO with a GRU of 16 units), evaluations ("ppo_eval": of
 // 3 episodes every 2 updates), masked actions ("ppo_masked": on
 // LitButtons instead of Hopper) or a Dict observation ("ppo_dict": on
-// LitButtons:dict=true).
+// LitButtons:dict=true), or TRPO's linear baseline ("trpo_linear").
 RunPlan SmallRun(const std::string& name, uint64_t seed,
                  const std::string& run_dir) {
   const std::vector<std::string> parts = absl::StrSplit(name, '_');
@@ -56,6 +56,8 @@ RunPlan SmallRun(const std::string& name, uint64_t seed,
     training.set_env("LitButtons");
   } else if (parts.size() > 1 && parts[1] == "dict") {
     training.set_env("LitButtons:dict=true");
+  } else if (parts.size() > 1 && parts[1] == "linear") {
+    run.mutable_trpo()->set_linear_baseline(true);
   } else if (parts.size() > 1) {
     training.set_core(parts[1]);
     training.set_core_size(16);
@@ -220,7 +222,8 @@ INSTANTIATE_TEST_SUITE_P(Algorithms, ResumeTest,
                          ::testing::Values("ppo", "a2c", "trpo", "ex2",
                                            "ppo_gru", "a2c_lstm", "ppo_eval",
                                            "ppo_masked", "a2c_masked",
-                                           "trpo_masked", "ppo_dict"));
+                                           "trpo_masked", "ppo_dict",
+                                           "trpo_linear"));
 
 // Every second version is evaluated before its row, which holds the
 // evaluation; checkpoints/best.pt is the version whose evaluation was best

@@ -155,6 +155,20 @@ TEST(RunConfigTest, ASharedTorsoNeedsOneOptimiserOverBothNetworks) {
       "optimiser; trpo fits its value network alone");
 }
 
+// TRPO's linear baseline is a setting of TRPO's (the learner refuses it
+// for images: learner_core_test).
+TEST(RunConfigTest, TheLinearBaselineIsTrposSetting) {
+  absl::StatusOr<pb::RunConfig> linear = Resolve(
+      R"({"training": {"env": "Hopper"}, "trpo": {"linear_baseline": true}})");
+  ASSERT_TRUE(linear.ok()) << linear.status();
+  absl::StatusOr<RunPlan> plan = PlanRun(*linear);
+  ASSERT_TRUE(plan.ok()) << plan.status();
+  EXPECT_TRUE(plan->learner.linear_critic());
+  absl::StatusOr<pb::RunConfig> ppo = Resolve(R"({"training": {}})");
+  ASSERT_TRUE(ppo.ok()) << ppo.status();
+  EXPECT_FALSE(PlanRun(*ppo)->learner.linear_critic());
+}
+
 // A recurrent core: its settings appear in the config only with a core;
 // its chunks default to whole segments (a2c: its minibatches' steps); each
 // rule names its flag.

@@ -11,6 +11,7 @@
 
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
+#include "learner/algorithms/trpo/trpo_config.h"
 #include "learner/checkpoint/checkpoint.h"
 #include "learner/exploration/ex2_bonus.h"
 #include "tests/fakes/learner_batches.h"
@@ -289,6 +290,13 @@ TEST(ByteObservationsTest, TravelAsBytesAndTrainAConvolutionalNetwork) {
   config.network.torso = Torso::kNature;
   EXPECT_THAT(LearnerCore::Create(config).status().message(),
               HasSubstr("torso nature needs frames of at least 36x36"));
+  // TRPO's linear baseline fits observation values, not pixels.
+  LearnerConfig linear = TestLearnerConfig(actor->spec(), "trpo");
+  linear.algorithm.Mutable<TrpoConfig>().linear_baseline = true;
+  EXPECT_THAT(LearnerCore::Create(linear).status().message(),
+              HasSubstr("--trpo_linear_baseline fits the observations' "
+                        "values and squares; MinAtarBreakout's observations "
+                        "are images (bytes): use the value network"));
 }
 
 // PPO and A2C train one trunk under both losses; a checkpoint keeps it one

@@ -268,6 +268,7 @@ Segment RealisticSegment() {
   s.behaviour_log_probs = -at::rand({kSteps}) * 5;
   s.episode_returns = {-0.1, 1234.5678};
   s.episode_lengths = {1000, 7};
+  s.first_episode_step = 988;
   return s;
 }
 
@@ -285,6 +286,7 @@ void ExpectSameSegment(const Segment& a, const Segment& b) {
   EXPECT_TRUE(BitEqual(a.behaviour_log_probs, b.behaviour_log_probs));
   EXPECT_EQ(a.episode_returns, b.episode_returns);
   EXPECT_EQ(a.episode_lengths, b.episode_lengths);
+  EXPECT_EQ(a.first_episode_step, b.first_episode_step);
 }
 
 // Through the serialized bytes, as over the network.

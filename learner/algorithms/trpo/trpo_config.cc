@@ -14,7 +14,8 @@ const SettingsTable<TrpoConfig, pb::TrpoSettings>& TrpoTable() {
                {"cg_iterations", &C::cg_iterations, AtLeast(1)},
                {"value_learning_rate", &C::value_learning_rate, Above(0)},
                {"value_epochs", &C::value_epochs, AtLeast(1)},
-               {"entropy_coef", &C::entropy_coef, AtLeast(0)}});
+               {"entropy_coef", &C::entropy_coef, AtLeast(0)},
+               {"linear_baseline", &C::linear_baseline}});
   return *table;
 }
 

@@ -21,6 +21,9 @@ struct TrpoConfig {
   double value_learning_rate = 1e-3;
   int value_epochs = 5;
   int value_minibatch_size = 64;
+  // The learner's LinearCritic values the states instead of the value
+  // network, which then is never fitted (value_* unused).
+  bool linear_baseline = false;
 
   // Names the rule a field breaks as its run-config field (trpo.max_kl).
   absl::Status Validate() const;

@@ -88,7 +88,9 @@ AlgorithmStats TrpoUpdater::Update(const UpdateBatch& batch,
   double surrogate = 0.0;
   stats.approx_kl = PolicyStep(batch, advantages, surrogate);
   stats.policy_loss = -surrogate;
-  stats.value_loss = FitValue(batch, rng);
+  // The linear baseline is the learner's, fitted (and its loss reported)
+  // once the update is kept.
+  stats.value_loss = config_.linear_baseline ? 0.0 : FitValue(batch, rng);
   return stats;
 }
 

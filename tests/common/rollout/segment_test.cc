@@ -251,6 +251,11 @@ TEST(SegmentTest, EpisodesMustMatchTheEpisodeEnds) {
       // The spec's time limit bounds every episode.
       {[](Segment& s) { s.episode_lengths[0] = 1001; },
        "episode_lengths[0] is 1001"},
+      // Step 0's place in its episode: within the spec's time limit.
+      {[](Segment& s) { s.first_episode_step = -1; },
+       "segment field first_episode_step is -1, expected 0..999"},
+      {[](Segment& s) { s.first_episode_step = 1000; },
+       "segment field first_episode_step is 1000, expected 0..999"},
       // A second end: that episode lies wholly inside the segment.
       {[](Segment& s) {
          s.terminated[3] = true;
@@ -270,6 +275,7 @@ TEST(SegmentTest, EpisodesMustMatchTheEpisodeEnds) {
   two.terminated[3] = true;
   two.episode_returns.push_back(1.0);
   two.episode_lengths.push_back(1);
+  two.first_episode_step = 999;
   EXPECT_TRUE(ValidateSegment(two, Spec(), 128).ok());
 }
 

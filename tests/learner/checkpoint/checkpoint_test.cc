@@ -14,6 +14,7 @@
 #include "common/nn/networks.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
+#include "learner/algorithms/trpo/trpo_config.h"
 #include "tests/fakes/learner_batches.h"
 
 namespace vantage {
@@ -169,6 +170,22 @@ TEST_F(CheckpointErrorTest, AnEx2RunDoesNotContinueARunWithoutIt) {
   EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument);
   EXPECT_THAT(std::string(status.message()), HasSubstr("'ex2.pool.rows'"));
   EXPECT_THAT(std::string(status.message()), HasSubstr("without EX2"));
+}
+
+TEST_F(CheckpointErrorTest, ALinearBaselineRunDoesNotContinueARunWithoutIt) {
+  const LearnerConfig trpo = Config(actor_->spec(), "trpo");
+  const std::string path = TempFile("value_network_trpo.pt");
+  ASSERT_TRUE(WriteCheckpoint(path, **LearnerCore::Create(trpo), {}).ok());
+  LearnerConfig linear = trpo;
+  linear.algorithm.Mutable<TrpoConfig>().linear_baseline = true;
+  const absl::Status status = ReadCheckpoint(path, linear).status();
+  EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(std::string(status.message()),
+              HasSubstr("checkpoint entry 'linear_critic' is missing"));
+  const std::string linear_path = TempFile("linear_trpo.pt");
+  ASSERT_TRUE(
+      WriteCheckpoint(linear_path, **LearnerCore::Create(linear), {}).ok());
+  EXPECT_TRUE(ReadCheckpoint(linear_path, linear).ok());
 }
 
 TEST_F(CheckpointErrorTest, AnotherAlgorithmIsRefused) {

@@ -11,7 +11,8 @@ namespace {
 
 // One long stream of `total` steps (obs 2, act 1) with known values, cut
 // into segments of the given lengths: step t has reward t, observation
-// (t, -t), truncation every 7th step with final observation (100 + t, 0).
+// (t, -t), truncation every 7th step with final observation (100 + t, 0),
+// so observation t is step t % 7 of its episode.
 struct Stream {
   std::vector<Segment> segments;
   at::Tensor observations, rewards, truncated, finals;
@@ -55,6 +56,7 @@ Stream MakeStream(const std::vector<int64_t>& lengths, int64_t actor = 0,
         stream.finals.slice(0, finals_before, finals_before + k).clone();
     finals_before += k;
     s.behaviour_log_probs = -s.rewards;
+    s.first_episode_step = begin % 7;
     stream.segments.push_back(s);
     begin += l;
   }
@@ -90,6 +92,21 @@ TEST(RolloutStitcherTest, StitchesAcrossSegmentBoundaries) {
     EXPECT_EQ(rollout.policy_versions[7].item<int64_t>(), (b + 7) / 5 + 1);
   }
   EXPECT_EQ(stitcher.stats().rollouts, 3);
+}
+
+// Each observation's step within its episode, from each segment's first
+// and the episode ends after it, across segment and rollout boundaries.
+TEST(RolloutStitcherTest, RolloutsSayWhichStepOfItsEpisodeEachObservationIs) {
+  const Stream stream = MakeStream({5, 3, 9, 4, 3});
+  RolloutStitcher stitcher(6);
+  for (const Segment& s : stream.segments) ASSERT_TRUE(stitcher.Add(s).ok());
+  const std::vector<Rollout> rollouts = stitcher.TakeReady();
+  ASSERT_EQ(rollouts.size(), 4u);
+  for (int64_t r = 0; r < 4; ++r) {
+    const at::Tensor expected = at::arange(6 * r, 6 * r + 7, at::kLong) % 7;
+    EXPECT_TRUE(at::equal(rollouts[r].episode_steps, expected))
+        << r << ": " << rollouts[r].episode_steps;
+  }
 }
 
 TEST(RolloutStitcherTest, LongSegmentsYieldSeveralRollouts) {

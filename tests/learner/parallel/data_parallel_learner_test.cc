@@ -149,9 +149,13 @@ void ExpectClose(const PolicyWeights& a, const PolicyWeights& b,
 // Settings under which the split batch must give the same update as the
 // whole: the bias on every sample (rho 1, so no mask is drawn), PPO on the
 // whole batch as its one minibatch, TRPO's critic on the whole batch.
-LearnerConfig SplittableConfig(const EnvSpec& spec,
-                               const std::string& algorithm) {
+LearnerConfig SplittableConfig(const EnvSpec& spec, const std::string& name) {
+  // "trpo_linear": TRPO with the linear baseline, whose normal equations
+  // are summed over the replicas.
+  const bool linear = name == "trpo_linear";
+  const std::string algorithm = linear ? "trpo" : name;
   LearnerConfig config = TestLearnerConfig(spec, algorithm);
+  config.algorithm.Mutable<TrpoConfig>().linear_baseline = linear;
   config.advantage.rho = 1.0;
   config.algorithm.Mutable<PpoConfig>().minibatches = 1;
   config.algorithm.Mutable<PpoConfig>().epochs = 3;
@@ -217,7 +221,8 @@ TEST_P(DataParallelLearnerTest, ASplitBatchGivesTheWholeBatchsUpdate) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Algorithms, DataParallelLearnerTest,
-                         ::testing::Values("ppo", "a2c", "trpo"));
+                         ::testing::Values("ppo", "a2c", "trpo",
+                                           "trpo_linear"));
 
 // A checkpoint is rank 0's state; both replicas resume from it. With the
 // rho mask and PPO's minibatches drawn on each replica, two replicas
