@@ -50,8 +50,9 @@ absl::Status RolloutStitcher::Add(Segment segment) {
   stream.last_fed = ++adds_;
   ++stats_.segments;
   const int64_t steps = segment.steps();
-  stream.pieces.push_back(
-      {std::make_shared<const Segment>(std::move(segment)), 0, steps});
+  at::Tensor episode_steps = EpisodeSteps(segment);
+  stream.pieces.push_back({std::make_shared<const Segment>(std::move(segment)),
+                           0, steps, std::move(episode_steps)});
   stream.steps += steps;
   buffered_ += steps;
   while (stream.steps >= horizon_) {
@@ -91,9 +92,8 @@ Rollout RolloutStitcher::Cut(int64_t actor_id, int64_t env_slot,
     finals.push_back(s.final_observations.slice(0, before, before + count));
     // A slice shares the segment's storage, which outlives the piece.
     next_observation = s.observations.slice(0, e, e + 1);
-    const at::Tensor steps_of = EpisodeSteps(s);
-    episode_steps.push_back(steps_of.slice(0, b, e));
-    next_episode_step = steps_of.slice(0, e, e + 1);
+    episode_steps.push_back(piece.episode_steps.slice(0, b, e));
+    next_episode_step = piece.episode_steps.slice(0, e, e + 1);
     needed -= take;
     stream.steps -= take;
     buffered_ -= take;

@@ -93,6 +93,9 @@ class RolloutStitcher {
     std::shared_ptr<const Segment> segment;
     int64_t begin = 0;
     int64_t end = 0;
+    // [T + 1] int64: the step of its episode each of the segment's
+    // observations is, counted once when the segment arrives.
+    at::Tensor episode_steps;
   };
   struct Stream {
     int64_t next_sequence = 0;
