@@ -26,6 +26,14 @@ std::string JsonOf(const google::protobuf::Message& message) {
   return json;
 }
 
+// A run's settings as this vantage reads them: a setting added after the
+// run was made is absent from its record and takes its default (a new
+// setting's default keeps what older versions did), so a grid goes on
+// with a newer binary; every setting the record holds is compared as held.
+absl::StatusOr<pb::RunConfig> ReadNow(const pb::RunConfig& held) {
+  return ResolveRunConfig(held);
+}
+
 }  // namespace
 
 std::string ExpandedExperimentToJson(const pb::ExpandedExperiment& experiment) {
@@ -54,6 +62,7 @@ absl::Status ExperimentDirectory::CheckRuns(
     const std::string config_path = RunDir(cell) + "/config.json";
     if (!std::filesystem::exists(config_path)) continue;
     absl::StatusOr<pb::RunConfig> held = ReadRunConfigFile(config_path);
+    if (held.ok()) held = ReadNow(*held);
     if (!held.ok()) {
       return absl::FailedPreconditionError(
           absl::StrCat(RunDir(cell),
@@ -103,12 +112,19 @@ absl::StatusOr<pb::ExpandedExperiment> ExperimentDirectory::Merged(
       *merged.add_cells() = cell;
       continue;
     }
+    absl::StatusOr<pb::RunConfig> held_config = ReadNow(cell.config());
+    if (!held_config.ok()) {
+      return absl::FailedPreconditionError(
+          absl::StrCat(ExperimentPath(), " records ", cell.dir(),
+                       " with settings this vantage refuses: ",
+                       held_config.status().message()));
+    }
     if (!google::protobuf::util::MessageDifferencer::Equals(
-            cell.config(), it->second->config())) {
+            *held_config, it->second->config())) {
       return absl::FailedPreconditionError(
           absl::StrCat(ExperimentPath(), " records ", cell.dir(),
                        " with other settings than this experiment's cell (",
-                       RunConfigDifference(it->second->config(), cell.config()),
+                       RunConfigDifference(it->second->config(), *held_config),
                        "): use another --out"));
     }
     *merged.add_cells() = *it->second;

@@ -95,6 +95,41 @@ TEST(ExperimentDirectoryTest, AnotherBudgetOrOtherSettingsAreRefused) {
                         "settings"));
 }
 
+// A vantage older than a setting wrote records without it: they go on
+// with the setting's default and are refused where that default is not
+// what the cell asks for.
+TEST(ExperimentDirectoryTest, RecordsFromBeforeASettingExistedTakeItsDefault) {
+  const ExperimentDirectory directory(Fresh("older"));
+  pb::ExpandedExperiment older = Expand("[0]");
+  for (pb::ExperimentCell& cell : *older.mutable_cells()) {
+    cell.mutable_config()->mutable_training()->clear_frame_stack();
+  }
+  ASSERT_TRUE(directory.Prepare(older, pb::RunConfig()).ok());
+  for (const pb::ExperimentCell& cell : older.cells()) {
+    Write(directory.RunDir(cell) + "/config.json",
+          RunConfigToJson(cell.config()));
+  }
+  const absl::Status now = directory.Prepare(Expand("[0]"), pb::RunConfig());
+  EXPECT_TRUE(now.ok()) << now;
+
+  // Without its estimator, the max cell's record reads as gae's.
+  pb::ExpandedExperiment unnamed = Expand("[0]");
+  unnamed.mutable_cells(0)
+      ->mutable_config()
+      ->mutable_advantage()
+      ->clear_estimator();
+  Write(directory.RunDir(unnamed.cells(0)) + "/config.json",
+        RunConfigToJson(unnamed.cells(0).config()));
+  const absl::Status runs = directory.CheckRuns(Expand("[0]"));
+  EXPECT_EQ(runs.code(), absl::StatusCode::kFailedPrecondition);
+  EXPECT_THAT(runs.message(), HasSubstr("estimator"));
+  const ExperimentDirectory record(Fresh("older-record"));
+  ASSERT_TRUE(record.Prepare(unnamed, pb::RunConfig()).ok());
+  const absl::Status merged = record.Merged(Expand("[0]")).status();
+  EXPECT_EQ(merged.code(), absl::StatusCode::kFailedPrecondition);
+  EXPECT_THAT(merged.message(), HasSubstr("with other settings"));
+}
+
 TEST(ExperimentDirectoryTest, ACellsStateComesFromItsRunDirectory) {
   const ExperimentDirectory directory(Fresh("states"));
   const pb::ExperimentCell cell = Expand("[0]").cells(0);
