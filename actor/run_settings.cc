@@ -1,5 +1,6 @@
 #include "actor/run_settings.h"
 
+#include <limits>
 #include <utility>
 
 #include "absl/strings/str_cat.h"
@@ -136,6 +137,12 @@ absl::StatusOr<ActorConfig> ActorConfigOf(const pb::RunConfig& run) {
   ActorTable().Read(training, actor);
   actor.env_options = EnvOptionsOf(run);
   if (training.has_envs()) actor.num_envs = training.envs();
+  // The clip bounds normalised observations; unnormalised ones pass as the
+  // environment gives them.
+  if (training.has_normalize_observations() &&
+      !training.normalize_observations()) {
+    actor.observation_clip = std::numeric_limits<double>::infinity();
+  }
   absl::StatusOr<NetworkConfig> network = PolicyNetworkOf(run);
   if (!network.ok()) return network.status();
   actor.network = *std::move(network);

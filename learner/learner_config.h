@@ -32,6 +32,10 @@ struct LearnerConfig {
   double observation_clip = 10.0;
   // Divide rewards by the running std of discounted returns (then clip).
   bool scale_rewards = false;
+  // Observations normalised by their running statistics (else the
+  // normaliser keeps its initial mean 0 and variance 1 and the networks
+  // see the environment's values, observation_clip then infinite).
+  bool normalize_observations = true;
   double reward_clip = 10.0;
   // An update with a larger global gradient norm (before clipping) in any
   // of its gradient steps is rolled back like one that produced non-finite

@@ -191,10 +191,12 @@ absl::Status LearnerCore::Commit(const std::vector<Rollout>& rollouts,
 }
 
 // A dropped batch must not move the statistics either; byte observations
-// are not normalised, so have none.
+// are not normalised, so have none, nor have a run's that normalises none.
 absl::Status LearnerCore::UpdateNormaliser(
     const std::vector<Rollout>& rollouts) {
-  if (config_.spec.byte_observations()) return absl::OkStatus();
+  if (config_.spec.byte_observations() || !config_.normalize_observations) {
+    return absl::OkStatus();
+  }
   std::vector<at::Tensor> observations;
   for (const Rollout& rollout : rollouts) {
     observations.push_back(rollout.observations.slice(0, 0, config_.horizon));

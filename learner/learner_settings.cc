@@ -18,7 +18,8 @@ const SettingsTable<LearnerConfig, pb::TrainingSettings>& TrainingTable() {
           "training",
           {{"steps", &C::total_env_steps, AtLeast(1)},
            {"horizon", &C::horizon, AtLeast(1)},
-           {"scale_rewards", &C::scale_rewards}},
+           {"scale_rewards", &C::scale_rewards},
+           {"normalize_observations", &C::normalize_observations}},
           SettingNames::kFlag);
   return *table;
 }

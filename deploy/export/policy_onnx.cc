@@ -163,6 +163,22 @@ std::string AddConvTorso(GraphBuilder& g, const ConvTorso& torso,
   return x;
 }
 
+// (x - mean) / std, clipped to [-clip, clip] unless the clip is infinite
+// (a run that does not normalise its observations passes them as they are).
+std::string AddNormalise(GraphBuilder& g, const at::Tensor& mean,
+                         const at::Tensor& std, double clip,
+                         const std::string& x) {
+  const std::string centred =
+      GraphBuilder::Out(g.Node("Sub", {x, g.Floats("mean", mean)}));
+  const std::string scaled =
+      GraphBuilder::Out(g.Node("Div", {centred, g.Floats("std", std)}));
+  if (!std::isfinite(clip)) return scaled;
+  onnx::NodeProto& clipped = g.Node("Clip", {scaled});
+  GraphBuilder::Floats(clipped, "min", static_cast<float>(-clip));
+  GraphBuilder::Floats(clipped, "max", static_cast<float>(clip));
+  return GraphBuilder::Out(clipped);
+}
+
 // The network's inputs from the environment's values: bytes divided by
 // their high, other values normalised and clipped.
 std::string AddInputs(GraphBuilder& g, const EnvSpec& spec,
@@ -175,14 +191,8 @@ std::string AddInputs(GraphBuilder& g, const EnvSpec& spec,
         "Mul",
         {x, g.Floats("scale", at::tensor({static_cast<float>(scale)}))}));
   }
-  const std::string centred = GraphBuilder::Out(
-      g.Node("Sub", {x, g.Floats("mean", normalizer.mean())}));
-  const std::string scaled = GraphBuilder::Out(g.Node(
-      "Div", {centred, g.Floats("std", at::sqrt(normalizer.var() + 1e-8))}));
-  onnx::NodeProto& clipped = g.Node("Clip", {scaled});
-  GraphBuilder::Floats(clipped, "min", static_cast<float>(-clip));
-  GraphBuilder::Floats(clipped, "max", static_cast<float>(clip));
-  return GraphBuilder::Out(clipped);
+  return AddNormalise(g, normalizer.mean(), at::sqrt(normalizer.var() + 1e-8),
+                      clip, x);
 }
 
 // A Dict observation's torso: each entry's slice of the row, vectors
@@ -208,14 +218,8 @@ std::string AddDictTorso(GraphBuilder& g, const DictTorso& torso,
           {part, g.Floats("inverse_high", at::tensor({1.0f / key.high}))}));
       part = AddConvTorso(g, torso->convs()[i], key.shape, part);
     } else {
-      part = GraphBuilder::Out(
-          g.Node("Sub", {part, g.Floats("mean", mean.slice(0, offset, end))}));
-      part = GraphBuilder::Out(
-          g.Node("Div", {part, g.Floats("std", std.slice(0, offset, end))}));
-      onnx::NodeProto& clipped = g.Node("Clip", {part});
-      GraphBuilder::Floats(clipped, "min", static_cast<float>(-clip));
-      GraphBuilder::Floats(clipped, "max", static_cast<float>(clip));
-      part = GraphBuilder::Out(clipped);
+      part = AddNormalise(g, mean.slice(0, offset, end),
+                          std.slice(0, offset, end), clip, part);
     }
     features.push_back(part);
     offset = end;

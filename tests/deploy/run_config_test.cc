@@ -1,5 +1,7 @@
 #include "deploy/run/run_config.h"
 
+#include <limits>
+
 #include "deploy/run/distributed_config.h"
 #include "deploy/run/run_plan.h"
 #include "gmock/gmock.h"
@@ -64,6 +66,7 @@ TEST(RunConfigTest, DefaultsAreTheComponentsOwn) {
   EXPECT_EQ(config->recording().checkpoint_every(),
             RecordingConfig().checkpoint_every);
   EXPECT_EQ(config->training().frame_stack(), 1);
+  EXPECT_TRUE(config->training().normalize_observations());
   // Only the chosen algorithm's section is there.
   EXPECT_EQ(config->algorithm_case(), pb::RunConfig::kPpo);
   absl::StatusOr<pb::RunConfig> a2c = Resolve(R"({"a2c": {"n": 3}})");
@@ -280,6 +283,28 @@ TEST(RunConfigTest, ThePlanGivesActorAndLearnerTheSameRun) {
   EXPECT_EQ(plan->recording.config_json, RunConfigToJson(*config));
   EXPECT_TRUE(plan->recording.run_dir.empty());
   EXPECT_TRUE(plan->learner.ValidateSettings().ok());
+}
+
+// Unnormalised observations reach the networks unclipped, in the actors
+// and in the learner alike (remote actors read the run config themselves).
+TEST(RunConfigTest, UnnormalisedObservationsAreNotClipped) {
+  absl::StatusOr<pb::RunConfig> config = Resolve(
+      R"({"mode": "local", "training": {"normalize_observations": false}})");
+  ASSERT_TRUE(config.ok()) << config.status();
+  EXPECT_FALSE(config->training().normalize_observations());
+  absl::StatusOr<RunPlan> plan = PlanRun(*config);
+  ASSERT_TRUE(plan.ok()) << plan.status();
+  EXPECT_FALSE(plan->learner.normalize_observations);
+  EXPECT_EQ(plan->actor.observation_clip,
+            std::numeric_limits<double>::infinity());
+  EXPECT_EQ(plan->learner.observation_clip, plan->actor.observation_clip);
+  EXPECT_EQ(ActorConfigOf(*config)->observation_clip,
+            plan->actor.observation_clip);
+  absl::StatusOr<RunPlan> normalised =
+      PlanRun(*Resolve(R"({"mode": "local"})"));
+  ASSERT_TRUE(normalised.ok()) << normalised.status();
+  EXPECT_TRUE(normalised->learner.normalize_observations);
+  EXPECT_EQ(normalised->actor.observation_clip, ActorConfig().observation_clip);
 }
 
 TEST(RunConfigTest, AResolvedConfigSurvivesItsJson) {

@@ -302,6 +302,36 @@ TEST(ByteObservationsTest, TravelAsBytesAndTrainAConvolutionalNetwork) {
 // PPO and A2C train one trunk under both losses; a checkpoint keeps it one
 // (a restored learner continues exactly) and says so, and the algorithm
 // that fits its value network alone is refused.
+// --normalize_observations=false: the normaliser keeps its initial
+// statistics through updates and checkpoints (the actors then pass the
+// environment's values through, see RunningMeanStdTest), while the
+// networks train; by default it follows the observations.
+TEST(ObservationNormalisationTest, ARunThatNormalisesNoneKeepsTheIdentity) {
+  for (const bool normalise : {false, true}) {
+    SCOPED_TRACE(normalise);
+    auto actor = MakeTestActor(kTestHorizon);
+    LearnerConfig config = TestLearnerConfig(actor->spec(), "ppo");
+    config.normalize_observations = normalise;
+    auto learner = *LearnerCore::Create(config);
+    const PolicyWeights initial = learner->CurrentWeights();
+    const UpdateStats stats =
+        UpdateWith(*learner, ActOneBatch(*actor, *learner));
+    EXPECT_FALSE(stats.rolled_back) << stats.rollback_reason;
+    const PolicyWeights trained = learner->CurrentWeights();
+    EXPECT_FALSE(trained.parameters[0].equal(initial.parameters[0]));
+    EXPECT_EQ(trained.normalizer_count == initial.normalizer_count, !normalise);
+    EXPECT_EQ(trained.normalizer_mean.equal(initial.normalizer_mean),
+              !normalise);
+    EXPECT_EQ(trained.normalizer_var.equal(initial.normalizer_var), !normalise);
+    if (!normalise) {
+      ExpectACheckpointContinuesExactly(*actor, *learner, config,
+                                        "unnormalised");
+      EXPECT_TRUE(learner->CurrentWeights().normalizer_mean.equal(
+          initial.normalizer_mean));
+    }
+  }
+}
+
 TEST(SharedTorsoTest, OneTrunkTrainsAndResumesAsOne) {
   for (const std::string algorithm : {"a2c", "ppo"}) {
     SCOPED_TRACE(algorithm);

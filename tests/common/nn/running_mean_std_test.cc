@@ -3,6 +3,7 @@
 #include <ATen/ATen.h>
 
 #include <cmath>
+#include <limits>
 
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
@@ -24,6 +25,18 @@ TEST(RunningMeanStdTest, BatchesMergeToTheStatisticsOfTheirUnion) {
   EXPECT_TRUE(at::allclose(stats.mean(), all.mean(0), 1e-9, 1e-9));
   EXPECT_TRUE(
       at::allclose(stats.var(), all.var(0, /*unbiased=*/false), 1e-9, 1e-9));
+}
+
+// A run that does not normalise keeps the initial statistics and an
+// infinite clip: the networks then see the environment's floats exactly.
+TEST(RunningMeanStdTest, TheInitialStatisticsWithoutAClipAreTheIdentity) {
+  const RunningMeanStd stats(5);
+  const at::Tensor x =
+      at::tensor({-1e6f, -37.5f, 3.14159274f, 12.0f, 1e-7f}).reshape({1, 5});
+  const at::Tensor passed =
+      stats.Normalize(x, std::numeric_limits<double>::infinity());
+  EXPECT_EQ(passed.scalar_type(), at::kFloat);
+  EXPECT_TRUE(passed.equal(x)) << passed;
 }
 
 TEST(RunningMeanStdTest, NormalizesAndClips) {

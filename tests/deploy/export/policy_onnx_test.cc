@@ -79,16 +79,20 @@ struct Exported {
   at::Tensor output;        // vantage's forward pass: means or logits
 };
 
-Exported Export(const EnvSpec& spec, const NetworkConfig& config) {
+// `clip` infinite: a run that does not normalise its observations (its
+// normaliser keeps the initial statistics).
+Exported Export(const EnvSpec& spec, const NetworkConfig& config,
+                double clip = kClip) {
   Exported e;
   e.spec = spec;
   e.policy = PolicyNetwork(spec, config);
   e.normalizer = RunningMeanStd(spec.observation_size);
   RandomisePolicy(*e.policy, e.normalizer, spec);
+  if (std::isinf(clip)) e.normalizer = RunningMeanStd(spec.observation_size);
   OnnxExportOptions options;
   options.distribution = true;
   absl::StatusOr<std::string> model =
-      PolicyToOnnx(spec, *e.policy, e.normalizer, kClip, options);
+      PolicyToOnnx(spec, *e.policy, e.normalizer, clip, options);
   EXPECT_TRUE(model.ok()) << model.status();
   if (model.ok()) e.model = *model;
   e.observations =
@@ -99,8 +103,7 @@ Exported Export(const EnvSpec& spec, const NetworkConfig& config) {
   at::NoGradGuard no_grad;
   e.output = e.policy->forward(ObservationsForNetwork(
       spec, e.normalizer,
-      ObservationTensor(spec, e.observations.data_ptr<double>(), kRows),
-      kClip));
+      ObservationTensor(spec, e.observations.data_ptr<double>(), kRows), clip));
   return e;
 }
 
@@ -119,6 +122,27 @@ TEST(PolicyOnnxTest, AGaussianMlpPolicyAgreesUnderOpenCv) {
   ExpectClose(out[0], at::max(at::min(e.output, high), low), "action");
   ExpectClose(out[1], e.output, "mean");
   ExpectClose(out[2], e.policy->log_std().expand({kRows, 6}), "log_std");
+}
+
+// Without normalisation nothing is clipped: observations far beyond any
+// clip reach the network as they are, in the export as in vantage.
+TEST(PolicyOnnxTest, AnUnnormalisedPolicyAgreesUnderOpenCv) {
+  at::manual_seed(4);
+  const EnvSpec spec = VectorSpec(false, 5, 2);
+  Exported e =
+      Export(spec, NetworkConfig(), std::numeric_limits<double>::infinity());
+  EXPECT_EQ(e.model.find("Clip"), std::string::npos);
+  const at::Tensor wide = e.observations * 10.0;
+  at::NoGradGuard no_grad;
+  const at::Tensor raw =
+      ObservationTensor(spec, wide.data_ptr<double>(), kRows);
+  const at::Tensor want = e.policy->forward(raw);
+  // A clip at kClip would have changed them.
+  EXPECT_FALSE(at::allclose(want, e.policy->forward(ObservationsForNetwork(
+                                      spec, e.normalizer, raw, kClip))));
+  const std::vector<cv::Mat> out = RunOnOpenCv(e.model, wide, {"mean"});
+  ASSERT_EQ(out.size(), 1u);
+  ExpectClose(out[0], want, "mean");
 }
 
 TEST(PolicyOnnxTest, ACategoricalMlpPolicyAgreesUnderOpenCv) {
