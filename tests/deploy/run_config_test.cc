@@ -307,16 +307,24 @@ TEST(RunConfigTest, UnnormalisedObservationsAreNotClipped) {
   EXPECT_EQ(normalised->actor.observation_clip, ActorConfig().observation_clip);
 }
 
-TEST(RunConfigTest, AResolvedConfigSurvivesItsJson) {
-  for (const std::string& json :
-       {std::string("{}"), std::string(R"({"mode": "local", "trpo": {}})"),
-        std::string(R"({"a2c": {"n": 2}, "distributed": {"sync": false}})")}) {
+TEST(RunConfigTest, AResolvedConfigSurvivesItsJsonAndResolvingAgain) {
+  for (
+      const std::string& json :
+      {std::string("{}"), std::string(R"({"mode": "local", "trpo": {}})"),
+       std::string(
+           R"({"mode": "local", "training": {"normalize_observations": false, "core": "gru"}})"),
+       std::string(R"({"a2c": {"n": 2}, "distributed": {"sync": false}})")}) {
     absl::StatusOr<pb::RunConfig> config = Resolve(json);
     ASSERT_TRUE(config.ok()) << config.status();
     absl::StatusOr<pb::RunConfig> again =
         ParseRunConfigJson(RunConfigToJson(*config));
     ASSERT_TRUE(again.ok()) << again.status();
     EXPECT_EQ(again->SerializeAsString(), config->SerializeAsString()) << json;
+    // Resolving is idempotent: experiment directories resolve the records
+    // they hold again before comparing them with their cells.
+    absl::StatusOr<pb::RunConfig> twice = ResolveRunConfig(*config);
+    ASSERT_TRUE(twice.ok()) << twice.status();
+    EXPECT_EQ(RunConfigDifference(*twice, *config), "") << json;
   }
 }
 
