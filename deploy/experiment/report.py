@@ -63,7 +63,10 @@ usage: vantage experiment report EXP_DIR [flags]
   effect (of the baseline's mean) would need at that level. A group beats
   (or trails) the baseline "with confidence" when the interval excludes 0
   and the Holm-adjusted p < 0.05; the report says so in words. A group of
-  fewer than 3 finished seeds gets no test (the report says so). Every
+  fewer than 3 finished seeds gets no test (the report says so). A
+  comparison counts the seeds both groups finished; a run of a seed the
+  other group has not finished is left out, and the comparison says how
+  many were (the groups of a pre-registered test run the same seeds). Every
   comparison names the CPU models that ran its groups (each run's
   machine.json): groups run on different models, or on unrecorded ones,
   are flagged in the verdict. Unfinished cells are listed, not counted. A
@@ -380,8 +383,9 @@ def verdict(difference, low, high, p):
 class Comparison:
   """One group's final return and area against its baseline group's."""
 
-  def __init__(self, group, base, runs, base_runs):
+  def __init__(self, group, base, runs, base_runs, left_out=0):
     self.group, self.base = group, base
+    self.left_out = left_out  # finished runs of a seed the other lacks
     self.finals = [r.final for r in runs]
     self.base_finals = [r.final for r in base_runs]
     self.runs, self.base_runs = len(self.finals), len(self.base_finals)
@@ -435,6 +439,9 @@ class Comparison:
   def verdict_sentence(self):
     group, base = f"`{self.group}`", f"`{self.base}`"
     counts = f"{self.runs} vs {self.base_runs} runs"
+    if self.left_out:
+      counts += (f" on the seeds both finished; {self.left_out} more "
+                 f"{'run' if self.left_out == 1 else 'runs'} not counted")
     power = (f"; detectable with 80% power: {number(self.mde)}, a 10% "
              f"effect needs {number(self.seeds, 0)} seeds a group"
              if math.isfinite(self.mde) else "")
@@ -490,6 +497,20 @@ def group_row(group, runs, total, threshold):
   return row
 
 
+def seed_of(run):
+  return str(run.cell.get("seed", run.cell["config"]["training"].get("seed")))
+
+
+def paired(runs, base_runs):
+  """The runs of the seeds both groups finished, and how many others were
+  left out: groups are compared on the same seeds (a grid still running, or
+  committed cell by cell, has groups a seed ahead of others)."""
+  common = {seed_of(r) for r in runs} & {seed_of(r) for r in base_runs}
+  own = [r for r in runs if seed_of(r) in common]
+  theirs = [r for r in base_runs if seed_of(r) in common]
+  return own, theirs, len(runs) + len(base_runs) - len(own) - len(theirs)
+
+
 class EnvResults:
   """An env's groups of cells, their finished runs and their comparisons
   with the baseline (adjusted later, with the whole report's family)."""
@@ -519,7 +540,7 @@ class EnvResults:
       if base is not None and base != group and self.tested(group) and \
           self.finished[group] and self.finished[base]:
         self.comparisons[group] = Comparison(
-            group, base, self.finished[group], self.finished[base])
+            group, base, *paired(self.finished[group], self.finished[base]))
 
   def key(self, cell):
     return group_key(cell, self.matched, self.ignored)

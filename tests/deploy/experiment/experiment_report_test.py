@@ -303,13 +303,16 @@ class ReportTest(unittest.TestCase):
                   "difference may be the machines'.", section)
 
   def test_fewer_than_three_seeds_get_no_test(self):
+    # Compared on the seeds both groups finished: max's seeds 0 and 1
+    # (35, 36) against gae's (30, 32); max's seed 2 is left out.
     section, rows = table_rows(self.report, "Swimmer")
     biased = rows["max-rho0.4-E1-16-64-2048"]
-    self.assertEqual(biased[3], "+5.0 [n/a, n/a]")
+    self.assertEqual(biased[3], "+4.5 [n/a, n/a]")
     self.assertEqual(biased[4:8], ["n/a", "n/a", "n/a", "n/a"])
     self.assertEqual(biased[9], "unrecorded ⚠")
-    self.assertIn("`max-rho0.4-E1-16-64-2048` vs `gae`: +5.0; fewer than 3 "
-                  "seeds in a group, so no test (3 vs 2 runs). (CPU models "
+    self.assertIn("`max-rho0.4-E1-16-64-2048` vs `gae`: +4.5; fewer than 3 "
+                  "seeds in a group, so no test (2 vs 2 runs on the seeds "
+                  "both finished; 1 more run not counted). (CPU models "
                   "unrecorded.)", section)
 
   def test_a_summary_of_every_comparison_before_the_envs(self):
@@ -327,7 +330,7 @@ class ReportTest(unittest.TestCase):
     self.assertTrue(max_row[1].endswith(f", Holm p {p_max:.3f}"), max_row)
     self.assertEqual(max_row[2], "")  # no such group on InvertedPendulum
     self.assertEqual(max_row[3], "too few seeds (CPU models unrecorded) "
-                     "+5.0 [n/a, n/a], Holm p n/a |")
+                     "+4.5 [n/a, n/a], Holm p n/a |")
     min_row = rows["| `min-rho0.4-E1-16-64-2048`"].split(" | ")
     self.assertTrue(min_row[2].startswith(
         "better (MIXED CPU models (CPU A + CPU B vs CPU A)) +208.0 ["),
@@ -534,6 +537,22 @@ class ReportTest(unittest.TestCase):
         ("--baseline_set=exploration=ex3", "--baseline_set: no gae cell "
          "sets exploration=ex3")]:
       self.refused(exp, flag, message)
+
+  def test_groups_are_compared_on_the_seeds_both_finished(self):
+    # max's seed 3 has finished, gae's has not (a grid committed cell by
+    # cell): the comparison is of seeds 0-2, +30 (with seed 3: +95).
+    exp = self.write_finals("paired", {
+        "gae": ({"estimator": "gae"}, [100, 110, 120]),
+        "max": ({"estimator": "max"}, [130, 140, 150, 400])})
+    _, rows = self.report_rows(exp)
+    self.assertEqual(rows["max"][0], "4/4")  # the group's own runs
+    self.assertTrue(rows["max"][3].startswith("+30.0 ["), rows["max"])
+    p = float(rows["max"][4])
+    self.assertAlmostEqual(p, welch_p([130, 140, 150], [100, 110, 120]),
+                           delta=1e-3)
+    with open(os.path.join(exp, "report.md")) as f:
+      self.assertIn("(3 vs 3 runs on the seeds both finished; 1 more run "
+                    "not counted", f.read())
 
   def test_a_damaged_machine_record_is_named(self):
     exp = os.path.join(self.root, "damaged_machine")
