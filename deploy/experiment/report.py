@@ -296,6 +296,8 @@ def compare(values, baseline):
   has fewer than MIN_SEEDS values."""
   import numpy as np
   from scipy import stats
+  if not values or not baseline:  # no seed both groups finished
+    return math.nan, math.nan, math.nan, math.nan
   difference = float(np.mean(values) - np.mean(baseline))
   if min(len(values), len(baseline)) < MIN_SEEDS:
     return difference, math.nan, math.nan, math.nan

@@ -553,6 +553,19 @@ class ReportTest(unittest.TestCase):
     with open(os.path.join(exp, "report.md")) as f:
       self.assertIn("(3 vs 3 runs on the seeds both finished; 1 more run "
                     "not counted", f.read())
+    # No seed in common: no test, and the report says why.
+    with open(os.path.join(exp, "experiment.json")) as f:
+      record = json.load(f)
+    for cell in record["cells"]:
+      if cell["group"] == "gae":
+        cell["seed"] = str(int(cell["seed"]) + 10)
+    with open(os.path.join(exp, "experiment.json"), "w") as f:
+      json.dump(record, f)
+    _, rows = self.report_rows(exp)
+    self.assertEqual(rows["max"][3], "n/a [n/a, n/a]")
+    with open(os.path.join(exp, "report.md")) as f:
+      self.assertIn("no test (0 vs 0 runs on the seeds both finished; 7 more "
+                    "runs not counted)", f.read())
 
   def test_a_damaged_machine_record_is_named(self):
     exp = os.path.join(self.root, "damaged_machine")
