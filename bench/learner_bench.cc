@@ -313,9 +313,9 @@ int RunLearnerBenchmark() {
   }
 
   // EX2's model fit (its reference code's settings but for fewer
-  // iterations) on HalfCheetah's states and actions, with the fused Adam
-  // and with torch's: the rest of each step (the model's forward and
-  // backward) is the same autograd.
+  // iterations) on HalfCheetah's states and actions: the flat model and
+  // Adam (the default), autograd's gradients with the flat Adam, and
+  // autograd with torch's Adam.
   Ex2Config ex2_config;
   ex2_config.replay_min = 1;
   ex2_config.first_train_iterations = 1;
@@ -325,10 +325,16 @@ int RunLearnerBenchmark() {
   ex2_rollout.observations = at::randn({1001, kObservations});
   ex2_rollout.actions = at::randn({1000, kActions});
   ex2_rollout.rewards = at::zeros({1000});
-  Ex2Bonus ex2_fused(ex2_config, HalfCheetahSpec(), 1, SoloReplicaGroup());
+  Ex2Bonus ex2_flat(ex2_config, HalfCheetahSpec(), 1, SoloReplicaGroup());
+  Ex2Bonus ex2_autograd(ex2_config, HalfCheetahSpec(), 1, SoloReplicaGroup(),
+                        Ex2Fit::kAutograd);
   Ex2Bonus ex2_torch(ex2_config, HalfCheetahSpec(), 1, SoloReplicaGroup(),
-                     /*torch_adam=*/true);
-  for (Ex2Bonus* ex2 : {&ex2_fused, &ex2_torch}) {
+                     Ex2Fit::kTorch);
+  const std::pair<const char*, Ex2Bonus*> ex2_fits[] = {
+      {"ex2_flat_fit", &ex2_flat},
+      {"ex2_autograd_fit", &ex2_autograd},
+      {"ex2_torch_fit", &ex2_torch}};
+  for (auto [name, ex2] : ex2_fits) {
     // The pool's first rows, then the first fit (of one iteration): the
     // timed ones are all of kEx2Iterations.
     for (int i = 0; i < 2; ++i) {
@@ -336,9 +342,6 @@ int RunLearnerBenchmark() {
       ex2->ShapeRewards(rollouts);
       ex2->Commit();
     }
-  }
-  for (auto [name, ex2] : {std::pair{"ex2_fused_fit", &ex2_fused},
-                           {"ex2_torch_fit", &ex2_torch}}) {
     benchmark::RegisterBenchmark(name, [&, ex2 = ex2](benchmark::State& state) {
       for (auto _ : state) {
         std::vector<Rollout> rollouts = {ex2_rollout};
@@ -369,8 +372,10 @@ int RunLearnerBenchmark() {
       a2c_samples / collector.Seconds("a2c_flat_update");
   const double a2c_autograd_rate =
       a2c_samples / collector.Seconds("a2c_autograd_update");
-  const double ex2_fused_rate =
-      kEx2Iterations / collector.Seconds("ex2_fused_fit");
+  const double ex2_flat_rate =
+      kEx2Iterations / collector.Seconds("ex2_flat_fit");
+  const double ex2_autograd_rate =
+      kEx2Iterations / collector.Seconds("ex2_autograd_fit");
   const double ex2_torch_rate =
       kEx2Iterations / collector.Seconds("ex2_torch_fit");
   absl::StatusOr<DataParallelFigures> measured = MeasureTwoReplicas(batch);
@@ -400,13 +405,15 @@ int RunLearnerBenchmark() {
       "two_replicas_samples_per_s=%.0f two_replicas_speedup=%.2f "
       "allreduce_us=%.1f allreduce_share=%.3f a2c_flat_samples_per_s=%.0f "
       "a2c_autograd_samples_per_s=%.0f a2c_speedup=%.2f "
-      "ex2_fused_steps_per_s=%.0f ex2_torch_steps_per_s=%.0f "
-      "ex2_speedup=%.2f blas=%s\n",
+      "ex2_flat_steps_per_s=%.0f ex2_autograd_steps_per_s=%.0f "
+      "ex2_torch_steps_per_s=%.0f ex2_speedup=%.2f "
+      "ex2_fused_adam_speedup=%.2f blas=%s\n",
       ppo_rate, bare_rate, ppo_rate / bare_rate, guarded_rate,
       guarded_rate / ppo_rate, dp_rate, dp_rate / ppo_rate,
       two.allreduce_seconds * 1e6, allreduce_share, a2c_flat_rate,
-      a2c_autograd_rate, a2c_flat_rate / a2c_autograd_rate, ex2_fused_rate,
-      ex2_torch_rate, ex2_fused_rate / ex2_torch_rate, blas.kind.c_str());
+      a2c_autograd_rate, a2c_flat_rate / a2c_autograd_rate, ex2_flat_rate,
+      ex2_autograd_rate, ex2_torch_rate, ex2_flat_rate / ex2_autograd_rate,
+      ex2_autograd_rate / ex2_torch_rate, blas.kind.c_str());
   return 0;
 }
 

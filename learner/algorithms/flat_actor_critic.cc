@@ -1,7 +1,6 @@
 #include "learner/algorithms/flat_actor_critic.h"
 
 #include <ATen/ATen.h>
-#include <cblas.h>
 #include <torch/nn/modules/linear.h>
 
 #include <algorithm>
@@ -35,58 +34,47 @@ absl::StatusOr<FlatActorCritic> FlatActorCritic::Create(
   flat.spec_ = policy.spec();
   flat.discrete_ = policy.discrete();
   flat.heads_ = policy.heads();
-  absl::StatusOr<int64_t> size = flat.TakeParameters(std::move(parameters));
-  if (!size.ok()) return size.status();
-  if (absl::Status status = flat.LayOutNetworks(policy, value); !status.ok()) {
+  absl::StatusOr<FlatParameterClaims> claims =
+      FlatParameterClaims::Create(std::move(parameters));
+  if (!claims.ok()) return claims.status();
+  if (absl::Status status = flat.LayOutNetworks(policy, value, *claims);
+      !status.ok()) {
     return status;
   }
-  flat.parameters_.resize(*size);
-  flat.gradients_.assign(*size, 0.0f);
+  flat.tensors_ = claims->tensors();
+  flat.offsets_ = claims->offsets();
+  flat.parameters_.resize(claims->size());
+  flat.gradients_.assign(claims->size(), 0.0f);
   flat.Pull();
   return flat;
 }
 
-absl::StatusOr<int64_t> FlatActorCritic::TakeParameters(
-    std::vector<at::Tensor> parameters) {
-  int64_t size = 0;
-  for (const at::Tensor& p : parameters) {
-    if (p.scalar_type() != at::kFloat || !p.is_contiguous() || !p.is_cpu()) {
-      return absl::UnimplementedError(
-          "a parameter is not a contiguous float tensor on the CPU");
-    }
-    offsets_.push_back(size);
-    size += p.numel();
-  }
-  tensors_ = std::move(parameters);
-  return size;
-}
-
 absl::Status FlatActorCritic::LayOutNetworks(PolicyNetworkImpl& policy,
-                                             ValueNetworkImpl& value) {
-  std::vector<bool> claimed(tensors_.size(), false);
+                                             ValueNetworkImpl& value,
+                                             FlatParameterClaims& claims) {
   if (policy.recurrent()) {
-    if (absl::Status status = LayOutRecurrent(policy, value, claimed);
+    if (absl::Status status = LayOutRecurrent(policy, value, claims);
         !status.ok()) {
       return status;
     }
   }
   const int64_t inputs = core_ ? core_->hidden() : spec_.observation_size;
-  if (absl::Status status =
-          LayOutMlp(policy.body(), inputs, spec_.action_size, claimed, policy_);
-      !status.ok()) {
-    return status;
-  }
-  if (absl::Status status = LayOutMlp(value.body(), inputs, 1, claimed, value_);
-      !status.ok()) {
-    return status;
-  }
+  absl::StatusOr<FlatMlp> policy_mlp =
+      FlatMlp::LayOut(policy.body()->layers(), inputs, spec_.action_size,
+                      /*squash_last=*/false, claims);
+  if (!policy_mlp.ok()) return policy_mlp.status();
+  policy_ = *std::move(policy_mlp);
+  absl::StatusOr<FlatMlp> value_mlp = FlatMlp::LayOut(
+      value.body()->layers(), inputs, 1, /*squash_last=*/false, claims);
+  if (!value_mlp.ok()) return value_mlp.status();
+  value_ = *std::move(value_mlp);
   if (!discrete_) {
-    log_std_ = ClaimOffset(policy.log_std(), claimed);
+    log_std_ = claims.Claim(policy.log_std());
     if (log_std_ < 0) {
       return absl::UnimplementedError("the log-std is not a given parameter");
     }
   }
-  if (std::find(claimed.begin(), claimed.end(), false) != claimed.end()) {
+  if (!claims.AllClaimed()) {
     return absl::UnimplementedError(
         "a parameter belongs to neither network's layers nor the log-std");
   }
@@ -95,7 +83,7 @@ absl::Status FlatActorCritic::LayOutNetworks(PolicyNetworkImpl& policy,
 
 absl::Status FlatActorCritic::LayOutRecurrent(PolicyNetworkImpl& policy,
                                               ValueNetworkImpl& value,
-                                              std::vector<bool>& claimed) {
+                                              FlatParameterClaims& claims) {
   if (!value.recurrent()) {
     return absl::UnimplementedError("the value network has no recurrent trunk");
   }
@@ -105,12 +93,11 @@ absl::Status FlatActorCritic::LayOutRecurrent(PolicyNetworkImpl& policy,
     const auto& last = trunk->encoder()->layers()->at<torch::nn::LinearImpl>(
         trunk->encoder()->layers()->size() - 1);
     width = last.weight.size(0);
-    if (absl::Status status = LayOutMlp(
-            trunk->encoder(), spec_.observation_size, width, claimed, encoder_);
-        !status.ok()) {
-      return status;
-    }
-    encoder_.squash_last = true;
+    absl::StatusOr<FlatMlp> encoder =
+        FlatMlp::LayOut(trunk->encoder()->layers(), spec_.observation_size,
+                        width, /*squash_last=*/true, claims);
+    if (!encoder.ok()) return encoder.status();
+    encoder_ = *std::move(encoder);
   }
   const bool lstm = trunk->core() == Core::kLstm;
   const at::Tensor& weight_ih =
@@ -118,12 +105,12 @@ absl::Status FlatActorCritic::LayOutRecurrent(PolicyNetworkImpl& policy,
   const at::Tensor& weight_hh =
       lstm ? trunk->lstm()->weight_hh : trunk->gru()->weight_hh;
   FlatRecurrentCore::Offsets offsets;
-  offsets.weight_ih = ClaimOffset(weight_ih, claimed);
-  offsets.weight_hh = ClaimOffset(weight_hh, claimed);
-  offsets.bias_ih = ClaimOffset(
-      lstm ? trunk->lstm()->bias_ih : trunk->gru()->bias_ih, claimed);
-  offsets.bias_hh = ClaimOffset(
-      lstm ? trunk->lstm()->bias_hh : trunk->gru()->bias_hh, claimed);
+  offsets.weight_ih = claims.Claim(weight_ih);
+  offsets.weight_hh = claims.Claim(weight_hh);
+  offsets.bias_ih =
+      claims.Claim(lstm ? trunk->lstm()->bias_ih : trunk->gru()->bias_ih);
+  offsets.bias_hh =
+      claims.Claim(lstm ? trunk->lstm()->bias_hh : trunk->gru()->bias_hh);
   if (offsets.weight_ih < 0 || offsets.weight_hh < 0 || offsets.bias_ih < 0 ||
       offsets.bias_hh < 0 || weight_ih.size(1) != width) {
     return absl::UnimplementedError(
@@ -132,46 +119,6 @@ absl::Status FlatActorCritic::LayOutRecurrent(PolicyNetworkImpl& policy,
   }
   core_.emplace(trunk->core(), width, trunk->features(), offsets);
   return absl::OkStatus();
-}
-
-absl::Status FlatActorCritic::LayOutMlp(const TanhMlp& body, int64_t inputs,
-                                        int64_t outputs,
-                                        std::vector<bool>& claimed, Mlp& mlp) {
-  const torch::nn::ModuleList& layers = body->layers();
-  int64_t width = inputs;
-  for (size_t i = 0; i < layers->size(); ++i) {
-    const auto& linear = layers->at<torch::nn::LinearImpl>(i);
-    Layer layer;
-    layer.outputs = linear.weight.size(0);
-    layer.inputs = linear.weight.size(1);
-    layer.weight = ClaimOffset(linear.weight, claimed);
-    layer.bias = linear.bias.defined() ? ClaimOffset(linear.bias, claimed) : -1;
-    if (layer.inputs != width || layer.weight < 0 || layer.bias < 0) {
-      return absl::UnimplementedError(
-          absl::StrCat("layer ", i, " is not a biased Linear layer on ", width,
-                       " inputs whose parameters are the given ones"));
-    }
-    width = layer.outputs;
-    mlp.layers.push_back(layer);
-  }
-  if (mlp.layers.empty() || width != outputs) {
-    return absl::UnimplementedError(
-        absl::StrCat("an MLP ends in ", width, " outputs, not ", outputs));
-  }
-  mlp.outputs.resize(mlp.layers.size());
-  return absl::OkStatus();
-}
-
-int64_t FlatActorCritic::ClaimOffset(const at::Tensor& tensor,
-                                     std::vector<bool>& claimed) const {
-  for (size_t i = 0; i < tensors_.size(); ++i) {
-    if (tensors_[i].unsafeGetTensorImpl() == tensor.unsafeGetTensorImpl() &&
-        !claimed[i]) {
-      claimed[i] = true;
-      return offsets_[i];
-    }
-  }
-  return -1;
 }
 
 void FlatActorCritic::Pull() {
@@ -194,68 +141,13 @@ at::Tensor FlatActorCritic::Inputs(const at::Tensor& observations) const {
       .contiguous();
 }
 
-void FlatActorCritic::MlpForward(Mlp& mlp, const float* inputs, int64_t rows) {
-  const float* x = inputs;
-  for (size_t l = 0; l < mlp.layers.size(); ++l) {
-    const Layer& layer = mlp.layers[l];
-    float* y = GrowScratch(mlp.outputs[l], rows * layer.outputs);
-    const float* bias = parameters_.data() + layer.bias;
-    // As addmm: the bias, then the product added onto it.
-    for (int64_t r = 0; r < rows; ++r) {
-      std::memcpy(y + r * layer.outputs, bias, sizeof(float) * layer.outputs);
-    }
-    cblas_sgemm(CblasRowMajor, CblasNoTrans, CblasTrans, rows, layer.outputs,
-                layer.inputs, 1.0f, x, layer.inputs,
-                parameters_.data() + layer.weight, layer.inputs, 1.0f, y,
-                layer.outputs);
-    if (l + 1 < mlp.layers.size() || mlp.squash_last) {
-      // LibTorch's vectorised tanh, the one the modules use: libm's scalar
-      // tanhf would take most of the step.
-      at::from_blob(y, {rows * layer.outputs}).tanh_();
-    }
-    x = y;
-  }
-}
-
-void FlatActorCritic::MlpBackward(Mlp& mlp, const float* inputs, int64_t rows,
-                                  std::vector<float>& gradient,
-                                  float* d_inputs) {
-  for (size_t l = mlp.layers.size(); l-- > 0;) {
-    const Layer& layer = mlp.layers[l];
-    const float* x = l == 0 ? inputs : mlp.outputs[l - 1].data();
-    const float* dy = gradient.data();
-    cblas_sgemm(CblasRowMajor, CblasTrans, CblasNoTrans, layer.outputs,
-                layer.inputs, rows, 1.0f, dy, layer.outputs, x, layer.inputs,
-                0.0f, gradients_.data() + layer.weight, layer.inputs);
-    float* db = gradients_.data() + layer.bias;
-    std::fill(db, db + layer.outputs, 0.0f);
-    for (int64_t r = 0; r < rows; ++r) {
-      for (int64_t j = 0; j < layer.outputs; ++j) {
-        db[j] += dy[r * layer.outputs + j];
-      }
-    }
-    if (l == 0 && d_inputs == nullptr) break;
-    float* dx = l == 0 ? d_inputs : GrowScratch(scratch_, rows * layer.inputs);
-    cblas_sgemm(CblasRowMajor, CblasNoTrans, CblasNoTrans, rows, layer.inputs,
-                layer.outputs, 1.0f, dy, layer.outputs,
-                parameters_.data() + layer.weight, layer.inputs, 0.0f, dx,
-                layer.inputs);
-    if (l == 0) break;
-    // Through the tanh whose outputs x are.
-    for (int64_t i = 0; i < rows * layer.inputs; ++i) {
-      dx[i] *= 1.0f - x[i] * x[i];
-    }
-    std::swap(gradient, scratch_);
-  }
-}
-
 void FlatActorCritic::Forward(const float* inputs, const float* actions,
                               int64_t rows, const uint8_t* masks) {
   rows_ = rows;
   inputs_ = inputs;
   actions_ = actions;
-  MlpForward(policy_, inputs, rows);
-  MlpForward(value_, inputs, rows);
+  policy_.Forward(parameters_.data(), inputs, rows);
+  value_.Forward(parameters_.data(), inputs, rows);
   Heads(actions, masks, rows);
 }
 
@@ -269,21 +161,20 @@ void FlatActorCritic::ForwardSequences(const float* inputs,
   inputs_ = inputs;
   actions_ = actions;
   const float* encoded = inputs;
-  if (!encoder_.layers.empty()) {
-    MlpForward(encoder_, inputs, rows);
-    encoded = encoder_.outputs.back().data();
+  if (!encoder_.empty()) {
+    encoder_.Forward(parameters_.data(), inputs, rows);
+    encoded = encoder_.output();
   }
   core_->Forward(parameters_.data(), encoded, starts, states, steps, chunks);
-  MlpForward(policy_, core_->features(), rows);
-  MlpForward(value_, core_->features(), rows);
+  policy_.Forward(parameters_.data(), core_->features(), rows);
+  value_.Forward(parameters_.data(), core_->features(), rows);
   Heads(actions, masks, rows);
 }
 
 void FlatActorCritic::Heads(const float* actions, const uint8_t* masks,
                             int64_t rows) {
   GrowScratch(values_, rows);
-  std::memcpy(values_.data(), value_.outputs.back().data(),
-              sizeof(float) * rows);
+  std::memcpy(values_.data(), value_.output(), sizeof(float) * rows);
   GrowScratch(log_probs_, rows);
   if (discrete_) {
     CategoricalHead(actions, masks, rows);
@@ -294,7 +185,7 @@ void FlatActorCritic::Heads(const float* actions, const uint8_t* masks,
 
 void FlatActorCritic::GaussianHead(const float* actions, int64_t rows) {
   const int64_t k = spec_.action_size;
-  const float* mean = policy_.outputs.back().data();
+  const float* mean = policy_.output();
   const float* log_std = parameters_.data() + log_std_;
   float* z = GrowScratch(head_, rows * k);
   const float constant = static_cast<float>(kLogSqrtTwoPi);
@@ -319,7 +210,7 @@ void FlatActorCritic::CategoricalHead(const float* actions,
   // The policy layer's outputs are not read again by Backward (no tanh
   // after it), so the masked logits replace them; an illegal action's
   // probability is then 0 and so is every gradient through its logit.
-  float* logits = policy_.outputs.back().data();
+  float* logits = policy_.output();
   if (masks != nullptr) MaskLogitsInPlace(logits, masks, rows, n);
   float* log_p = GrowScratch(head_, rows * n);
   float* entropies = GrowScratch(entropies_, rows * width);
@@ -408,8 +299,10 @@ void FlatActorCritic::Backward(const float* d_log_probs, double entropy_weight,
     TrunkBackward(rows);
     return;
   }
-  MlpBackward(policy_, inputs_, rows, policy_gradient_);
-  MlpBackward(value_, inputs_, rows, value_gradient_);
+  policy_.Backward(parameters_.data(), gradients_.data(), inputs_, rows,
+                   policy_gradient_);
+  value_.Backward(parameters_.data(), gradients_.data(), inputs_, rows,
+                  value_gradient_);
 }
 
 void FlatActorCritic::TrunkBackward(int64_t rows) {
@@ -417,19 +310,22 @@ void FlatActorCritic::TrunkBackward(int64_t rows) {
   const float* features = core_->features();
   float* d_features = GrowScratch(d_features_, rows * h);
   float* d_value_features = GrowScratch(d_value_features_, rows * h);
-  MlpBackward(policy_, features, rows, policy_gradient_, d_features);
-  MlpBackward(value_, features, rows, value_gradient_, d_value_features);
+  policy_.Backward(parameters_.data(), gradients_.data(), features, rows,
+                   policy_gradient_, d_features);
+  value_.Backward(parameters_.data(), gradients_.data(), features, rows,
+                  value_gradient_, d_value_features);
   for (int64_t i = 0; i < rows * h; ++i) d_features[i] += d_value_features[i];
   const int64_t width = core_->inputs();
   float* d_encoded = GrowScratch(d_encoded_, rows * width);
   core_->Backward(parameters_.data(), d_features, gradients_.data(), d_encoded);
-  if (encoder_.layers.empty()) return;
+  if (encoder_.empty()) return;
   // Through the encoder's last tanh, then its layers.
-  const float* encoded = encoder_.outputs.back().data();
+  const float* encoded = encoder_.output();
   for (int64_t i = 0; i < rows * width; ++i) {
     d_encoded[i] *= 1.0f - encoded[i] * encoded[i];
   }
-  MlpBackward(encoder_, inputs_, rows, d_encoded_);
+  encoder_.Backward(parameters_.data(), gradients_.data(), inputs_, rows,
+                    d_encoded_);
 }
 
 }  // namespace vantage

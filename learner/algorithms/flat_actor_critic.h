@@ -19,12 +19,12 @@
 
 #include "absl/status/statusor.h"
 #include "common/env/environment.h"
+#include "learner/algorithms/flat_mlp.h"
 #include "learner/algorithms/flat_recurrent_core.h"
 
 namespace vantage {
 
 class PolicyNetworkImpl;
-class TanhMlp;
 class ValueNetworkImpl;
 
 class FlatActorCritic {
@@ -88,43 +88,18 @@ class FlatActorCritic {
                 const float* d_values);
 
  private:
-  struct Layer {
-    int64_t inputs = 0;
-    int64_t outputs = 0;
-    int64_t weight = 0;  // offsets: [outputs, inputs] row-major
-    int64_t bias = 0;
-  };
-  struct Mlp {
-    std::vector<Layer> layers;
-    bool squash_last = false;  // tanh after the last layer too (an encoder)
-    // Each layer's output of the last Forward (after tanh but the last).
-    std::vector<std::vector<float>> outputs;
-  };
-
   FlatActorCritic() = default;
-  // Create's steps. TakeParameters returns the flat size. LayOutNetworks
-  // fails unless every parameter is claimed exactly once, by a layer or the
-  // log-std: the flat arrays must cover the networks and nothing else.
-  absl::StatusOr<int64_t> TakeParameters(std::vector<at::Tensor> parameters);
+  // Create's steps. LayOutNetworks fails unless every parameter is claimed
+  // exactly once, by a layer or the log-std: the flat arrays must cover the
+  // networks and nothing else.
   absl::Status LayOutNetworks(PolicyNetworkImpl& policy,
-                              ValueNetworkImpl& value);
-  absl::Status LayOutMlp(const TanhMlp& body, int64_t inputs, int64_t outputs,
-                         std::vector<bool>& claimed, Mlp& mlp);
+                              ValueNetworkImpl& value,
+                              FlatParameterClaims& claims);
   // A recurrent trunk: its encoder, its cell; then both heads on its
   // features.
   absl::Status LayOutRecurrent(PolicyNetworkImpl& policy,
                                ValueNetworkImpl& value,
-                               std::vector<bool>& claimed);
-  // -1 for a tensor that is not a given parameter or whose parameter is
-  // already claimed (shared by two layers).
-  int64_t ClaimOffset(const at::Tensor& tensor,
-                      std::vector<bool>& claimed) const;
-  void MlpForward(Mlp& mlp, const float* inputs, int64_t rows);
-  // From d loss / d (the last layer's output) in `gradient` [rows, last
-  // outputs] (used as scratch); d loss / d inputs into `d_inputs` unless
-  // null.
-  void MlpBackward(Mlp& mlp, const float* inputs, int64_t rows,
-                   std::vector<float>& gradient, float* d_inputs = nullptr);
+                               FlatParameterClaims& claims);
   // The values and log-probabilities after both networks' forward passes.
   void Heads(const float* actions, const uint8_t* masks, int64_t rows);
   // Backward's path through a recurrent trunk from both heads' gradients.
@@ -140,10 +115,10 @@ class FlatActorCritic {
   std::vector<int64_t> offsets_;
   std::vector<float> parameters_;
   std::vector<float> gradients_;
-  Mlp policy_;
-  Mlp value_;
+  FlatMlp policy_;
+  FlatMlp value_;
   // A recurrent trunk's (the heads above then read its features).
-  Mlp encoder_;
+  FlatMlp encoder_;
   std::optional<FlatRecurrentCore> core_;
   std::vector<float> d_features_, d_value_features_, d_encoded_;
   int64_t log_std_ = -1;  // offset; continuous only
@@ -158,7 +133,7 @@ class FlatActorCritic {
   // log-softmax of the logits (categorical).
   std::vector<float> head_;
   std::vector<float> entropies_;  // per row and head (categorical)
-  std::vector<float> policy_gradient_, value_gradient_, scratch_;
+  std::vector<float> policy_gradient_, value_gradient_;
 };
 
 }  // namespace vantage

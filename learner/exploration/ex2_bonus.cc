@@ -34,7 +34,7 @@ double Median(const at::Tensor& values) {
 }  // namespace
 
 Ex2Bonus::Ex2Bonus(const Ex2Config& config, const EnvSpec& spec, uint64_t seed,
-                   std::shared_ptr<ReplicaGroup> replicas, bool torch_adam)
+                   std::shared_ptr<ReplicaGroup> replicas, Ex2Fit fit)
     : config_(config),
       spec_(spec),
       replicas_(std::move(replicas)),
@@ -44,7 +44,7 @@ Ex2Bonus::Ex2Bonus(const Ex2Config& config, const EnvSpec& spec, uint64_t seed,
           torch::optim::AdamOptions(config.learning_rate))),
       generator_(at::make_generator<at::CPUGeneratorImpl>(seed)),
       pool_(config.replay_size, InputWidth(config, spec)) {
-  if (torch_adam) return;
+  if (fit == Ex2Fit::kTorch) return;
   std::vector<at::Tensor> parameters = model_->parameters();
   std::vector<int64_t> offsets;
   int64_t size = 0;
@@ -64,6 +64,13 @@ Ex2Bonus::Ex2Bonus(const Ex2Config& config, const EnvSpec& spec, uint64_t seed,
     parameters[i].set_data(view);
   }
   flat_gradients_.assign(size, 0.0f);
+  if (fit == Ex2Fit::kFlat) {
+    absl::StatusOr<FlatExemplarModel> flat =
+        FlatExemplarModel::Create(*model_, config_, parameters);
+    // The model is always the layers FlatExemplarModel lays out.
+    TORCH_CHECK(flat.ok(), "EX2's flat model: ", flat.status().ToString());
+    flat_model_.emplace(*std::move(flat));
+  }
   flat_adam_.emplace(std::move(parameters), std::move(offsets), size);
 }
 
@@ -123,11 +130,9 @@ ExplorationStats Ex2Bonus::ShapeRewards(std::vector<Rollout>& rollouts) {
           0, at::randint(m, {config_.batch_size}, generator_,
                          at::TensorOptions(at::kLong)));
       const at::Tensor negatives = pool_.Sample(config_.batch_size, generator_);
-      const ExemplarLoss loss = ComputeExemplarLoss(
-          *model_, positives, negatives, config_.kl_weight, generator_);
-      FitStep(loss.loss);
-      loss_sum += loss.loss.item<double>();
-      accuracy_sum += loss.accuracy;
+      const auto [loss, accuracy] = FitStep(positives, negatives);
+      loss_sum += loss;
+      accuracy_sum += accuracy;
     }
     fitted_ = true;
     stats.fit_steps = iterations;
@@ -162,10 +167,36 @@ ExplorationStats Ex2Bonus::ShapeRewards(std::vector<Rollout>& rollouts) {
   return stats;
 }
 
-void Ex2Bonus::FitStep(const at::Tensor& loss) {
-  const std::vector<at::Tensor> parameters = model_->parameters();
+std::pair<double, double> Ex2Bonus::FitStep(const at::Tensor& positives,
+                                            const at::Tensor& negatives) {
+  double loss = 0.0, accuracy = 0.0;
+  if (flat_model_.has_value()) {
+    const FlatExemplarLoss flat = flat_model_->LossAndGradient(
+        flat_parameters_.data_ptr<float>(), positives, negatives,
+        config_.kl_weight, generator_, flat_gradients_.data());
+    loss = flat.loss;
+    accuracy = flat.accuracy;
+  } else {
+    const ExemplarLoss autograd = ComputeExemplarLoss(
+        *model_, positives, negatives, config_.kl_weight, generator_);
+    AutogradStep(autograd.loss);
+    loss = autograd.loss.item<double>();
+    accuracy = autograd.accuracy;
+    if (!flat_adam_.has_value()) return {loss, accuracy};
+  }
   constexpr double kNoClipping = std::numeric_limits<double>::infinity();
+  AverageAndClipFlatGradient(flat_gradients_.data(),
+                             static_cast<int64_t>(flat_gradients_.size()),
+                             kNoClipping, *replicas_);
+  flat_adam_->Step(*optimizer_, flat_parameters_.data_ptr<float>(),
+                   flat_gradients_.data());
+  return {loss, accuracy};
+}
+
+void Ex2Bonus::AutogradStep(const at::Tensor& loss) {
+  const std::vector<at::Tensor> parameters = model_->parameters();
   if (!flat_adam_.has_value()) {
+    constexpr double kNoClipping = std::numeric_limits<double>::infinity();
     GradientStep(*optimizer_, parameters, loss, kNoClipping, *replicas_);
     return;
   }
@@ -185,10 +216,6 @@ void Ex2Bonus::FitStep(const at::Tensor& loss) {
     }
     offset += p.numel();
   }
-  AverageAndClipFlatGradient(flat_gradients_.data(), offset, kNoClipping,
-                             *replicas_);
-  flat_adam_->Step(*optimizer_, flat_parameters_.data_ptr<float>(),
-                   flat_gradients_.data());
 }
 
 void Ex2Bonus::Commit() {

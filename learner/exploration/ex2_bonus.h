@@ -17,6 +17,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "absl/status/status.h"
@@ -25,6 +26,7 @@
 #include "learner/exploration/ex2_config.h"
 #include "learner/exploration/exemplar_model.h"
 #include "learner/exploration/exploration_stats.h"
+#include "learner/exploration/flat_exemplar_model.h"
 #include "learner/exploration/replay_pool.h"
 #include "learner/ingest/rollout_stitcher.h"
 #include "learner/parallel/replica_group.h"
@@ -39,17 +41,21 @@ class OutputArchive;
 
 namespace vantage {
 
+// How the model is fitted. kFlat (the default): FlatExemplarModel's
+// gradients and FlatAdam's steps, in a few loops over flat arrays;
+// kAutograd: autograd's gradients and FlatAdam's steps; kTorch: autograd
+// and torch::optim::Adam (the same arithmetic, a dozen operators per
+// parameter tensor). The last two for tests and benchmarks.
+enum class Ex2Fit { kFlat, kAutograd, kTorch };
+
 class Ex2Bonus {
  public:
   // The model's initial weights come from LibTorch's global generator; its
   // sampling from its own, seeded by `seed`. With `replicas`, gradients
   // are averaged over them (every replica must start from the same
-  // weights, which the learner broadcasts). The model's Adam steps are
-  // FlatAdam's, in one loop over every parameter, unless `torch_adam`
-  // (torch::optim::Adam's, the same arithmetic a dozen operators per
-  // parameter tensor at a time; for tests and benchmarks).
+  // weights, which the learner broadcasts).
   Ex2Bonus(const Ex2Config& config, const EnvSpec& spec, uint64_t seed,
-           std::shared_ptr<ReplicaGroup> replicas, bool torch_adam = false);
+           std::shared_ptr<ReplicaGroup> replicas, Ex2Fit fit = Ex2Fit::kFlat);
   ~Ex2Bonus();
 
   // Fits the model and adds the bonus to the rollouts' rewards (see
@@ -84,9 +90,13 @@ class Ex2Bonus {
   at::Tensor Inputs(const std::vector<Rollout>& rollouts) const;
 
  private:
-  // One Adam step of the model on `loss`'s gradients, averaged over the
-  // replicas.
-  void FitStep(const at::Tensor& loss);
+  // One fit step on a batch of positives (its loss and accuracy), its
+  // gradients averaged over the replicas.
+  std::pair<double, double> FitStep(const at::Tensor& positives,
+                                    const at::Tensor& negatives);
+  // autograd's gradients of `loss` into flat_gradients_ (kAutograd), or
+  // its step (kTorch).
+  void AutogradStep(const at::Tensor& loss);
 
   Ex2Config config_;
   EnvSpec spec_;
@@ -94,11 +104,13 @@ class Ex2Bonus {
   ExemplarModel model_{nullptr};
   std::unique_ptr<torch::optim::Adam> optimizer_;
   // With FlatAdam, the model's parameters are views of one flat tensor,
-  // which it steps in place; their gradients are gathered into one array.
-  // optimizer_ then only carries the state into checkpoints.
+  // which it steps in place, from one array of gradients (FlatExemplarModel
+  // writes them there; autograd's are gathered). optimizer_ then only
+  // carries the state into checkpoints.
   at::Tensor flat_parameters_;
   std::vector<float> flat_gradients_;
   std::optional<FlatAdam> flat_adam_;
+  std::optional<FlatExemplarModel> flat_model_;
   at::Generator generator_;
   ReplayPool pool_;
   bool fitted_ = false;

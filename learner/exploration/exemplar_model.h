@@ -27,6 +27,8 @@ class GlorotMlpImpl : public torch::nn::Module {
   GlorotMlpImpl(int64_t inputs, const std::vector<int64_t>& sizes,
                 bool linear_output);
   at::Tensor forward(const at::Tensor& x);
+  const torch::nn::ModuleList& layers() const { return layers_; }
+  bool linear_output() const { return linear_output_; }
 
  private:
   torch::nn::ModuleList layers_;
@@ -39,6 +41,9 @@ class ExemplarEncoderImpl : public torch::nn::Module {
   ExemplarEncoderImpl(int64_t inputs, const Ex2Config& config);
   // The latent's mean and log-variance, [B, feature_dim] each.
   std::pair<at::Tensor, at::Tensor> forward(const at::Tensor& x);
+  const GlorotMlp& trunk() const { return trunk_; }
+  const GlorotMlp& mean() const { return mean_; }
+  const GlorotMlp& log_variance() const { return log_variance_; }
 
  private:
   GlorotMlp trunk_{nullptr};
@@ -63,6 +68,11 @@ class ExemplarModelImpl : public torch::nn::Module {
                          const at::Generator* noise);
 
   int64_t inputs() const { return inputs_; }
+  const ExemplarEncoder& exemplar_encoder() const { return exemplar_encoder_; }
+  const ExemplarEncoder& candidate_encoder() const {
+    return candidate_encoder_;
+  }
+  const GlorotMlp& discriminator() const { return discriminator_; }
 
  private:
   int64_t inputs_;

@@ -379,7 +379,7 @@ TEST(Ex2BonusTest, SameSeedSameBonusesAndASavedModelContinuesExactly) {
   EXPECT_THAT(std::string(status.message()), HasSubstr("replay pool"));
 }
 
-// The fused Adam (the default) fits the model as torch::optim::Adam does:
+// The fused Adam fits the model as torch::optim::Adam does:
 // from the same weights, draws and batches, the same parameters to 1e-5
 // of each tensor's scale and the same bonuses; and a checkpoint of one
 // continues on the other.
@@ -389,10 +389,10 @@ TEST(Ex2BonusTest, TheFusedAdamFitsAsTorchsAdam) {
   config.first_train_iterations = 60;
   config.train_iterations = 30;
   at::manual_seed(2);
-  Ex2Bonus fused(config, PlaneSpec(), 5, SoloReplicaGroup());
+  Ex2Bonus fused(config, PlaneSpec(), 5, SoloReplicaGroup(), Ex2Fit::kAutograd);
   at::manual_seed(2);
   Ex2Bonus reference(config, PlaneSpec(), 5, SoloReplicaGroup(),
-                     /*torch_adam=*/true);
+                     Ex2Fit::kTorch);
   const auto expect_same = [](Ex2Bonus& a, Ex2Bonus& b, const char* when) {
     const std::vector<at::Tensor> pa = a.parameters();
     const std::vector<at::Tensor> pb = b.parameters();
@@ -425,8 +425,7 @@ TEST(Ex2BonusTest, TheFusedAdamFitsAsTorchsAdam) {
   fused.Save(out, "ex2");
   std::ostringstream bytes;
   out.save_to(bytes);
-  Ex2Bonus resumed(config, PlaneSpec(), 77, SoloReplicaGroup(),
-                   /*torch_adam=*/true);
+  Ex2Bonus resumed(config, PlaneSpec(), 77, SoloReplicaGroup(), Ex2Fit::kTorch);
   torch::serialize::InputArchive in;
   std::istringstream stream(bytes.str());
   in.load_from(stream);
@@ -437,6 +436,36 @@ TEST(Ex2BonusTest, TheFusedAdamFitsAsTorchsAdam) {
   fused.ShapeRewards(a);
   resumed.ShapeRewards(b);
   expect_same(fused, resumed, "resumed");
+}
+
+// A bonus fitted on the flat model (the default) shapes the rewards as one
+// fitted through autograd does, from the same weights, draws and batches
+// (both step with the fused Adam; only rounding differs).
+TEST(Ex2BonusTest, TheFlatModelFitsAsAutogradDoes) {
+  Ex2Config config = SmallConfig();
+  config.replay_min = 500;
+  config.first_train_iterations = 60;
+  config.train_iterations = 30;
+  at::manual_seed(5);
+  Ex2Bonus flat(config, PlaneSpec(), 9, SoloReplicaGroup());
+  at::manual_seed(5);
+  Ex2Bonus autograd(config, PlaneSpec(), 9, SoloReplicaGroup(),
+                    Ex2Fit::kAutograd);
+  at::Generator generator = at::make_generator<at::CPUGeneratorImpl>(6);
+  for (int batch = 0; batch < 4; ++batch) {
+    const at::Tensor states = at::randn({300, 2}, generator) * (batch + 1);
+    std::vector<Rollout> a = {RolloutOf(states)};
+    std::vector<Rollout> b = {RolloutOf(states)};
+    const ExplorationStats sa = flat.ShapeRewards(a);
+    const ExplorationStats sb = autograd.ShapeRewards(b);
+    flat.Commit();
+    autograd.Commit();
+    EXPECT_EQ(sa.fit_steps, sb.fit_steps);
+    if (sa.fit_steps > 0) EXPECT_NEAR(sa.model_loss, sb.model_loss, 1e-3);
+    EXPECT_LE((a[0].rewards - b[0].rewards).abs().max().item<double>(),
+              1e-3 * std::max(1.0, b[0].rewards.abs().max().item<double>()))
+        << "batch " << batch;
+  }
 }
 
 TEST(Ex2ConfigTest, RulesNameTheirField) {
