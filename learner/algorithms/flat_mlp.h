@@ -61,8 +61,8 @@ class FlatMlp {
   int64_t outputs() const { return empty() ? 0 : layers_.back().outputs; }
 
   // [rows, outputs()] of the last Forward: the last layer's outputs (after
-  // tanh if squash_last). Writable: Backward does not read them unless
-  // squash_last.
+  // tanh if squash_last). Writable: Backward never reads them (a caller
+  // takes a squashed output's tanh derivative from them before).
   float* output() { return outputs_.back().data(); }
 
   // `inputs` [rows, inputs] must stay unchanged until Backward.
