@@ -503,6 +503,40 @@ def seed_of(run):
   return str(run.cell.get("seed", run.cell["config"]["training"].get("seed")))
 
 
+def seed_ranges(seeds):
+  """'16-36' for 16, 17, ..., 36; '3, 5, 7-9' when there are gaps."""
+  ranges = []
+  for seed in sorted(seeds):
+    if ranges and seed == ranges[-1][1] + 1:
+      ranges[-1][1] = seed
+    else:
+      ranges.append([seed, seed])
+  return ", ".join(str(a) if a == b else f"{a}-{b}" for a, b in ranges)
+
+
+def cell_list(runs):
+  """The runs' directories, a group's runs as one entry with its seeds
+  ('TwoDMaze/gae seeds 16-36 (21 runs)'): a grid in progress leaves
+  dozens unfinished, one per seed."""
+  by_group = {}
+  for run in runs:
+    group, _, name = run.cell["dir"].rpartition("/")
+    seed = seed_of(run)
+    if name == f"seed-{seed}" and seed.isdigit():
+      by_group.setdefault(group, []).append(int(seed))
+    else:
+      by_group.setdefault(run.cell["dir"], None)
+  entries = []
+  for group, seeds in by_group.items():
+    if seeds is None:
+      entries.append(group)
+    elif len(seeds) == 1:
+      entries.append(f"{group}/seed-{seeds[0]}")
+    else:
+      entries.append(f"{group} seeds {seed_ranges(seeds)} ({len(seeds)} runs)")
+  return ", ".join(entries)
+
+
 def paired(runs, base_runs):
   """The runs of the seeds both groups finished, and how many others were
   left out: groups are compared on the same seeds (a grid still running, or
@@ -580,16 +614,15 @@ def env_section(results, threshold, figure, figure_problem):
                  if g in results.comparisons]
   lines += [f"- {c.sentence()}" for c in comparisons] or [
       "- No group has a baseline to be compared with."]
-  unfinished = [r.cell["dir"] for g in results.order
+  unfinished = [r for g in results.order
                 for r in results.groups[g] if not r.finished]
-  no_return = [r.cell["dir"] for g in results.order
-               for r in results.groups[g]
+  no_return = [r for g in results.order for r in results.groups[g]
                if r.finished and not math.isfinite(r.final)]
   if unfinished:
-    lines += ["", f"Unfinished, not counted: {', '.join(unfinished)}."]
+    lines += ["", f"Unfinished, not counted: {cell_list(unfinished)}."]
   if no_return:
     lines += ["", f"Finished without a completed episode in their last 100 "
-              f"(no final return), not counted: {', '.join(no_return)}."]
+              f"(no final return), not counted: {cell_list(no_return)}."]
   lines.append("")
   return lines
 

@@ -567,6 +567,24 @@ class ReportTest(unittest.TestCase):
       self.assertIn("no test (0 vs 0 runs on the seeds both finished; 7 more "
                     "runs not counted)", f.read())
 
+  def test_unfinished_runs_are_listed_by_group_and_seed_ranges(self):
+    # A grid in progress: a group's unfinished seeds are one entry.
+    exp = self.write_finals("in_progress", {
+        "gae": ({"estimator": "gae"}, [100, 110, 120, 130, 140, 150, 160]),
+        "max": ({"estimator": "max"}, [130, 140, 150, 160])})
+    for group, seed in [("gae", 1), ("gae", 2), ("gae", 3), ("gae", 5),
+                        ("max", 2)]:
+      with open(os.path.join(exp, f"Hopper/{group}/seed-{seed}",
+                             "progress.csv"), "w") as f:
+        f.write("env_steps,updates,mean_return,elapsed_s,sps\n"
+                "500,1,90,1,1\n")
+    _, rows = self.report_rows(exp)
+    self.assertEqual(rows["gae"][0], "3/7")
+    self.assertEqual(rows["max"][0], "3/4")
+    with open(os.path.join(exp, "report.md")) as f:
+      self.assertIn("Unfinished, not counted: Hopper/gae seeds 1-3, 5 "
+                    "(4 runs), Hopper/max/seed-2.\n", f.read())
+
   def test_a_damaged_machine_record_is_named(self):
     exp = os.path.join(self.root, "damaged_machine")
     shutil.rmtree(exp, ignore_errors=True)
