@@ -9,6 +9,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "deploy/cli/command.h"
+#include "deploy/cli/resolved_run_configs.h"
 
 namespace vantage {
 namespace {
@@ -52,6 +53,7 @@ int ExecPythonScript(const std::string& command, const std::string& script,
     return CommandFailure(command, kRuntimeError,
                           std::string(installed.message()));
   }
+  ExportResolvedRunConfigs(args);
   std::vector<std::string> all = {kPython, script};
   all.insert(all.end(), args.begin(), args.end());
   std::vector<char*> argv;

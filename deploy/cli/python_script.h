@@ -22,6 +22,8 @@ std::string PythonScriptHelp(const std::string& script,
 // Replaces this process with the script run on `args`, so that its exit
 // code (0, 1 or 2, with its own one-line errors) is the command's; returns
 // only on failure, with the command's exit code after a one-line message.
+// The runs below the directories among `args` reach the script resolved
+// (deploy/cli/resolved_run_configs.h).
 int ExecPythonScript(const std::string& command, const std::string& script,
                      const std::vector<std::string>& args);
 

@@ -289,6 +289,29 @@ def _flatten(section, prefix, out):
       out[path] = _canonical(value)
 
 
+_resolved_configs = None
+
+
+def resolved_config(directory):
+  """The run's config as the vantage that started this script resolves it
+  (VANTAGE_RESOLVED_RUN_CONFIGS, deploy/cli/resolved_run_configs.h), or
+  None (run as a script, or a config that vantage does not read): a run
+  made before a setting existed records no value for it, and ran with the
+  behaviour that setting's default keeps, not with the type's zero."""
+  global _resolved_configs
+  if _resolved_configs is None:
+    _resolved_configs = {}
+    path = os.environ.get("VANTAGE_RESOLVED_RUN_CONFIGS")
+    if path:
+      try:
+        with open(path, encoding="utf-8") as f:
+          _resolved_configs = json.load(f)
+      except (OSError, ValueError) as e:
+        warn(f"cannot read the resolved run configs ({e}): reading each "
+             f"run's config.json as it is")
+  return _resolved_configs.get(os.path.realpath(directory))
+
+
 def read_config(directory):
   path = os.path.join(directory, "config.json")
   try:
@@ -300,6 +323,7 @@ def read_config(directory):
     raise PlotError(f"{path}: cannot read it ({e})")
   if not isinstance(config, dict):
     raise PlotError(f"{path}: not a JSON object")
+  config = resolved_config(directory) or config
   if "training" not in config:
     raise PlotError(f"{path}: not a sectioned run config (no \"training\" "
                     f"section; an older flat config?): vantage plot reads "

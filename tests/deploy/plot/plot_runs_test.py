@@ -217,6 +217,35 @@ class PlotRunsTest(unittest.TestCase):
         self.assertPlots(self.experiment, self.runs[0],
                          f"--out={self.out('twice.png')}"), (2, 1, 4))
 
+  @unittest.skipIf(os.environ.get("VANTAGE_PLOT_VIA_SCRIPT"),
+                   "vantage resolves the configs; the script alone cannot")
+  def test_a_setting_older_runs_did_not_record_takes_its_default(self):
+    # An older run's config.json lacks a setting added later; it ran with
+    # the behaviour the setting's default (normalised observations) keeps,
+    # so it belongs with newer runs that record the default.
+    root = tempfile.mkdtemp(prefix="plot_old_runs.")
+    self.addCleanup(shutil.rmtree, root, ignore_errors=True)
+    runs = {}
+    for name, value in [("recorded", True), ("older", None), ("off", False)]:
+      runs[name] = os.path.join(root, name)
+      shutil.copytree(self.runs[0], runs[name])
+      path = os.path.join(runs[name], "config.json")
+      with open(path) as f:
+        config = json.load(f)
+      self.assertIs(config["training"]["normalize_observations"], True)
+      if value is None:
+        del config["training"]["normalize_observations"]
+      else:
+        config["training"]["normalize_observations"] = value
+      with open(path, "w") as f:
+        json.dump(config, f)
+    self.assertEqual(
+        self.assertPlots(runs["recorded"], runs["older"],
+                         f"--out={self.out('older.png')}"), (1, 1, 2))
+    self.assertEqual(
+        self.assertPlots(root, f"--out={self.out('older_and_off.png')}"),
+        (2, 1, 3))
+
   def test_panel_by_env_with_two_envs(self):
     other = self.copy_run("other-env")
     self.set_env(other, "HalfCheetah")
