@@ -326,8 +326,9 @@ def read_config(directory):
   config = resolved_config(directory) or config
   if "training" not in config:
     raise PlotError(f"{path}: not a sectioned run config (no \"training\" "
-                    f"section; an older flat config?): vantage plot reads "
-                    f"only sectioned configs")
+                    f"section; an older flat config?): the plotting script "
+                    f"reads only sectioned configs (`vantage plot` converts "
+                    f"a flat one it can read)")
   algorithms = [a for a in ALGORITHMS if a in config]
   if len(algorithms) != 1:
     raise PlotError(f"{path}: must hold exactly one of the sections "

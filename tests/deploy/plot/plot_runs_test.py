@@ -245,6 +245,15 @@ class PlotRunsTest(unittest.TestCase):
     self.assertEqual(
         self.assertPlots(root, f"--out={self.out('older_and_off.png')}"),
         (2, 1, 3))
+    # The flat config.json of still older runs: vantage converts it.
+    flat = os.path.join(root, "flat", "run")
+    os.makedirs(flat)
+    shutil.copy(os.path.join(self.runs[0], "progress.csv"), flat)
+    with open(os.path.join(flat, "config.json"), "w") as f:
+      json.dump({"mode": "local", "env": "InvertedPendulum",
+                 "estimator": "gae", "steps": STEPS, "horizon": HORIZON}, f)
+    self.assertEqual(
+        self.assertPlots(flat, f"--out={self.out('flat.png')}"), (1, 1, 1))
 
   def test_panel_by_env_with_two_envs(self):
     other = self.copy_run("other-env")
