@@ -3,26 +3,49 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <memory>
 #include <sstream>
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_split.h"
 #include "deploy/run/run_config.h"
+#include "google/protobuf/io/coded_stream.h"
+#include "google/protobuf/io/zero_copy_stream_impl_lite.h"
 #include "google/protobuf/util/json_util.h"
 #include "google/protobuf/util/message_differencer.h"
+#include "google/protobuf/util/type_resolver_util.h"
 #include "learner/checkpoint/checkpoint_files.h"
 #include "learner/run/run_directory.h"
 
 namespace vantage {
 namespace {
 
+constexpr char kTypeUrlPrefix[] = "type.googleapis.com";
+
+// Map fields print in the order of their serialised entries, which
+// protobuf leaves to its hash tables unless asked for a deterministic
+// (key-sorted) encoding; without one, the records committed beside a
+// grid's cells would change order every time the grid is run.
 std::string JsonOf(const google::protobuf::Message& message) {
+  std::string bytes;
+  {
+    google::protobuf::io::StringOutputStream stream(&bytes);
+    google::protobuf::io::CodedOutputStream coded(&stream);
+    coded.SetSerializationDeterministic(true);
+    (void)message.SerializeToCodedStream(&coded);
+  }
+  const google::protobuf::Descriptor& type = *message.GetDescriptor();
+  const std::unique_ptr<google::protobuf::util::TypeResolver> resolver(
+      google::protobuf::util::NewTypeResolverForDescriptorPool(
+          kTypeUrlPrefix, type.file()->pool()));
   google::protobuf::util::JsonPrintOptions options;
   options.add_whitespace = true;
   options.preserve_proto_field_names = true;
   std::string json;
   // Messages of known types always print.
-  (void)google::protobuf::util::MessageToJsonString(message, &json, options);
+  (void)google::protobuf::util::BinaryToJsonString(
+      resolver.get(), absl::StrCat(kTypeUrlPrefix, "/", type.full_name()),
+      bytes, &json, options);
   return json;
 }
 

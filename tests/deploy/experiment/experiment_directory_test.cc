@@ -3,6 +3,7 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <vector>
 
 #include "absl/strings/str_cat.h"
 #include "deploy/cli/experiment_command.h"
@@ -128,6 +129,35 @@ TEST(ExperimentDirectoryTest, RecordsFromBeforeASettingExistedTakeItsDefault) {
   const absl::Status merged = record.Merged(Expand("[0]")).status();
   EXPECT_EQ(merged.code(), absl::StatusCode::kFailedPrecondition);
   EXPECT_THAT(merged.message(), HasSubstr("with other settings"));
+}
+
+// The record is committed beside a grid's cells: the same cells must write
+// the same bytes, whatever order their maps were filled in.
+TEST(ExperimentDirectoryTest, TheRecordListsEveryMapInKeyOrder) {
+  const std::vector<std::string> keys = {"a", "b", "c", "d", "e",
+                                         "f", "g", "h", "i", "j"};
+  pb::ExpandedExperiment experiment;
+  for (int cell = 0; cell < 20; ++cell) {
+    pb::ExperimentCell& added = *experiment.add_cells();
+    for (size_t i = 0; i < keys.size(); ++i) {
+      // Each cell inserts its keys from another starting point.
+      const std::string& key = keys[(i + cell) % keys.size()];
+      (*added.mutable_flags())[key] = key;
+      (*added.mutable_origins())[key] = key;
+    }
+  }
+  const std::string json = ExpandedExperimentToJson(experiment);
+  size_t at = 0;
+  for (int map = 0; map < 2 * experiment.cells_size(); ++map) {
+    for (const std::string& key : keys) {
+      const size_t found = json.find(absl::StrCat("\"", key, "\": "), at);
+      ASSERT_NE(found, std::string::npos)
+          << "map " << map << " lists " << key << " out of order:\n"
+          << json;
+      at = found;
+    }
+  }
+  EXPECT_EQ(json, ExpandedExperimentToJson(experiment));
 }
 
 TEST(ExperimentDirectoryTest, ACellsStateComesFromItsRunDirectory) {
