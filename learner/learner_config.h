@@ -36,6 +36,9 @@ struct LearnerConfig {
   // normaliser keeps its initial mean 0 and variance 1 and the networks
   // see the environment's values, observation_clip then infinite).
   bool normalize_observations = true;
+  // A step cut off by the time limit bootstraps with the critic's value of
+  // the state after it (else its return ends there, as at a terminal step).
+  bool bootstrap_time_limits = true;
   double reward_clip = 10.0;
   // An update with a larger global gradient norm (before clipping) in any
   // of its gradient steps is rolled back like one that produced non-finite

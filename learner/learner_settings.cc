@@ -19,7 +19,8 @@ const SettingsTable<LearnerConfig, pb::TrainingSettings>& TrainingTable() {
           {{"steps", &C::total_env_steps, AtLeast(1)},
            {"horizon", &C::horizon, AtLeast(1)},
            {"scale_rewards", &C::scale_rewards},
-           {"normalize_observations", &C::normalize_observations}},
+           {"normalize_observations", &C::normalize_observations},
+           {"bootstrap_time_limits", &C::bootstrap_time_limits}},
           SettingNames::kFlag);
   return *table;
 }

@@ -87,6 +87,7 @@ absl::StatusOr<PreparedBatch> BatchPreparer::Prepare(
   if (!batch.ok()) return batch.status();
   prepared.batch = *std::move(batch);
   AdvantageInputs& inputs = prepared.batch.advantage_inputs;
+  if (!config_.bootstrap_time_limits) EndReturnsAtTimeLimits(inputs);
   if (config_.scale_rewards) {
     if (absl::Status status = reward_scaler_.Observe(rollouts, replicas_);
         !status.ok()) {

@@ -3,7 +3,8 @@
 
 // The learner's second stage: a batch of rollouts becomes what the
 // algorithm trains on. The exploration bonus shapes the rewards, the
-// current critic values every observation, the rewards are scaled, the
+// current critic values every observation (a time limit ends the return
+// instead where the run says so), the rewards are scaled, the
 // advantages (GAE and the rho-mixed path-ensemble estimate) computed, and
 // the observations normalised.
 

@@ -76,6 +76,10 @@ absl::StatusOr<TrainingBatch> AssembleBatch(
   return batch;
 }
 
+void EndReturnsAtTimeLimits(AdvantageInputs& inputs) {
+  inputs.truncation_values.zero_();
+}
+
 UpdateBatch MakeUpdateBatch(
     const TrainingBatch& batch, const Advantages& advantages,
     absl::FunctionRef<at::Tensor(const at::Tensor&)> normalize) {

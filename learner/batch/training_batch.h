@@ -48,6 +48,11 @@ using CriticValuesOf =
 absl::StatusOr<TrainingBatch> AssembleBatch(
     const std::vector<Rollout>& rollouts, CriticValuesOf values_of);
 
+// A return that ends at each time limit, as at a terminal step (rllab's
+// and the baselines' samplers): every truncated step bootstraps with 0
+// instead of the critic's value of the state after it.
+void EndReturnsAtTimeLimits(AdvantageInputs& inputs);
+
 // Where episodes start in a batch's [T, N] step flags: after every step
 // that ended one (never at step 0, whose state the rollout carries).
 at::Tensor EpisodeStarts(const at::Tensor& terminated,

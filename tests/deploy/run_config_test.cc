@@ -307,6 +307,22 @@ TEST(RunConfigTest, UnnormalisedObservationsAreNotClipped) {
   EXPECT_EQ(normalised->actor.observation_clip, ActorConfig().observation_clip);
 }
 
+// Time limits bootstrap unless the run says otherwise, and the learner is
+// told so.
+TEST(RunConfigTest, ATimeLimitEndsTheReturnWhereTheRunSaysSo) {
+  absl::StatusOr<pb::RunConfig> config = Resolve(
+      R"({"mode": "local", "training": {"bootstrap_time_limits": false}})");
+  ASSERT_TRUE(config.ok()) << config.status();
+  EXPECT_FALSE(config->training().bootstrap_time_limits());
+  absl::StatusOr<RunPlan> plan = PlanRun(*config);
+  ASSERT_TRUE(plan.ok()) << plan.status();
+  EXPECT_FALSE(plan->learner.bootstrap_time_limits);
+  absl::StatusOr<pb::RunConfig> defaults = Resolve(R"({"mode": "local"})");
+  ASSERT_TRUE(defaults.ok()) << defaults.status();
+  EXPECT_TRUE(defaults->training().bootstrap_time_limits());
+  EXPECT_TRUE(PlanRun(*defaults)->learner.bootstrap_time_limits);
+}
+
 TEST(RunConfigTest, AResolvedConfigSurvivesItsJsonAndResolvingAgain) {
   for (
       const std::string& json :

@@ -3,6 +3,7 @@
 #include <ATen/ATen.h>
 #include <torch/serialize/archive.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -329,6 +330,74 @@ TEST(ObservationNormalisationTest, ARunThatNormalisesNoneKeepsTheIdentity) {
       EXPECT_TRUE(learner->CurrentWeights().normalizer_mean.equal(
           initial.normalizer_mean));
     }
+  }
+}
+
+// `segments` (which end no episode) with one step of each cut off by a
+// time limit (its final observation the state after it), or, if
+// `as_terminal`, ended there; the episode is reported as the actor would.
+std::vector<Segment> WithAnEndAtStep(std::vector<Segment> segments,
+                                     int64_t step, bool as_terminal) {
+  for (Segment& s : segments) {
+    EXPECT_FALSE(s.terminated.any().item<bool>() ||
+                 s.truncated.any().item<bool>());
+    s.terminated = s.terminated.clone();
+    s.truncated = s.truncated.clone();
+    s.episode_lengths = {s.first_episode_step + step + 1};
+    s.episode_returns = {s.rewards.slice(0, 0, step + 1).sum().item<double>()};
+    if (as_terminal) {
+      s.terminated[step] = true;
+    } else {
+      s.truncated[step] = true;
+      s.final_observations = s.observations.slice(0, step + 1, step + 2);
+    }
+  }
+  return segments;
+}
+
+double LargestDifference(LearnerCore& a, LearnerCore& b) {
+  const PolicyWeights wa = a.CurrentWeights();
+  const PolicyWeights wb = b.CurrentWeights();
+  double largest = 0.0;
+  for (size_t i = 0; i < wa.parameters.size(); ++i) {
+    largest = std::max(
+        largest,
+        (wa.parameters[i] - wb.parameters[i]).abs().max().item<double>());
+  }
+  return largest;
+}
+
+// --bootstrap_time_limits=false: a learner trains on a time limit as on a
+// terminal step (to rounding), the critic's fit (the linear baseline's, which
+// the next update's advantages read) included; bootstrapped, it trains
+// otherwise.
+TEST(TimeLimitTest, AReturnEndedAtTheLimitTrainsAsATerminalStep) {
+  for (const std::string algorithm : {"ppo", "trpo"}) {
+    SCOPED_TRACE(algorithm);
+    // HalfCheetah never terminates, so the one end is the test's.
+    auto actor = MakeTestActor(kTestHorizon, "HalfCheetah");
+    LearnerConfig bootstrapped = TestLearnerConfig(actor->spec(), algorithm);
+    if (algorithm == "trpo") {
+      bootstrapped.algorithm.Mutable<TrpoConfig>().linear_baseline = true;
+    }
+    LearnerConfig ended = bootstrapped;
+    ended.bootstrap_time_limits = false;
+    auto learner = *LearnerCore::Create(ended);
+    auto terminal = *LearnerCore::Create(bootstrapped);
+    auto bootstrapping = *LearnerCore::Create(bootstrapped);
+    for (int update = 0; update < 2; ++update) {
+      const std::vector<Segment> batch = ActOneBatch(*actor, *learner);
+      const UpdateStats stats =
+          UpdateWith(*learner, WithAnEndAtStep(batch, 5, false));
+      EXPECT_FALSE(stats.rolled_back) << stats.rollback_reason;
+      UpdateWith(*terminal, WithAnEndAtStep(batch, 5, true));
+      UpdateWith(*bootstrapping, WithAnEndAtStep(batch, 5, false));
+    }
+    // The critic values the truncated steps' final observations in the same
+    // pass as the others, a pass of other rows that rounds differently in
+    // the last bits; a bootstrapped limit changes the weights far more.
+    EXPECT_LT(LargestDifference(*learner, *terminal), 1e-6);
+    EXPECT_GT(LargestDifference(*learner, *bootstrapping), 1e-4);
   }
 }
 

@@ -90,6 +90,44 @@ TEST(TrainingBatchTest, RefusesMixedLengthsAndEmptyBatches) {
               ::testing::HasSubstr("cannot share a batch"));
 }
 
+// Ending returns at the time limits makes every estimate, GAE, the
+// path ensemble's statistic and the critic's targets, what it is when the
+// truncated steps are terminal ones; bootstrapped, they differ.
+TEST(TrainingBatchTest, AReturnEndedAtTheTimeLimitIsOneEndedByTermination) {
+  at::manual_seed(5);
+  const std::vector<Rollout> rollouts = {MakeRollout(40, 0),
+                                         MakeRollout(40, 7)};
+  const TrainingBatch bootstrapped = *AssembleBatch(rollouts, FakeCritic);
+  AdvantageInputs ended = bootstrapped.advantage_inputs;
+  ended.truncation_values = ended.truncation_values.clone();
+  EndReturnsAtTimeLimits(ended);
+  AdvantageInputs terminal = bootstrapped.advantage_inputs;
+  terminal.terminated = at::logical_or(terminal.terminated, terminal.truncated);
+  terminal.truncated = at::zeros_like(terminal.truncated);
+  terminal.truncation_values = at::zeros_like(terminal.truncation_values);
+  AdvantageConfig config;
+  config.statistic = *ParseStatistic("max");
+  config.ensemble = {1, 4, 16};
+  config.rho = 0.5;
+  const auto advantages_of = [&](const AdvantageInputs& in) {
+    std::mt19937_64 rng(3);
+    return *ComputeAdvantages(in, config, rng);
+  };
+  const Advantages a = advantages_of(ended);
+  const Advantages b = advantages_of(terminal);
+  EXPECT_TRUE(a.gae.equal(b.gae));
+  EXPECT_TRUE(a.biased.equal(b.biased));
+  EXPECT_TRUE(a.mixed.equal(b.mixed));
+  EXPECT_TRUE(a.returns.equal(b.returns));
+  const Advantages c = advantages_of(bootstrapped.advantage_inputs);
+  EXPECT_FALSE(c.gae.equal(a.gae));
+  EXPECT_FALSE(c.returns.equal(a.returns));
+  // A step the limit cut off returns its reward alone.
+  const at::Tensor cut = ended.truncated;
+  EXPECT_TRUE(at::allclose(a.returns.masked_select(cut),
+                           ended.rewards.masked_select(cut)));
+}
+
 // With rho = 1 every policy sample uses the biased estimate, and still the
 // critic's targets are V + GAE, not V + biased.
 TEST(MakeUpdateBatchTest, CriticTargetsStayVPlusGaeAtRhoOne) {
