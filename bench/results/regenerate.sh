@@ -23,3 +23,13 @@ for experiment in $(grep -lE '"exploration": *"none"' "$here"/*/experiment.json)
   "$vantage" experiment report "$dir" --baseline_set=exploration=none \
     --no_figures --out="$dir/report_vs_trpo.md"
 done
+# The maze with EX2's code's inputs pre-registers each of its tests as a
+# family of one (docs/experiments.md): EX2 alone against plain TRPO, and
+# max over EX2 against EX2 alone.
+rllab=$here/sparse_maze_rllab
+"$vantage" experiment report "$rllab" --baseline_set=exploration=none \
+  --groups=gae --no_figures --out="$rllab/report_vs_trpo.md"
+if compgen -G "$rllab/TwoDMaze/max-*" > /dev/null; then
+  "$vantage" experiment report "$rllab" --groups='max-*' --no_figures \
+    --out="$rllab/report_max.md"
+fi
