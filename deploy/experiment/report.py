@@ -72,7 +72,7 @@ usage: vantage experiment report EXP_DIR [flags]
   are flagged in the verdict. Unfinished cells are listed, not counted. A
   summary table before the envs gives every group's verdict, difference
   [CI] and adjusted p on each env. One learning-curve figure per env
-  (`vantage plot`) goes beside the report.
+  (`vantage plot`) of its finished runs goes beside the report.
   Ends with a line `wrote FILE: E envs, G groups, R finished runs`.
 
 flags:
@@ -592,8 +592,14 @@ def env_section(results, threshold, figure, figure_problem):
   """The env's Markdown lines."""
   env = results.env
   lines = [f"## {env}", ""]
+  unfinished = [r for g in results.order
+                for r in results.groups[g] if not r.finished]
   if figure:
     lines += [f"![learning curves on {env}]({figure})", ""]
+    if any(r.curve for r in unfinished):
+      drawn = sum(r.finished for rs in results.groups.values() for r in rs)
+      lines += [f"The figure draws the {drawn} finished runs; unfinished "
+                f"runs are not drawn.", ""]
   elif figure_problem:
     lines += [f"(No figure: {figure_problem}.)", ""]
   lines += table_header(results.baseline.label(), threshold)
@@ -614,8 +620,6 @@ def env_section(results, threshold, figure, figure_problem):
                  if g in results.comparisons]
   lines += [f"- {c.sentence()}" for c in comparisons] or [
       "- No group has a baseline to be compared with."]
-  unfinished = [r for g in results.order
-                for r in results.groups[g] if not r.finished]
   no_return = [r for g in results.order for r in results.groups[g]
                if r.finished and not math.isfinite(r.final)]
   if unfinished:
@@ -666,14 +670,19 @@ def summary_section(comparisons_by_env, baseline_name):
   return lines
 
 
-def make_figure(exp_dir, results, path, env):
-  """True when drawn, False when no run has rows yet, else why not."""
-  run_dirs = [os.path.join(exp_dir, r.cell["dir"]) for r in results
-              if r.curve]
-  if not run_dirs:
+def make_figure(exp_dir, results, path):
+  """True when drawn, False when no run has rows yet, else why not. Only
+  finished runs are drawn, as only they are counted: a group's curve ends
+  at its shortest run, so one run in progress would cut it short."""
+  runs = [r for g in results.order for r in results.groups[g] if r.curve]
+  if not runs:
     return False
+  run_dirs = [os.path.join(exp_dir, r.cell["dir"]) for r in runs
+              if r.finished]
+  if not run_dirs:
+    return "no run has finished yet"
   try:
-    plot_runs.main(run_dirs + [f"--out={path}", f"--title={env}"])
+    plot_runs.main(run_dirs + [f"--out={path}", f"--title={results.env}"])
   except run_files.CommandError as e:
     return str(e)
   return True
@@ -748,7 +757,7 @@ def main(argv):
     if not args.no_figures:
       figure_path = os.path.join(out_dir, "figures", f"{env}.png")
       os.makedirs(os.path.dirname(figure_path), exist_ok=True)
-      drawn = make_figure(args.exp_dir, by_env[env], figure_path, env)
+      drawn = make_figure(args.exp_dir, env_results, figure_path)
       if drawn is True:
         figure = os.path.relpath(figure_path, out_dir)
       elif drawn:

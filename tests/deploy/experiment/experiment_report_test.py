@@ -350,6 +350,35 @@ class ReportTest(unittest.TestCase):
       self.assertIn(f"![learning curves on {env}](figures/{env}.png)",
                     self.report)
 
+  def test_a_figure_draws_the_finished_runs_alone(self):
+    # Hopper's fourth max run stops short; drawn, it would cut the group's
+    # curve at its last row. The plot's own line counts what it drew.
+    hopper = os.path.join(self.exp, "figures", "Hopper.png")
+    self.assertIn(f"wrote {hopper}: 2 groups, 1 panel, 6 runs\n",
+                  self.result.stdout)
+    self.assertIn("The figure draws the 6 finished runs; unfinished runs "
+                  "are not drawn.", table_rows(self.report, "Hopper")[0])
+    self.assertNotIn("The figure draws",
+                     table_rows(self.report, "InvertedPendulum")[0])
+
+  def test_no_figure_before_a_run_has_finished(self):
+    exp = self.write_finals("none_finished", {
+        "gae": ({"estimator": "gae"}, [100, 110, 120]),
+        "max": ({"estimator": "max"}, [130, 140, 150])})
+    for group in ("gae", "max"):
+      for seed in range(3):
+        with open(os.path.join(exp, f"Hopper/{group}/seed-{seed}",
+                               "progress.csv"), "w") as f:
+          f.write("env_steps,updates,mean_return,elapsed_s,sps\n"
+                  "500,1,90,1,1\n")
+    result = subprocess.run([VANTAGE, "experiment", "report", exp],
+                            capture_output=True, text=True, timeout=300)
+    self.assertEqual(result.returncode, 0, result.stderr)
+    with open(os.path.join(exp, "report.md")) as f:
+      self.assertIn("(No figure: no run has finished yet.)", f.read())
+    self.assertFalse(os.path.exists(os.path.join(exp, "figures",
+                                                 "Hopper.png")))
+
   def test_the_same_report_again(self):
     out = os.path.join(self.root, "again.md")
     result = subprocess.run([VANTAGE, "experiment", "report", self.exp,
@@ -358,7 +387,8 @@ class ReportTest(unittest.TestCase):
     self.assertEqual(result.returncode, 0, result.stderr)
     with open(out) as f:
       again = f.read()
-    strip = lambda text: re.sub(r"!\[.*\n\n", "", text)
+    strip = lambda text: re.sub(r"!\[.*\n\n(The figure draws .*\n\n)?", "",
+                                text)
     self.assertEqual(strip(again), strip(self.report))
 
   def test_bad_input_is_one_line_with_exit_2(self):
