@@ -70,10 +70,8 @@ absl::Status ResolveNetwork(pb::TrainingSettings& training) {
   }
   if (!training.has_torso()) training.set_torso(TorsoName(network->torso));
   if (!ParseTorso(training.torso()).ok()) {
-    return FlagError("torso",
-                     absl::StrCat("'", training.torso(),
-                                  "' is not one of auto, mlp, minatar, "
-                                  "nature"));
+    return FlagError("torso", absl::StrCat("'", training.torso(),
+                                           "' is not one of ", TorsoNames()));
   }
   if (training.has_core() && !ParseCore(training.core()).ok()) {
     return FlagError("core", absl::StrCat("'", training.core(),

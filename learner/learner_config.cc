@@ -10,6 +10,10 @@ bool LearnerConfig::linear_critic() const {
          algorithm.Get<TrpoConfig>().linear_baseline;
 }
 
+bool LearnerConfig::zero_critic() const {
+  return algorithm.name == "trpo" && algorithm.Get<TrpoConfig>().zero_baseline;
+}
+
 absl::Status LearnerConfig::Validate() const {
   if (spec.observation_size < 1 || spec.action_size < 1) {
     return absl::InvalidArgumentError("learner needs an environment spec");

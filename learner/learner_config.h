@@ -59,6 +59,9 @@ struct LearnerConfig {
   // Whether the critic is the linear feature baseline (TRPO's
   // --trpo_linear_baseline) rather than the value network.
   bool linear_critic() const;
+  // Whether there is no critic at all (TRPO's --trpo_zero_baseline): every
+  // state is valued 0.
+  bool zero_critic() const;
   // Everything, the spec and the network's fit to it included.
   absl::Status Validate() const;
   // Every rule that holds without the env's spec (what a run config

@@ -12,6 +12,7 @@ const std::vector<ConvTorsoDesign>& Designs() {
   static const auto* designs = new std::vector<ConvTorsoDesign>{
       {Torso::kMinAtar, "minatar", {{16, 3, 1}}, 128},
       {Torso::kNature, "nature", {{32, 8, 4}, {64, 4, 2}, {64, 3, 1}}, 512},
+      {Torso::kEx2Doom, "ex2doom", {{16, 4, 4}, {16, 4, 4}}, 32},
   };
   return *designs;
 }
@@ -46,8 +47,16 @@ absl::StatusOr<Torso> ParseTorso(absl::string_view name) {
   for (const ConvTorsoDesign& design : Designs()) {
     if (name == design.name) return design.torso;
   }
-  return absl::InvalidArgumentError(absl::StrCat(
-      "unknown torso \"", name, "\"; valid: auto, mlp, minatar, nature"));
+  return absl::InvalidArgumentError(
+      absl::StrCat("unknown torso \"", name, "\"; valid: ", TorsoNames()));
+}
+
+std::string TorsoNames() {
+  std::vector<std::string> names = {"auto", "mlp"};
+  for (const ConvTorsoDesign& design : Designs()) {
+    names.push_back(design.name);
+  }
+  return absl::StrJoin(names, ", ");
 }
 
 std::string TorsoName(Torso torso) {

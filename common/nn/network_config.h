@@ -11,6 +11,9 @@
 //   3x3 convolution of 16 channels, stride 1, then 128 units.
 // - nature: the DQN net (Mnih et al. 2015): 32 8x8/4, 64 4x4/2, 64 3x3/1,
 //   then 512 units; needs frames of at least 36 pixels a side.
+// - ex2doom: the policy of EX2's first-person-maze run (Fu et al. 2017's
+//   code, exps/doom.py): 16 4x4/4, 16 4x4/4, then 32 units; frames of at
+//   least 16 pixels a side.
 
 #include <cstdint>
 #include <string>
@@ -28,18 +31,22 @@ enum class Torso {
   kMlp,
   kMinAtar,
   kNature,
+  kEx2Doom,
 };
 
-// "auto", "mlp", "minatar", "nature"; an unknown name lists them.
+// "auto", "mlp", "minatar", "nature", "ex2doom"; an unknown name lists
+// them (TorsoNames).
 absl::StatusOr<Torso> ParseTorso(absl::string_view name);
 std::string TorsoName(Torso torso);
+// Every name ParseTorso takes, comma-separated.
+std::string TorsoNames();
 
 // The torso networks for `spec` get (never kAuto), or why `torso` cannot
 // take its observations (a convolution needs an observation_shape, nature
 // at least 36x36).
 absl::StatusOr<Torso> ResolveTorso(Torso torso, const EnvSpec& spec);
 
-// The layers of a convolutional torso (kMinAtar, kNature).
+// The layers of a convolutional torso (every torso but kAuto and kMlp).
 struct ConvLayerDesign {
   int64_t channels;
   int64_t kernel;

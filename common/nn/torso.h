@@ -20,7 +20,7 @@ namespace vantage {
 // [B, C*H*W] (flat, as batches hold observations) -> [B, features()].
 class ConvTorsoImpl : public torch::nn::Module {
  public:
-  // `torso` is kMinAtar or kNature; `shape` is [C, H, W] and fits it
+  // `torso` is a convolutional one; `shape` is [C, H, W] and fits it
   // (ResolveTorso said so).
   ConvTorsoImpl(Torso torso, const std::vector<int64_t>& shape);
   at::Tensor forward(const at::Tensor& flat);

@@ -4,10 +4,12 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <functional>
 #include <map>
+#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
@@ -20,6 +22,7 @@
 #include "bench/advantage_bench.h"
 #include "bench/env_bench.h"
 #include "bench/learner_bench.h"
+#include "bench/malloc_bench.h"
 #include "bench/recurrent_learner_bench.h"
 #include "bench/train_bench.h"
 #include "bench/transport_bench.h"
@@ -28,6 +31,7 @@
 #include "deploy/cli/shared_flags.h"
 #include "deploy/run/run_config.h"
 #include "learner/algorithms/algorithm.h"
+#include "learner/run/batch_memory.h"
 
 ABSL_FLAG(int64_t, bench_steps, 2048, "advantages: rollout length T");
 ABSL_FLAG(int64_t, bench_streams, 16, "advantages: number of env streams");
@@ -60,6 +64,12 @@ constexpr int kActorBenchEnvs = 16;
 constexpr char kTrainBenchEnv[] = "HalfCheetah";
 constexpr int64_t kTrainBenchSteps = 122880;
 constexpr int kConnectionsBenchActors = 200;
+// `bench malloc`'s run unless told otherwise: the first-person maze preset's
+// TRPO batches (8 x 500 frames), three updates, in one process.
+constexpr char kMallocBenchEnv[] = "FirstPersonMaze";
+constexpr int64_t kMallocBenchSteps = 12000;
+constexpr int kMallocBenchEnvs = 8;
+constexpr int64_t kMallocBenchHorizon = 500;
 
 int Usage(const char* message) {
   std::fprintf(stderr, "vantage bench %s\n", message);
@@ -182,6 +192,75 @@ int RunTrainBench() {
   return code;
 }
 
+// The bench's run unless told otherwise (see kMallocBench*). An error's
+// message is a usage line.
+absl::Status ApplyMallocBenchDefaults(RunRequest& request) {
+  if (!request.resume.empty() || !request.run_dir.empty()) {
+    return absl::InvalidArgumentError(
+        "malloc: --run_dir and --resume are not for a benchmark");
+  }
+  if (std::getenv("MALLOC_MMAP_MAX_") != nullptr ||
+      std::getenv("MALLOC_TRIM_THRESHOLD_") != nullptr ||
+      std::getenv("GLIBC_TUNABLES") != nullptr) {
+    return absl::InvalidArgumentError(
+        "malloc: compares glibc's defaults with vantage's settings; unset "
+        "MALLOC_MMAP_MAX_, MALLOC_TRIM_THRESHOLD_ and GLIBC_TUNABLES");
+  }
+  pb::TrainingSettings& training = *request.flags.mutable_training();
+  if (!training.has_env()) training.set_env(kMallocBenchEnv);
+  if (!training.has_steps()) training.set_steps(kMallocBenchSteps);
+  if (!training.has_envs()) training.set_envs(kMallocBenchEnvs);
+  if (!training.has_horizon()) training.set_horizon(kMallocBenchHorizon);
+  if (!request.flags.has_mode()) request.flags.set_mode("local");
+  if (request.algo.empty() &&
+      request.flags.algorithm_case() == pb::RunConfig::ALGORITHM_NOT_SET) {
+    request.algo = "trpo";
+  }
+  return absl::OkStatus();
+}
+
+// The run `vantage train` would make of the run flags given (with the
+// bench's defaults), timed with glibc's malloc defaults and with vantage's.
+int RunMallocBench() {
+  absl::StatusOr<RunRequest> request = RunRequestFromFlags();
+  if (!request.ok()) {
+    return Usage(std::string(request.status().message()).c_str());
+  }
+  if (absl::Status status = ApplyMallocBenchDefaults(*request); !status.ok()) {
+    return Usage(std::string(status.message()).c_str());
+  }
+  absl::StatusOr<ResolvedRun> run = ResolveRunRequest(*request);
+  if (!run.ok()) return Usage(std::string(run.status().message()).c_str());
+  absl::StatusOr<std::unique_ptr<Environment>> env =
+      MakeEnvironment(run->config.training().env(), EnvOptionsOf(run->config));
+  if (!env.ok()) return Usage(std::string(env.status().message()).c_str());
+  LearnerConfig learner = run->plan.learner;
+  learner.spec = (*env)->spec();
+  MallocBenchConfig bench;
+  bench.env = run->config.training().env();
+  bench.batch_observation_bytes = BatchObservationBytes(learner);
+  if (bench.batch_observation_bytes < (int64_t{32} << 20)) {
+    return Usage(
+        absl::StrCat("malloc: a batch's observations take ",
+                     bench.batch_observation_bytes,
+                     " bytes, below glibc's largest mmap threshold (32 MiB): "
+                     "vantage keeps glibc's defaults for such a run")
+            .c_str());
+  }
+  bench.config_path =
+      absl::StrCat(std::filesystem::temp_directory_path().string(),
+                   "/vantage-bench-malloc-", ::getpid(), ".json");
+  {
+    std::ofstream file(bench.config_path, std::ios::trunc);
+    file << RunConfigToJson(run->config);
+    if (!file.flush()) return Usage("malloc: cannot write its run config");
+  }
+  const int code = RunMallocBenchmark(bench);
+  std::error_code error;
+  std::filesystem::remove(bench.config_path, error);
+  return code;
+}
+
 int RunAdvantagesBench() {
   const int64_t steps = absl::GetFlag(FLAGS_bench_steps);
   const int64_t streams = absl::GetFlag(FLAGS_bench_streams);
@@ -299,6 +378,7 @@ const std::map<std::string, std::function<int()>>& Benchmarks() {
           {"connections", RunConnectionsBench},
           {"learner", RunLearnerBench},
           {"learner_scaling", RunLearnerScalingBench},
+          {"malloc", RunMallocBench},
       };
   return *benchmarks;
 }
@@ -339,7 +419,7 @@ Command BenchCommand() {
   command.summary = "benchmarks: ratios against a baseline of the same run";
   command.usage =
       "vantage bench (advantages | actor | connections | env | ingest | "
-      "learner | learner_scaling | train) [flags] [--benchmark_*]";
+      "learner | learner_scaling | malloc | train) [flags] [--benchmark_*]";
   command.description =
       "advantages: the path-ensemble estimators against GAE; env: the\n"
       "environment layer against raw physics (a MinAtar game: its bare\n"
@@ -354,7 +434,11 @@ Command BenchCommand() {
       "footprint; train: the distributed main job (`vantage train` with the\n"
       "run flags given) against the\n"
       "machine's limit from raw physics and vantage's own update (the bare\n"
-      "loop's limit beside it). Each ends with a\n"
+      "loop's limit beside it); malloc: a local run on frames (`vantage\n"
+      "train` with the run flags given; FirstPersonMaze's TRPO batches by\n"
+      "default) with glibc's malloc defaults against the freed memory\n"
+      "vantage keeps for batches above glibc's mmap threshold. Each ends\n"
+      "with a\n"
       "line `RESULT <name> ... ratio=...` measured in the same run. Google\n"
       "Benchmark's --benchmark_* flags apply.";
   command.flags = {"bench_steps",
@@ -378,9 +462,14 @@ Command BenchCommand() {
   // The run flags mean what they mean to `vantage train`, but for these.
   command.defaults = RunFlagDefaults(/*with_mode=*/false);
   command.defaults["env"] = absl::StrCat(
-      "actor: ", kActorBenchEnv, "; env: required; train: ", kTrainBenchEnv);
-  command.defaults["steps"] = absl::StrCat("train: ", kTrainBenchSteps);
-  command.defaults["envs"] = absl::StrCat("actor: ", kActorBenchEnvs);
+      "actor: ", kActorBenchEnv, "; env: required; train: ", kTrainBenchEnv,
+      "; malloc: ", kMallocBenchEnv);
+  command.defaults["steps"] = absl::StrCat("train: ", kTrainBenchSteps,
+                                           "; malloc: ", kMallocBenchSteps);
+  command.defaults["envs"] =
+      absl::StrCat("actor: ", kActorBenchEnvs, "; malloc: ", kMallocBenchEnvs);
+  command.defaults["horizon"] +=
+      absl::StrCat("; malloc: ", kMallocBenchHorizon);
   command.example = "vantage bench env --env=Hopper";
   command.take_own_arguments = InitializeGoogleBenchmark;
   command.takes_arguments = true;

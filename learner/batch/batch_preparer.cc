@@ -52,6 +52,16 @@ at::Tensor BatchPreparer::Values(const std::vector<Rollout>& rollouts) const {
 
 absl::StatusOr<TrainingBatch> BatchPreparer::Assemble(
     const std::vector<Rollout>& rollouts) const {
+  if (config_.zero_critic()) {
+    return AssembleBatch(rollouts, [](const std::vector<Rollout>& r) {
+      int64_t rows = 0;
+      for (const Rollout& rollout : r) {
+        rows +=
+            rollout.observations.size(0) + rollout.final_observations.size(0);
+      }
+      return at::zeros({rows}, at::kFloat);
+    });
+  }
   if (linear_critic_ != nullptr) {
     absl::StatusOr<at::Tensor> values = linear_critic_->Values(rollouts);
     if (!values.ok()) return values.status();

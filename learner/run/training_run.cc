@@ -5,6 +5,7 @@
 #include <string>
 #include <utility>
 
+#include "learner/run/batch_memory.h"
 #include "learner/run/run_directory.h"
 #include "learner/run/run_resume.h"
 
@@ -19,6 +20,7 @@ TrainingRun::TrainingRun(std::unique_ptr<LearnerCore> learner,
 absl::StatusOr<std::unique_ptr<TrainingRun>> TrainingRun::Open(
     const RecordingConfig& recording, const LearnerConfig& learner_config,
     const RestoreExtras& restore, std::shared_ptr<ReplicaGroup> replicas) {
+  KeepFreedMemoryForLargeBatches(learner_config);
   std::optional<RunDirectory> run;
   std::unique_ptr<LearnerCore> learner;
   double elapsed_before = 0.0;

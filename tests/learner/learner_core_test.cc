@@ -406,6 +406,49 @@ TEST(TimeLimitTest, AReturnEndedAtTheLimitTrainsAsATerminalStep) {
   }
 }
 
+// --trpo_zero_baseline: no critic, every state valued 0, so an advantage
+// is a sum of discounted rewards. The linear baseline starts at exactly 0,
+// so the first updates agree; the value network's first values are not 0,
+// and after its first fit neither are the linear baseline's.
+TEST(ZeroBaselineTest, EveryStateIsValuedZero) {
+  auto actor = MakeTestActor(kTestHorizon, "HalfCheetah");
+  LearnerConfig zero_config = TestLearnerConfig(actor->spec(), "trpo");
+  LearnerConfig linear_config = zero_config;
+  const LearnerConfig value_config = zero_config;
+  zero_config.algorithm.Mutable<TrpoConfig>().zero_baseline = true;
+  linear_config.algorithm.Mutable<TrpoConfig>().linear_baseline = true;
+  auto zero = *LearnerCore::Create(zero_config);
+  auto linear = *LearnerCore::Create(linear_config);
+  auto valued = *LearnerCore::Create(value_config);
+  for (int update = 0; update < 2; ++update) {
+    const std::vector<Segment> batch = ActOneBatch(*actor, *zero);
+    const UpdateStats stats = UpdateWith(*zero, batch);
+    EXPECT_FALSE(stats.rolled_back) << stats.rollback_reason;
+    EXPECT_EQ(stats.algorithm.value_loss, 0.0);
+    UpdateWith(*linear, batch);
+    UpdateWith(*valued, batch);
+    if (update == 0) {
+      EXPECT_LT(LargestDifference(*zero, *linear), 1e-6);
+      EXPECT_GT(LargestDifference(*zero, *valued), 1e-4);
+    }
+  }
+  EXPECT_GT(LargestDifference(*zero, *linear), 1e-4);
+  ExpectACheckpointContinuesExactly(*actor, *zero, zero_config, "zero");
+
+  // Unlike the linear baseline it takes frames; and it is one critic.
+  auto frames = MakeTestActor(kTestHorizon, "MinAtarBreakout");
+  LearnerConfig on_frames = TestLearnerConfig(frames->spec(), "trpo");
+  on_frames.algorithm.Mutable<TrpoConfig>().zero_baseline = true;
+  auto learner = *LearnerCore::Create(on_frames);
+  const UpdateStats stats =
+      UpdateWith(*learner, ActOneBatch(*frames, *learner));
+  EXPECT_FALSE(stats.rolled_back) << stats.rollback_reason;
+  zero_config.algorithm.Mutable<TrpoConfig>().linear_baseline = true;
+  EXPECT_EQ(LearnerCore::Create(zero_config).status().message(),
+            "trpo.linear_baseline and trpo.zero_baseline are two different "
+            "critics; set one of them");
+}
+
 TEST(SharedTorsoTest, OneTrunkTrainsAndResumesAsOne) {
   for (const std::string algorithm : {"a2c", "ppo"}) {
     SCOPED_TRACE(algorithm);

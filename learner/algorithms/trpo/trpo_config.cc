@@ -15,7 +15,8 @@ const SettingsTable<TrpoConfig, pb::TrpoSettings>& TrpoTable() {
                {"value_learning_rate", &C::value_learning_rate, Above(0)},
                {"value_epochs", &C::value_epochs, AtLeast(1)},
                {"entropy_coef", &C::entropy_coef, AtLeast(0)},
-               {"linear_baseline", &C::linear_baseline}});
+               {"linear_baseline", &C::linear_baseline},
+               {"zero_baseline", &C::zero_baseline}});
   return *table;
 }
 
@@ -24,6 +25,11 @@ const SettingsTable<TrpoConfig, pb::TrpoSettings>& TrpoTable() {
 absl::Status TrpoConfig::Validate() const {
   if (absl::Status status = TrpoTable().Validate(*this); !status.ok()) {
     return status;
+  }
+  if (linear_baseline && zero_baseline) {
+    return absl::InvalidArgumentError(
+        "trpo.linear_baseline and trpo.zero_baseline are two different "
+        "critics; set one of them");
   }
   // Not settings of a run: fixed by the code that makes the config.
   if (line_search_steps < 1) {

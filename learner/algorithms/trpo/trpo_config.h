@@ -24,6 +24,9 @@ struct TrpoConfig {
   // The learner's LinearCritic values the states instead of the value
   // network, which then is never fitted (value_* unused).
   bool linear_baseline = false;
+  // No critic: every state is valued 0 (rllab's ZeroBaseline); the value
+  // network is never used or fitted.
+  bool zero_baseline = false;
 
   // Names the rule a field breaks as its run-config field (trpo.max_kl).
   absl::Status Validate() const;

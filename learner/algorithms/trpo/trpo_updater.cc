@@ -89,8 +89,10 @@ AlgorithmStats TrpoUpdater::Update(const UpdateBatch& batch,
   stats.approx_kl = PolicyStep(batch, advantages, surrogate);
   stats.policy_loss = -surrogate;
   // The linear baseline is the learner's, fitted (and its loss reported)
-  // once the update is kept.
-  stats.value_loss = config_.linear_baseline ? 0.0 : FitValue(batch, rng);
+  // once the update is kept; the zero baseline fits nothing.
+  stats.value_loss = config_.linear_baseline || config_.zero_baseline
+                         ? 0.0
+                         : FitValue(batch, rng);
   return stats;
 }
 

@@ -106,12 +106,13 @@ int64_t ParameterCount(torch::nn::Module& module) {
 }
 
 TEST(TorsoTest, NamesParseAndAutoPicksByTheObservations) {
-  for (Torso torso :
-       {Torso::kAuto, Torso::kMlp, Torso::kMinAtar, Torso::kNature}) {
+  for (Torso torso : {Torso::kAuto, Torso::kMlp, Torso::kMinAtar,
+                      Torso::kNature, Torso::kEx2Doom}) {
     EXPECT_EQ(ParseTorso(TorsoName(torso)).value(), torso);
   }
   EXPECT_EQ(ParseTorso("resnet").status().message(),
-            "unknown torso \"resnet\"; valid: auto, mlp, minatar, nature");
+            "unknown torso \"resnet\"; valid: auto, mlp, minatar, nature, "
+            "ex2doom");
   EXPECT_EQ(ResolveTorso(Torso::kAuto, ContinuousSpec()).value(), Torso::kMlp);
   EXPECT_EQ(ResolveTorso(Torso::kAuto, ImageSpec(4, 10, 1)).value(),
             Torso::kMinAtar);
@@ -125,6 +126,12 @@ TEST(TorsoTest, NamesParseAndAutoPicksByTheObservations) {
       ResolveTorso(Torso::kNature, ImageSpec(4, 10, 1)).status().message(),
       "torso nature needs frames of at least 36x36 pixels; Image has "
       "4x10x10 (use --torso=minatar)");
+  EXPECT_EQ(
+      ResolveTorso(Torso::kEx2Doom, ImageSpec(4, 10, 1)).status().message(),
+      "torso ex2doom needs frames of at least 16x16 pixels; Image has "
+      "4x10x10 (use --torso=minatar)");
+  EXPECT_EQ(ResolveTorso(Torso::kEx2Doom, ImageSpec(3, 16, 255)).value(),
+            Torso::kEx2Doom);
   EXPECT_EQ(ResolveTorso(Torso::kMinAtar, ContinuousSpec()).status().message(),
             "torso minatar needs image observations; test has vectors of 5 "
             "(use --torso=mlp)");
@@ -144,6 +151,12 @@ TEST(TorsoTest, ConvolutionalTorsosHaveThePublishedLayers) {
   EXPECT_EQ(ParameterCount(*nature),
             (3 * 32 * 64 + 32) + (32 * 64 * 16 + 64) + (64 * 64 * 9 + 64) +
                 (64 * 1 * 1 * 512 + 512) + (512 * 6 + 6));
+  // EX2's first-person-maze policy: 42 -> 10 -> 2 pixels a side.
+  PolicyNetwork ex2doom(ImageSpec(3, 42, 255),
+                        NetworkConfig{{64, 64}, Torso::kEx2Doom});
+  EXPECT_EQ(ParameterCount(*ex2doom), (3 * 16 * 16 + 16) + (16 * 16 * 16 + 16) +
+                                          (16 * 2 * 2 * 32 + 32) +
+                                          (32 * 6 + 6));
   // Convolutions orthogonal with gain sqrt(2) over their flattened inputs,
   // zero biases; the output layer keeps the policy's 0.01.
   const auto parameters = nature->named_parameters();
