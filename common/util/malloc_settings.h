@@ -6,8 +6,8 @@
 // of free memory. A run on frames allocates and frees batches of tens of
 // megabytes every update (4000 frames of 3 x 42 x 42 floats: 85 MB, and
 // the convolutions' activations over them), so the kernel maps and zeroes
-// fresh pages for each: a third of a first-person-maze run's CPU time
-// (docs/benchmarks.md, "Large batches of frames and glibc's allocator").
+// fresh pages for each: half of a first-person-maze TRPO run's CPU time
+// (docs/benchmarks.md, `vantage bench malloc`).
 
 namespace vantage {
 
