@@ -26,6 +26,7 @@
 #include "bench/recurrent_learner_bench.h"
 #include "bench/train_bench.h"
 #include "bench/transport_bench.h"
+#include "common/util/malloc_settings.h"
 #include "deploy/cli/command_line.h"
 #include "deploy/cli/run_flags.h"
 #include "deploy/cli/shared_flags.h"
@@ -199,19 +200,21 @@ absl::Status ApplyMallocBenchDefaults(RunRequest& request) {
     return absl::InvalidArgumentError(
         "malloc: --run_dir and --resume are not for a benchmark");
   }
-  if (std::getenv("MALLOC_MMAP_MAX_") != nullptr ||
-      std::getenv("MALLOC_TRIM_THRESHOLD_") != nullptr ||
-      std::getenv("GLIBC_TUNABLES") != nullptr) {
+  if (EnvironmentSetsMalloc(std::getenv("MALLOC_MMAP_MAX_"),
+                            std::getenv("MALLOC_TRIM_THRESHOLD_"),
+                            std::getenv("GLIBC_TUNABLES"))) {
     return absl::InvalidArgumentError(
         "malloc: compares glibc's defaults with vantage's settings; unset "
-        "MALLOC_MMAP_MAX_, MALLOC_TRIM_THRESHOLD_ and GLIBC_TUNABLES");
+        "MALLOC_MMAP_MAX_, MALLOC_TRIM_THRESHOLD_ and GLIBC_TUNABLES's "
+        "glibc.malloc tunables");
   }
   pb::TrainingSettings& training = *request.flags.mutable_training();
   if (!training.has_env()) training.set_env(kMallocBenchEnv);
   if (!training.has_steps()) training.set_steps(kMallocBenchSteps);
   if (!training.has_envs()) training.set_envs(kMallocBenchEnvs);
   if (!training.has_horizon()) training.set_horizon(kMallocBenchHorizon);
-  if (!request.flags.has_mode()) request.flags.set_mode("local");
+  // One process: its CPU time, faults and peak memory are the run's.
+  request.flags.set_mode("local");
   if (request.algo.empty() &&
       request.flags.algorithm_case() == pb::RunConfig::ALGORITHM_NOT_SET) {
     request.algo = "trpo";
@@ -411,6 +414,21 @@ void InitializeGoogleBenchmark(std::vector<char*>& argv) {
   argv.resize(argc);
 }
 
+// The run flags mean what they mean to `vantage train`, but for these.
+std::map<std::string, std::string> BenchFlagDefaults() {
+  std::map<std::string, std::string> defaults =
+      RunFlagDefaults(/*with_mode=*/false);
+  defaults["env"] = absl::StrCat("actor: ", kActorBenchEnv,
+                                 "; env: required; train: ", kTrainBenchEnv,
+                                 "; malloc: ", kMallocBenchEnv);
+  defaults["steps"] = absl::StrCat("train: ", kTrainBenchSteps,
+                                   "; malloc: ", kMallocBenchSteps);
+  defaults["envs"] =
+      absl::StrCat("actor: ", kActorBenchEnvs, "; malloc: ", kMallocBenchEnvs);
+  defaults["horizon"] += absl::StrCat("; malloc: ", kMallocBenchHorizon);
+  return defaults;
+}
+
 }  // namespace
 
 Command BenchCommand() {
@@ -459,17 +477,7 @@ Command BenchCommand() {
       command.flags.push_back(name);
     }
   }
-  // The run flags mean what they mean to `vantage train`, but for these.
-  command.defaults = RunFlagDefaults(/*with_mode=*/false);
-  command.defaults["env"] = absl::StrCat(
-      "actor: ", kActorBenchEnv, "; env: required; train: ", kTrainBenchEnv,
-      "; malloc: ", kMallocBenchEnv);
-  command.defaults["steps"] = absl::StrCat("train: ", kTrainBenchSteps,
-                                           "; malloc: ", kMallocBenchSteps);
-  command.defaults["envs"] =
-      absl::StrCat("actor: ", kActorBenchEnvs, "; malloc: ", kMallocBenchEnvs);
-  command.defaults["horizon"] +=
-      absl::StrCat("; malloc: ", kMallocBenchHorizon);
+  command.defaults = BenchFlagDefaults();
   command.example = "vantage bench env --env=Hopper";
   command.take_own_arguments = InitializeGoogleBenchmark;
   command.takes_arguments = true;

@@ -197,6 +197,32 @@ TEST(BenchCommandsTest, TrainRefusesWhatItCannotTime) {
   EXPECT_THAT(lagged_sync.err, HasSubstr("--sync"));
 }
 
+// A learner on frames (16 x 128 of 3 x 42 x 42: 43 MB a batch, one update)
+// keeps freed memory, and its run's page faults fall with it; the CPU times
+// are for docs/benchmarks.md.
+TEST(BenchCommandsTest, MallocRunsTheSameRunWithAndWithoutGlibcsDefaults) {
+  const Outcome outcome = RunVantage(
+      "bench malloc --envs=16 --horizon=128 --steps=2048 "
+      "--trpo_zero_baseline");
+  ASSERT_EQ(outcome.exit_code, 0) << outcome.err;
+  const auto fields = ResultFields(outcome.out, "RESULT malloc ");
+  EXPECT_EQ(fields.at("env"), "FirstPersonMaze");
+  EXPECT_LT(Number(fields, "kept_faults"), Number(fields, "glibc_faults") / 4);
+  EXPECT_GT(Number(fields, "kept_faults"), 0);
+  EXPECT_NEAR(Number(fields, "ratio"),
+              Number(fields, "glibc_cpu_s") / Number(fields, "kept_cpu_s"),
+              0.01 * Number(fields, "ratio") + 0.01);
+
+  const Outcome small = RunVantage("bench malloc --env=Hopper");
+  EXPECT_EQ(small.exit_code, 2);
+  EXPECT_THAT(small.err, HasSubstr("below glibc's largest mmap threshold"));
+  setenv("MALLOC_MMAP_MAX_", "65536", 1);
+  const Outcome told = RunVantage("bench malloc");
+  unsetenv("MALLOC_MMAP_MAX_");
+  EXPECT_EQ(told.exit_code, 2);
+  EXPECT_THAT(told.err, HasSubstr("unset MALLOC_MMAP_MAX_"));
+}
+
 // A real learner process with connected actors against its idle self: each
 // open stream holds a server thread, so the threads grow with the actors.
 TEST(BenchCommandsTest, ConnectionsMeasureALearnerPerConnectedActor) {
