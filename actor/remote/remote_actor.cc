@@ -17,6 +17,7 @@
 #include "actor/remote/round_watchdog.h"
 #include "actor/run_settings.h"
 #include "common/net/grpc_security.h"
+#include "common/net/keepalive.h"
 #include "common/net/port_file.h"
 #include "common/rollout/horizon_pacer.h"
 #include "common/util/phase_times.h"
@@ -408,6 +409,12 @@ grpc::ChannelArguments ChannelArgumentsFor(const RemoteActorConfig& config) {
   grpc::ChannelArguments arguments;
   arguments.SetMaxReceiveMessageSize(config.max_message_bytes);
   arguments.SetMaxSendMessageSize(config.max_message_bytes);
+  // A dead link is noticed by pings, not by TCP's backoff (keepalive.h).
+  arguments.SetInt(GRPC_ARG_KEEPALIVE_TIME_MS, kKeepaliveIntervalMs);
+  arguments.SetInt(GRPC_ARG_KEEPALIVE_TIMEOUT_MS, kKeepaliveTimeoutMs);
+  // Pings while the actor waits for weights and sends nothing.
+  arguments.SetInt(GRPC_ARG_HTTP2_MAX_PINGS_WITHOUT_DATA, 0);
+  arguments.SetInt(GRPC_ARG_MAX_RECONNECT_BACKOFF_MS, kMaxReconnectBackoffMs);
   return arguments;
 }
 

@@ -12,6 +12,7 @@
 
 #include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
+#include "common/net/keepalive.h"
 #include "proto/wire_format.h"
 
 namespace vantage {
@@ -314,6 +315,13 @@ absl::StatusOr<RunningServer> StartServer(const ServerOptions& options,
   builder.SetResourceQuota(quota);
   // An actor keeps three calls open on one connection.
   builder.AddChannelArgument(GRPC_ARG_MAX_CONCURRENT_STREAMS, 16);
+  // Actors ping every kKeepaliveIntervalMs to notice a dead link
+  // (common/net/keepalive.h); by default gRPC would close their
+  // connections for it.
+  builder.AddChannelArgument(
+      GRPC_ARG_HTTP2_MIN_RECV_PING_INTERVAL_WITHOUT_DATA_MS,
+      kMinPingIntervalMs);
+  builder.AddChannelArgument(GRPC_ARG_KEEPALIVE_PERMIT_WITHOUT_CALLS, 1);
   builder.RegisterService(&service);
   running.server = builder.BuildAndStart();
   if (running.server == nullptr || running.port == 0) {
