@@ -242,7 +242,7 @@ int RunMallocBench() {
   MallocBenchConfig bench;
   bench.env = run->config.training().env();
   bench.batch_observation_bytes = BatchObservationBytes(learner);
-  if (bench.batch_observation_bytes < (int64_t{32} << 20)) {
+  if (bench.batch_observation_bytes < kLargestMmapThreshold) {
     return Usage(
         absl::StrCat("malloc: a batch's observations take ",
                      bench.batch_observation_bytes,

@@ -5,11 +5,6 @@
 #include "common/util/malloc_settings.h"
 
 namespace vantage {
-namespace {
-
-constexpr int64_t kLargestMmapThreshold = int64_t{32} << 20;
-
-}  // namespace
 
 int64_t BatchObservationBytes(const LearnerConfig& config) {
   return config.horizon * config.rollouts_per_batch *
