@@ -146,7 +146,9 @@ ExplorationStats Ex2Bonus::ShapeRewards(std::vector<Rollout>& rollouts) {
   if (pool_.total_added() + m >= config_.replay_min) {
     bonus = NoveltyBonus(*model_, inputs);
   }
-  stats.mean_bonus = bonus.to(at::kDouble).mean().item<double>();
+  const at::Tensor bonus_double = bonus.to(at::kDouble);
+  stats.mean_bonus = bonus_double.mean().item<double>();
+  stats.bonus_std = bonus_double.std(/*unbiased=*/false).item<double>();
   if (!std::isfinite(stats.mean_bonus)) {
     // The rewards stay as they are and the learner undoes the update.
     stats.fault = absl::StrCat(

@@ -17,6 +17,10 @@ struct ExplorationStats {
   // Mean bonus over the batch before centring and weighting (0 until the
   // model is in use).
   double mean_bonus = std::numeric_limits<double>::quiet_NaN();
+  // Its standard deviation over the batch: how much the bonus tells the
+  // batch's states apart, which the model's accuracy does not say (a
+  // discriminator right on 99% of pairs can still rank states).
+  double bonus_std = std::numeric_limits<double>::quiet_NaN();
   int64_t fit_steps = 0;
   // Why this update must be undone (a non-finite bonus: the model
   // diverged); empty if nothing is wrong.

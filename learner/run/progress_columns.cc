@@ -122,6 +122,11 @@ std::vector<ProgressColumn> ExplorationColumns() {
        "Mean exploration bonus of the last batch before centring and "
        "weighting (EX2: -log p(s)).",
        [](const ProgressRow& r) { return r.stats.exploration.mean_bonus; }},
+      {"exploration_bonus_std", "exploration_bonus_std", Metric::kGauge,
+       Format::kNumber,
+       "Standard deviation of the exploration bonus over the last batch "
+       "(before weighting): how much it tells the batch's states apart.",
+       [](const ProgressRow& r) { return r.stats.exploration.bonus_std; }},
   };
 }
 

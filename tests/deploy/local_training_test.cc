@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "absl/strings/match.h"
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_join.h"
@@ -125,7 +126,8 @@ TEST(LocalTrainingTest, SameSeedSameProgressCsv) {
             "explained_variance,biased_fraction,mean_abs_bias,"
             "rejected_segments,rolled_back_updates,batch_actors,"
             "batch_env_slots,exploration_loss,"
-            "exploration_accuracy,exploration_bonus,eval_version,eval_return,"
+            "exploration_accuracy,exploration_bonus,exploration_bonus_std,"
+            "eval_version,eval_return,"
             "eval_return_std,eval_return_min,eval_return_max,eval_length");
   EXPECT_EQ(first, DeterministicProgress(b));
   EXPECT_NE(first, DeterministicProgress(c));
@@ -277,14 +279,16 @@ TEST(LocalTrainingTest, EvaluationsFillTheirRowsAndKeepTheBestCheckpoint) {
 std::vector<std::string> WithoutExploration(
     const std::vector<std::string>& rows) {
   const std::vector<std::string> names = absl::StrSplit(ProgressHeader(), ',');
-  const auto first = static_cast<size_t>(
-      std::find(names.begin(), names.end(), "exploration_loss") -
-      names.begin());
   std::vector<std::string> kept;
   for (const std::string& row : rows) {
-    std::vector<std::string> fields = absl::StrSplit(row, ',');
-    fields.erase(fields.begin() + first, fields.begin() + first + 3);
-    kept.push_back(absl::StrJoin(fields, ","));
+    const std::vector<std::string> fields = absl::StrSplit(row, ',');
+    std::vector<std::string> others;
+    for (size_t i = 0; i < fields.size(); ++i) {
+      if (!absl::StartsWith(names.at(i), "exploration_")) {
+        others.push_back(fields[i]);
+      }
+    }
+    kept.push_back(absl::StrJoin(others, ","));
   }
   return kept;
 }
@@ -312,8 +316,10 @@ TEST(LocalTrainingTest, Ex2ChangesTrainingOnlyThroughTheRewards) {
     return ProgressField(silent_rows, row, name);
   };
   EXPECT_EQ(field(1, "exploration_bonus"), "0");
+  EXPECT_EQ(field(1, "exploration_bonus_std"), "0");
   EXPECT_EQ(field(1, "exploration_loss"), "");
   EXPECT_NE(field(2, "exploration_bonus"), "0");
+  EXPECT_GT(std::stod(field(2, "exploration_bonus_std")), 0.0);
   EXPECT_NE(field(3, "exploration_loss"), "");
   EXPECT_GT(std::stod(field(3, "exploration_accuracy")), 0.0);
 }

@@ -302,6 +302,7 @@ TEST(Ex2BonusTest, FitsAndShapesOnEx2sSchedule) {
     if (batch == 0) {
       EXPECT_TRUE(added.equal(at::zeros({600}))) << "no bonus before the pool";
       EXPECT_TRUE(std::isnan(stats.model_loss));
+      EXPECT_EQ(stats.bonus_std, 0.0);
     } else {
       // Centred on the median: as many steps above it as below.
       EXPECT_EQ((added > 0).sum().item<int64_t>(),
@@ -313,6 +314,9 @@ TEST(Ex2BonusTest, FitsAndShapesOnEx2sSchedule) {
       const double median =
           0.5 * (sorted[299].item<double>() + sorted[300].item<double>());
       EXPECT_TRUE(at::allclose(added, 0.25 * (raw - median), 1e-5, 1e-6));
+      EXPECT_NEAR(stats.mean_bonus, raw.mean().item<double>(), 1e-6);
+      EXPECT_NEAR(stats.bonus_std, raw.std(/*unbiased=*/false).item<double>(),
+                  1e-6);
     }
     ex2.Commit();
     EXPECT_EQ(ex2.pool().total_added(), 600 * (batch + 1));
