@@ -32,6 +32,14 @@ absl::Status LearnerConfig::Validate() const {
         spec.byte_observations() ? "images (bytes)" : "a Dict or Tuple",
         ": use the value network"));
   }
+  if (exploration.ex2.has_value() && exploration.ex2->convolutional() &&
+      spec.observation_shape.empty()) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "--ex2_encoder=conv convolves an image observation; ", spec.name,
+        "'s observations are ",
+        spec.observation_keys.empty() ? "a vector" : "a Dict or Tuple",
+        ": use --ex2_encoder=mlp"));
+  }
   return ValidateSettings();
 }
 

@@ -38,7 +38,9 @@ Ex2Bonus::Ex2Bonus(const Ex2Config& config, const EnvSpec& spec, uint64_t seed,
     : config_(config),
       spec_(spec),
       replicas_(std::move(replicas)),
-      model_(InputWidth(config, spec), config),
+      model_(InputWidth(config, spec), config,
+             config.convolutional() ? spec.observation_shape
+                                    : std::vector<int64_t>{}),
       optimizer_(std::make_unique<torch::optim::Adam>(
           model_->parameters(),
           torch::optim::AdamOptions(config.learning_rate))),
@@ -64,7 +66,8 @@ Ex2Bonus::Ex2Bonus(const Ex2Config& config, const EnvSpec& spec, uint64_t seed,
     parameters[i].set_data(view);
   }
   flat_gradients_.assign(size, 0.0f);
-  if (fit == Ex2Fit::kFlat) {
+  // FlatExemplarModel writes out MLP encoders' gradients only.
+  if (fit == Ex2Fit::kFlat && !config.convolutional()) {
     absl::StatusOr<FlatExemplarModel> flat =
         FlatExemplarModel::Create(*model_, config_, parameters);
     // The model is always the layers FlatExemplarModel lays out.

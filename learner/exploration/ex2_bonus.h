@@ -45,7 +45,8 @@ namespace vantage {
 // gradients and FlatAdam's steps, in a few loops over flat arrays;
 // kAutograd: autograd's gradients and FlatAdam's steps; kTorch: autograd
 // and torch::optim::Adam (the same arithmetic, a dozen operators per
-// parameter tensor). The last two for tests and benchmarks.
+// parameter tensor). The last two for tests and benchmarks. A
+// convolutional model fits as kAutograd when kFlat is asked.
 enum class Ex2Fit { kFlat, kAutograd, kTorch };
 
 class Ex2Bonus {

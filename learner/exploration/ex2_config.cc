@@ -1,5 +1,7 @@
 #include "learner/exploration/ex2_config.h"
 
+#include <algorithm>
+
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_join.h"
 #include "proto/run_config.pb.h"
@@ -23,7 +25,8 @@ const SettingsTable<Ex2Config, pb::Ex2Settings>& Ex2Table() {
               {"replay_min", &C::replay_min},
               {"replay_size", &C::replay_size},
               {"batch_size", &C::batch_size},
-              {"use_actions", &C::use_actions}});
+              {"use_actions", &C::use_actions},
+              {"encoder", &C::encoder}});
   return *table;
 }
 
@@ -73,8 +76,16 @@ absl::Status Ex2Config::Validate() const {
     return absl::InvalidArgumentError(
         absl::StrCat("ex2.replay_min must be >= 1, got ", replay_min));
   }
+  const std::vector<std::string> encoders = Ex2EncoderNames();
+  if (std::find(encoders.begin(), encoders.end(), encoder) == encoders.end()) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("ex2.encoder must be one of ",
+                     absl::StrJoin(encoders, ", "), ", got '", encoder, "'"));
+  }
   return absl::OkStatus();
 }
+
+std::vector<std::string> Ex2EncoderNames() { return {"mlp", "conv"}; }
 
 std::vector<std::string> ExplorationNames() { return {"none", "ex2"}; }
 

@@ -28,10 +28,16 @@ struct Ex2Config {
   int64_t replay_size = 250000;
   int batch_size = 128;
   bool use_actions = true;
+  // The encoders' trunk (Ex2EncoderNames()): "mlp", or "conv" for image
+  // observations (EX2's SiameseConv, its Atari and Doom scripts' model).
+  std::string encoder = "mlp";
+  bool convolutional() const { return encoder == "conv"; }
 
   // Names the rule a field breaks as its run-config field (ex2.kl_weight).
   absl::Status Validate() const;
 };
+
+std::vector<std::string> Ex2EncoderNames();  // "mlp", "conv"
 
 // The exploration bonus of a run, if it has one.
 struct ExplorationConfig {

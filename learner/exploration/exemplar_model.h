@@ -13,6 +13,7 @@
 #include <torch/nn/modules/container/modulelist.h>
 
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "learner/exploration/ex2_config.h"
@@ -36,17 +37,42 @@ class GlorotMlpImpl : public torch::nn::Module {
 };
 TORCH_MODULE(GlorotMlp);
 
+// EX2's ConvNet for images [C, H, W] (its Doom and Atari scripts): two
+// convolutions of 16 4x4 filters, stride 2, zero-padded by 3 on every
+// side (Lasagne's pad='full'), tanh after each, flattened. Glorot-uniform
+// weights, zero biases.
+class Ex2ConvTrunkImpl : public torch::nn::Module {
+ public:
+  explicit Ex2ConvTrunkImpl(const std::vector<int64_t>& image_shape);
+  // [B, C * H * W] -> [B, features()].
+  at::Tensor forward(const at::Tensor& images);
+  int64_t features() const { return features_; }
+
+ private:
+  std::vector<int64_t> image_shape_;
+  torch::nn::ModuleList layers_;
+  int64_t features_ = 0;
+};
+TORCH_MODULE(Ex2ConvTrunk);
+
+// The trunk is a tanh MLP, or with a convolutional model the ConvNet over
+// the image (the first image_size inputs), the rest of the inputs (the
+// action, if modelled) joined to its features as EX2's SiameseConv does.
 class ExemplarEncoderImpl : public torch::nn::Module {
  public:
-  ExemplarEncoderImpl(int64_t inputs, const Ex2Config& config);
+  ExemplarEncoderImpl(int64_t inputs, const Ex2Config& config,
+                      const std::vector<int64_t>& image_shape);
   // The latent's mean and log-variance, [B, feature_dim] each.
   std::pair<at::Tensor, at::Tensor> forward(const at::Tensor& x);
+  // Null in a convolutional model.
   const GlorotMlp& trunk() const { return trunk_; }
   const GlorotMlp& mean() const { return mean_; }
   const GlorotMlp& log_variance() const { return log_variance_; }
 
  private:
   GlorotMlp trunk_{nullptr};
+  Ex2ConvTrunk conv_{nullptr};
+  int64_t image_size_ = 0;
   GlorotMlp mean_{nullptr};
   GlorotMlp log_variance_{nullptr};
 };
@@ -59,15 +85,24 @@ struct ExemplarOutput {
 
 class ExemplarModelImpl : public torch::nn::Module {
  public:
-  ExemplarModelImpl(int64_t inputs, const Ex2Config& config);
+  // `image_shape` [C, H, W]: the image at the front of every input row,
+  // for config.convolutional(); empty otherwise.
+  ExemplarModelImpl(int64_t inputs, const Ex2Config& config,
+                    const std::vector<int64_t>& image_shape = {});
 
   // With `noise`, latents are sampled from it (training); without, they
   // are the means (the bonus).
   ExemplarOutput forward(const at::Tensor& exemplars,
                          const at::Tensor& candidates,
                          const at::Generator* noise);
+  // The training pairs: (x, x) for each positive x, then (x, x') for the
+  // i-th positive and the i-th negative; latents drawn from `noise` as
+  // forward draws them for (cat(x, x), cat(x, x')).
+  ExemplarOutput Pairs(const at::Tensor& positives, const at::Tensor& negatives,
+                       const at::Generator& noise);
 
   int64_t inputs() const { return inputs_; }
+  bool convolutional() const { return convolutional_; }
   const ExemplarEncoder& exemplar_encoder() const { return exemplar_encoder_; }
   const ExemplarEncoder& candidate_encoder() const {
     return candidate_encoder_;
@@ -75,7 +110,15 @@ class ExemplarModelImpl : public torch::nn::Module {
   const GlorotMlp& discriminator() const { return discriminator_; }
 
  private:
+  // The discriminator on latents drawn from both encoders' (mean,
+  // log-variance).
+  ExemplarOutput Discriminate(
+      const std::pair<at::Tensor, at::Tensor>& exemplars,
+      const std::pair<at::Tensor, at::Tensor>& candidates,
+      const at::Generator* noise);
+
   int64_t inputs_;
+  bool convolutional_;
   ExemplarEncoder exemplar_encoder_{nullptr};
   ExemplarEncoder candidate_encoder_{nullptr};
   GlorotMlp discriminator_{nullptr};

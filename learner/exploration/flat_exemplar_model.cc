@@ -15,6 +15,11 @@ namespace vantage {
 absl::StatusOr<FlatExemplarModel> FlatExemplarModel::Create(
     const ExemplarModelImpl& model, const Ex2Config& config,
     std::vector<at::Tensor> parameters) {
+  if (model.convolutional()) {
+    return absl::UnimplementedError(
+        "the flat fit lays out MLP encoders only; a convolutional model fits "
+        "through autograd");
+  }
   absl::StatusOr<FlatParameterClaims> claims =
       FlatParameterClaims::Create(std::move(parameters));
   if (!claims.ok()) return claims.status();

@@ -449,6 +449,39 @@ TEST(ZeroBaselineTest, EveryStateIsValuedZero) {
             "critics; set one of them");
 }
 
+// EX2's convolutional model on frames: it fits and shapes the rewards of
+// MinAtar's images, and a checkpoint continues it exactly; on vector
+// observations it is refused up front.
+TEST(Ex2ConvTest, FitsOnFramesAndResumesExactly) {
+  auto actor = MakeTestActor(kTestHorizon, "MinAtarBreakout");
+  LearnerConfig config = TestLearnerConfig(actor->spec(), "trpo");
+  Ex2Config ex2;
+  ex2.encoder = "conv";
+  ex2.replay_min = 1;
+  ex2.first_train_iterations = 20;
+  ex2.train_iterations = 10;
+  config.exploration.ex2 = ex2;
+  auto learner = *LearnerCore::Create(config);
+  const at::Tensor initial =
+      learner->exploration()->parameters()[0].detach().clone();
+  EXPECT_EQ(initial.dim(), 4);  // the first convolution's filters
+  for (int update = 0; update < 2; ++update) {
+    const UpdateStats stats =
+        UpdateWith(*learner, ActOneBatch(*actor, *learner));
+    EXPECT_FALSE(stats.rolled_back) << stats.rollback_reason;
+    EXPECT_GT(stats.exploration.bonus_std, 0.0);
+    EXPECT_EQ(stats.exploration.fit_steps, update == 0 ? 0 : 20);
+  }
+  EXPECT_FALSE(learner->exploration()->parameters()[0].equal(initial));
+  ExpectACheckpointContinuesExactly(*actor, *learner, config, "ex2_conv");
+
+  auto vectors = MakeTestActor();
+  LearnerConfig refused = TestLearnerConfig(vectors->spec(), "trpo");
+  refused.exploration.ex2 = ex2;
+  EXPECT_THAT(LearnerCore::Create(refused).status().message(),
+              HasSubstr("--ex2_encoder=conv convolves an image observation; "));
+}
+
 TEST(SharedTorsoTest, OneTrunkTrainsAndResumesAsOne) {
   for (const std::string algorithm : {"a2c", "ppo"}) {
     SCOPED_TRACE(algorithm);

@@ -52,6 +52,8 @@ TEST(RunRequestTest, BadSettingsNameTheirFlag) {
        "--segment_length must divide --horizon"},
       {R"({"exploration": {"ex2": {"kl_weight": -1}}})",
        "ex2.kl_weight must be in [0, 1e6), got -1 (--ex2_kl_weight)"},
+      {R"({"exploration": {"ex2": {"encoder": "cnn"}}})",
+       "ex2.encoder must be one of mlp, conv, got 'cnn'"},
       {R"({"mode": "local", "distributed": {"actors": 2}})",
        "--mode=local runs one strictly on-policy process: drop the "
        "distributed settings"},
