@@ -320,7 +320,7 @@ TEST(Ex2ConvModelTest, LayersAreEx2sSiameseConv) {
 // (columns 6-7, in one batch) and those just beyond them (8-9, never a
 // square's column) above the oldest (0-1, in every batch). Frames whose
 // pixels no batch ever lit (columns 12-14) are not ranked reliably (from
-// -2.0 to +2.0 over four seeds, the MLP's -0.4): the model is fitted where
+// -1.9 to +2.0 over four seeds; the MLP: -0.4): the model is fitted where
 // the data is, and its extrapolation is not EX2's to promise.
 TEST(Ex2ConvModelTest, OnAWideningStreamOfFramesRarerFramesEarnMore) {
   at::manual_seed(0);
