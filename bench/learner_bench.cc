@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <memory>
 #include <random>
 #include <thread>
 
@@ -21,6 +22,7 @@
 #include "common/nn/compute_threads.h"
 #include "common/util/self_process.h"
 #include "learner/algorithms/a2c/a2c_updater.h"
+#include "learner/algorithms/flat_adam.h"
 #include "learner/algorithms/ppo/ppo_updater.h"
 #include "learner/exploration/ex2_bonus.h"
 #include "learner/parallel/gloo_replica_group.h"
@@ -256,6 +258,65 @@ int RunLearnerScalingBenchmark(const std::vector<int64_t>& minibatches,
   return 0;
 }
 
+// Adam over as many floats as EX2's model on the first-person maze's frames
+// holds (two MLP encoders of 3 x 42 x 42 pixels into 32 units, their
+// latent heads and the discriminator: about 340,000), where the optimiser's
+// pass over memory is a visible share of the fit: FlatAdam's one pass
+// against torch::optim::Adam's step on the same tensors.
+class FrameSizedAdam {
+ public:
+  FrameSizedAdam() {
+    at::manual_seed(3);
+    for (std::array<int64_t, 2> shape :
+         {std::array<int64_t, 2>{32, 5292}, {32, 5292}, {32, 32}, {32, 32}}) {
+      for (int64_t rows : {shape[0] * shape[1], shape[0]}) {
+        parameters_.push_back(at::randn({rows}) * 0.01);
+        parameters_.back().mutable_grad() = at::randn({rows}) * 1e-3;
+        offsets_.push_back(size_);
+        size_ += rows;
+      }
+    }
+    flat_parameters_ = at::cat(parameters_).contiguous();
+    flat_gradients_ = at::cat(GradientsOf(parameters_)).contiguous();
+    torch_ = std::make_unique<torch::optim::Adam>(
+        parameters_, torch::optim::AdamOptions(1e-4));
+    flat_ = std::make_unique<FlatAdam>(parameters_, offsets_, size_);
+  }
+
+  void Register() {
+    benchmark::RegisterBenchmark("adam_flat_step", [this](benchmark::State&
+                                                              state) {
+      for (auto _ : state) {
+        flat_->Step(*torch_, flat_parameters_.data_ptr<float>(),
+                    flat_gradients_.data_ptr<float>());
+      }
+    })->Apply([](auto* b) { UseFastestOfSingleRuns(b, kRepetitions); });
+    benchmark::RegisterBenchmark("adam_torch_step",
+                                 [this](benchmark::State& state) {
+                                   for (auto _ : state) torch_->step();
+                                 })
+        ->Apply([](auto* b) { UseFastestOfSingleRuns(b, kRepetitions); });
+  }
+
+  int64_t size() const { return size_; }
+
+ private:
+  static std::vector<at::Tensor> GradientsOf(
+      const std::vector<at::Tensor>& ps) {
+    std::vector<at::Tensor> gradients;
+    for (const at::Tensor& p : ps) gradients.push_back(p.grad());
+    return gradients;
+  }
+
+  std::vector<at::Tensor> parameters_;
+  std::vector<int64_t> offsets_;
+  int64_t size_ = 0;
+  at::Tensor flat_parameters_;
+  at::Tensor flat_gradients_;
+  std::unique_ptr<torch::optim::Adam> torch_;
+  std::unique_ptr<FlatAdam> flat_;
+};
+
 int RunLearnerBenchmark() {
   SetComputeThreads(1);
   at::manual_seed(0);
@@ -350,6 +411,9 @@ int RunLearnerBenchmark() {
     })->Apply([](auto* b) { UseFastestOfSingleRuns(b, kRepetitions); });
   }
 
+  FrameSizedAdam frame_adam;
+  frame_adam.Register();
+
   BarePpo bare(BenchShape());
   benchmark::RegisterBenchmark("bare_update", [&](benchmark::State& state) {
     for (auto _ : state) bare.Update(batch);
@@ -378,6 +442,8 @@ int RunLearnerBenchmark() {
       kEx2Iterations / collector.Seconds("ex2_autograd_fit");
   const double ex2_torch_rate =
       kEx2Iterations / collector.Seconds("ex2_torch_fit");
+  const double adam_flat_rate = 1.0 / collector.Seconds("adam_flat_step");
+  const double adam_torch_rate = 1.0 / collector.Seconds("adam_torch_step");
   absl::StatusOr<DataParallelFigures> measured = MeasureTwoReplicas(batch);
   if (!measured.ok()) {
     std::fprintf(stderr, "bench learner: %s\n",
@@ -407,13 +473,16 @@ int RunLearnerBenchmark() {
       "a2c_autograd_samples_per_s=%.0f a2c_speedup=%.2f "
       "ex2_flat_steps_per_s=%.0f ex2_autograd_steps_per_s=%.0f "
       "ex2_torch_steps_per_s=%.0f ex2_speedup=%.2f "
-      "ex2_fused_adam_speedup=%.2f blas=%s\n",
+      "ex2_fused_adam_speedup=%.2f adam_floats=%ld adam_flat_steps_per_s=%.0f "
+      "adam_torch_steps_per_s=%.0f adam_speedup=%.2f blas=%s\n",
       ppo_rate, bare_rate, ppo_rate / bare_rate, guarded_rate,
       guarded_rate / ppo_rate, dp_rate, dp_rate / ppo_rate,
       two.allreduce_seconds * 1e6, allreduce_share, a2c_flat_rate,
       a2c_autograd_rate, a2c_flat_rate / a2c_autograd_rate, ex2_flat_rate,
       ex2_autograd_rate, ex2_torch_rate, ex2_flat_rate / ex2_autograd_rate,
-      ex2_autograd_rate / ex2_torch_rate, blas.kind.c_str());
+      ex2_autograd_rate / ex2_torch_rate, static_cast<long>(frame_adam.size()),
+      adam_flat_rate, adam_torch_rate, adam_flat_rate / adam_torch_rate,
+      blas.kind.c_str());
   return 0;
 }
 

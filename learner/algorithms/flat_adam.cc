@@ -10,6 +10,7 @@
 #include <tuple>
 #include <utility>
 
+#include "learner/algorithms/flat_optimizer_kernels.h"
 #include "learner/algorithms/flat_optimizer_state.h"
 
 namespace vantage {
@@ -30,25 +31,17 @@ void FlatAdam::Step(const torch::optim::Optimizer& adam, float* parameters,
   const double beta2 = std::get<1>(options.betas());
   const double bias_correction1 = 1.0 - std::pow(beta1, step_);
   const double bias_correction2 = 1.0 - std::pow(beta2, step_);
-  // The scalars in float, as LibTorch's float kernels take them.
-  const float b1 = static_cast<float>(beta1);
-  const float b2 = static_cast<float>(beta2);
-  const float one_minus_b1 = static_cast<float>(1.0 - beta1);
-  const float one_minus_b2 = static_cast<float>(1.0 - beta2);
-  const float correction2_sqrt =
+  AdamCoefficients coefficients;
+  coefficients.beta1 = static_cast<float>(beta1);
+  coefficients.beta2 = static_cast<float>(beta2);
+  coefficients.one_minus_beta1 = static_cast<float>(1.0 - beta1);
+  coefficients.one_minus_beta2 = static_cast<float>(1.0 - beta2);
+  coefficients.correction2_sqrt =
       static_cast<float>(std::sqrt(bias_correction2));
-  const float eps = static_cast<float>(options.eps());
-  const float step_size = static_cast<float>(options.lr() / bias_correction1);
-  const int64_t size = static_cast<int64_t>(exp_avg_.size());
-  float* m = exp_avg_.data();
-  float* v = exp_avg_sq_.data();
-  for (int64_t i = 0; i < size; ++i) {
-    const float g = gradients[i];
-    m[i] = m[i] * b1 + one_minus_b1 * g;
-    v[i] = v[i] * b2 + one_minus_b2 * g * g;
-    const float denominator = std::sqrt(v[i]) / correction2_sqrt + eps;
-    parameters[i] -= step_size * (m[i] / denominator);
-  }
+  coefficients.eps = static_cast<float>(options.eps());
+  coefficients.step_size = static_cast<float>(options.lr() / bias_correction1);
+  AdamKernel(coefficients, static_cast<int64_t>(exp_avg_.size()), parameters,
+             gradients, exp_avg_.data(), exp_avg_sq_.data());
 }
 
 void FlatAdam::StoreInto(torch::optim::Optimizer& adam) const {

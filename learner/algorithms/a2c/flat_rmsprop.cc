@@ -4,11 +4,11 @@
 #include <torch/optim/rmsprop.h>
 
 #include <algorithm>
-#include <cmath>
 #include <memory>
 #include <string>
 #include <utility>
 
+#include "learner/algorithms/flat_optimizer_kernels.h"
 #include "learner/algorithms/flat_optimizer_state.h"
 
 namespace vantage {
@@ -40,21 +40,10 @@ void FlatRmsprop::Step(const torch::optim::Optimizer& rmsprop,
   const float one_minus_alpha = static_cast<float>(1.0 - options.alpha());
   const float eps = static_cast<float>(options.eps());
   const float minus_lr = static_cast<float>(-options.lr());
-  const int64_t size = static_cast<int64_t>(square_avg_.size());
-  float* v = square_avg_.data();
-  if (arithmetic_ == RmspropArithmetic::kTensorflow) {
-    for (int64_t i = 0; i < size; ++i) {
-      const float g = gradients[i];
-      v[i] = v[i] * alpha + one_minus_alpha * g * g;
-      parameters[i] += minus_lr * g / std::sqrt(v[i] + eps);
-    }
-    return;
-  }
-  for (int64_t i = 0; i < size; ++i) {
-    const float g = gradients[i];
-    v[i] = v[i] * alpha + one_minus_alpha * g * g;
-    parameters[i] += minus_lr * g / (std::sqrt(v[i]) + eps);
-  }
+  RmspropKernel(alpha, one_minus_alpha, eps, minus_lr,
+                arithmetic_ == RmspropArithmetic::kTensorflow,
+                static_cast<int64_t>(square_avg_.size()), parameters, gradients,
+                square_avg_.data());
 }
 
 void FlatRmsprop::StoreInto(torch::optim::Optimizer& rmsprop) const {
