@@ -46,10 +46,12 @@ FirstOrderUpdater::FlatRows FirstOrderUpdater::StartFlatUpdate(
     const UpdateBatch& batch) {
   flat_->Pull();
   const int64_t size = batch.observations.size(0);
-  FlatRows rows{
-      flat_->Inputs(batch.observations), FloatRows(batch.actions, size),
-      FloatRows(batch.behaviour_log_probs, size),
-      FloatRows(batch.advantages, size), FloatRows(batch.returns, size)};
+  FlatRows rows;
+  rows.inputs = flat_->Inputs(batch.observations);
+  rows.actions = FloatRows(batch.actions, size);
+  rows.behaviour = FloatRows(batch.behaviour_log_probs, size);
+  rows.advantages = FloatRows(batch.advantages, size);
+  rows.returns = FloatRows(batch.returns, size);
   if (batch.action_masks.defined()) {
     rows.masks = batch.action_masks.to(at::kByte).contiguous();
   }

@@ -25,7 +25,7 @@ int64_t InputWidth(const Ex2Config& config, const EnvSpec& spec) {
 
 // numpy's median: the mean of the two middle values of an even count.
 double Median(const at::Tensor& values) {
-  const at::Tensor sorted = std::get<0>(values.to(at::kDouble).sort());
+  const at::Tensor sorted = std::get<0>(values.sort());
   const int64_t n = sorted.size(0);
   const double upper = sorted[n / 2].item<double>();
   return n % 2 == 1 ? upper : 0.5 * (upper + sorted[n / 2 - 1].item<double>());
@@ -161,7 +161,7 @@ ExplorationStats Ex2Bonus::ShapeRewards(std::vector<Rollout>& rollouts) {
     return stats;
   }
   const at::Tensor shaped =
-      (config_.bonus_coeff * (bonus.to(at::kDouble) - Median(bonus)))
+      (config_.bonus_coeff * (bonus_double - Median(bonus_double)))
           .to(at::kFloat);
   int64_t offset = 0;
   for (Rollout& rollout : rollouts) {
