@@ -23,6 +23,13 @@ int64_t InputWidth(const Ex2Config& config, const EnvSpec& spec) {
   return spec.observation_size + (config.use_actions ? spec.action_size : 0);
 }
 
+// Byte observations alone are pooled as the bytes they arrive in (scaled
+// as the networks scale them when sampled); with actions, rows of floats.
+int64_t PoolByteHigh(const Ex2Config& config, const EnvSpec& spec) {
+  return spec.byte_observations() && !config.use_actions ? spec.observation_high
+                                                         : 0;
+}
+
 // numpy's median: the mean of the two middle values of an even count.
 double Median(const at::Tensor& values) {
   const at::Tensor sorted = std::get<0>(values.sort());
@@ -45,7 +52,8 @@ Ex2Bonus::Ex2Bonus(const Ex2Config& config, const EnvSpec& spec, uint64_t seed,
           model_->parameters(),
           torch::optim::AdamOptions(config.learning_rate))),
       generator_(at::make_generator<at::CPUGeneratorImpl>(seed)),
-      pool_(config.replay_size, InputWidth(config, spec)) {
+      pool_(config.replay_size, InputWidth(config, spec),
+            PoolByteHigh(config, spec)) {
   if (fit == Ex2Fit::kTorch) return;
   std::vector<at::Tensor> parameters = model_->parameters();
   std::vector<int64_t> offsets;
@@ -120,6 +128,14 @@ at::Tensor Ex2Bonus::Inputs(const std::vector<Rollout>& rollouts) const {
   return at::cat(rows).to(at::kFloat).contiguous();
 }
 
+at::Tensor Ex2Bonus::ByteRows(const std::vector<Rollout>& rollouts) const {
+  std::vector<at::Tensor> rows;
+  for (const Rollout& rollout : rollouts) {
+    rows.push_back(rollout.observations.slice(0, 0, rollout.rewards.size(0)));
+  }
+  return at::cat(rows).reshape({-1, spec_.observation_size}).contiguous();
+}
+
 ExplorationStats Ex2Bonus::ShapeRewards(std::vector<Rollout>& rollouts) {
   ExplorationStats stats;
   const at::Tensor inputs = Inputs(rollouts);
@@ -132,7 +148,8 @@ ExplorationStats Ex2Bonus::ShapeRewards(std::vector<Rollout>& rollouts) {
       const at::Tensor positives = inputs.index_select(
           0, at::randint(m, {config_.batch_size}, generator_,
                          at::TensorOptions(at::kLong)));
-      const at::Tensor negatives = pool_.Sample(config_.batch_size, generator_);
+      const at::Tensor negatives =
+          NetworkInputs(spec_, pool_.Sample(config_.batch_size, generator_));
       const auto [loss, accuracy] = FitStep(positives, negatives);
       loss_sum += loss;
       accuracy_sum += accuracy;
@@ -142,7 +159,7 @@ ExplorationStats Ex2Bonus::ShapeRewards(std::vector<Rollout>& rollouts) {
     stats.model_loss = loss_sum / iterations;
     stats.model_accuracy = accuracy_sum / iterations;
   }
-  pending_ = inputs;
+  pending_ = pool_.dtype() == at::kByte ? ByteRows(rollouts) : inputs;
   // The reference checks the pool's size after adding the batch: one batch
   // earlier than the fit does.
   at::Tensor bonus = at::zeros({m}, at::kFloat);

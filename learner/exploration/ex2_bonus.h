@@ -91,6 +91,9 @@ class Ex2Bonus {
   at::Tensor Inputs(const std::vector<Rollout>& rollouts) const;
 
  private:
+  // The rollouts' byte observations as the pool keeps them, [steps, obs]
+  // uint8, in Inputs' row order.
+  at::Tensor ByteRows(const std::vector<Rollout>& rollouts) const;
   // One fit step on a batch of positives (its loss and accuracy), its
   // gradients averaged over the replicas.
   std::pair<double, double> FitStep(const at::Tensor& positives,
@@ -115,7 +118,9 @@ class Ex2Bonus {
   at::Generator generator_;
   ReplayPool pool_;
   bool fitted_ = false;
-  at::Tensor pending_;  // inputs of the batch shaped last, until Commit
+  // Pool rows of the batch shaped last (its inputs, or its bytes for a
+  // byte pool), until Commit.
+  at::Tensor pending_;
 };
 
 }  // namespace vantage

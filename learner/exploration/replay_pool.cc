@@ -10,18 +10,19 @@
 
 namespace vantage {
 
-ReplayPool::ReplayPool(int64_t capacity, int64_t width)
+ReplayPool::ReplayPool(int64_t capacity, int64_t width, int64_t byte_high)
     : capacity_(capacity),
       width_(width),
-      rows_(at::zeros({0, width}, at::kFloat)) {}
+      byte_high_(byte_high),
+      rows_(at::zeros({0, width}, byte_high > 0 ? at::kByte : at::kFloat)) {}
 
 void ReplayPool::Reserve(int64_t rows) {
   if (rows <= rows_.size(0)) return;
   // Grown as it fills (doubling), so that a large capacity costs memory
   // only once the states are there.
   const int64_t grown = std::min(capacity_, std::max(rows, 2 * rows_.size(0)));
-  rows_ =
-      at::cat({rows_, at::zeros({grown - rows_.size(0), width_}, at::kFloat)});
+  rows_ = at::cat(
+      {rows_, at::zeros({grown - rows_.size(0), width_}, rows_.options())});
 }
 
 void ReplayPool::Add(const at::Tensor& rows) {
@@ -83,20 +84,48 @@ absl::Status ReplayPool::Load(torch::serialize::InputArchive& archive,
     return absl::InvalidArgumentError(
         "replay pool entry 'counts' is inconsistent");
   }
-  if (rows.scalar_type() != at::kFloat || rows.dim() != 2 ||
-      rows.size(0) != size || rows.size(1) != width) {
-    return absl::InvalidArgumentError(absl::StrCat(
-        "replay pool entry 'rows' is not [", size, ", ", width, "] float32"));
+  if (rows.dim() != 2 || rows.size(0) != size || rows.size(1) != width ||
+      (rows.scalar_type() != at::kFloat && rows.scalar_type() != dtype())) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("replay pool entry 'rows' is not [", size, ", ", width,
+                     "] ", dtype() == at::kByte ? "uint8" : "float32"));
+  }
+  absl::StatusOr<at::Tensor> stored = StoredRows(rows);
+  if (!stored.ok()) return stored.status();
+  rows_ = stored->clone();
+  next_ = next;
+  size_ = size;
+  total_added_ = total;
+  return absl::OkStatus();
+}
+
+absl::StatusOr<at::Tensor> ReplayPool::StoredRows(
+    const at::Tensor& rows) const {
+  if (rows.scalar_type() == at::kByte) {
+    if (rows.gt(byte_high_).any().item<bool>()) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          "replay pool entry 'rows' holds values above ", byte_high_));
+    }
+    return rows;
   }
   if (!at::isfinite(rows).all().item<bool>()) {
     return absl::InvalidArgumentError(
         "replay pool entry 'rows' holds non-finite values");
   }
-  rows_ = rows.clone();
-  next_ = next;
-  size_ = size;
-  total_added_ = total;
-  return absl::OkStatus();
+  if (dtype() == at::kFloat) return rows;
+  const at::Tensor bytes =
+      rows.mul(static_cast<double>(byte_high_)).round().clamp(0, byte_high_);
+  const at::Tensor stored = bytes.to(at::kByte);
+  // The networks' scaling (NetworkInputs), which must give the rows back.
+  const at::Tensor scaled =
+      stored.to(at::kFloat).mul_(1.0 / static_cast<double>(byte_high_));
+  if (!at::equal(scaled, rows)) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "replay pool entry 'rows' is float32 but not observations of 0..",
+        byte_high_, " scaled by 1/", byte_high_,
+        ", which this run's pool keeps as bytes"));
+  }
+  return stored;
 }
 
 }  // namespace vantage

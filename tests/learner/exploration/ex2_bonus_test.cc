@@ -129,6 +129,59 @@ TEST(ReplayPoolTest, SavedPoolLoadsBackAndBadOnesAreRefused) {
               HasSubstr("non-finite"));
 }
 
+// A pool's rows through a checkpoint archive into `into`.
+absl::Status SaveAndLoad(const ReplayPool& from, ReplayPool& into) {
+  torch::serialize::OutputArchive out;
+  from.Save(out, "pool");
+  std::ostringstream bytes;
+  out.save_to(bytes);
+  torch::serialize::InputArchive in;
+  std::istringstream stream(bytes.str());
+  in.load_from(stream);
+  return into.Load(in, "pool");
+}
+
+TEST(ReplayPoolTest, ByteObservationsArePooledAsBytes) {
+  constexpr int64_t kHigh = 255;
+  const at::Tensor frames =
+      at::randint(kHigh + 1, {6, 5}, at::TensorOptions(at::kByte));
+  ReplayPool pool(4, 5, kHigh);
+  pool.Add(frames);
+  EXPECT_EQ(pool.dtype(), at::kByte);
+  at::Generator a = at::make_generator<at::CPUGeneratorImpl>(3);
+  const at::Tensor sample = pool.Sample(20, a);
+  EXPECT_EQ(sample.scalar_type(), at::kByte);
+  ReplayPool copy(4, 5, kHigh);
+  ASSERT_TRUE(SaveAndLoad(pool, copy).ok());
+  at::Generator b = at::make_generator<at::CPUGeneratorImpl>(3);
+  EXPECT_TRUE(copy.Sample(20, b).equal(sample));
+
+  // A checkpoint from before byte pools held the frames as the networks
+  // scale them: loaded into a byte pool, the same bytes.
+  ReplayPool legacy(4, 5);
+  legacy.Add(frames.to(at::kFloat).mul_(1.0 / kHigh));
+  ReplayPool converted(4, 5, kHigh);
+  ASSERT_TRUE(SaveAndLoad(legacy, converted).ok());
+  at::Generator c = at::make_generator<at::CPUGeneratorImpl>(3);
+  EXPECT_TRUE(converted.Sample(20, c).equal(sample));
+
+  // Floats that are no scaled bytes, and bytes above the run's highest
+  // value, are refused by name; the pool keeps what it had.
+  ReplayPool vectors(4, 5);
+  vectors.Add(at::full({2, 5}, 0.3f));
+  absl::Status status = SaveAndLoad(vectors, converted);
+  EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(std::string(status.message()),
+              HasSubstr("not observations of 0..255 scaled by 1/255"));
+  ReplayPool brighter(4, 5, kHigh);
+  brighter.Add(at::full({2, 5}, 9, at::kByte));
+  ReplayPool dimmer(4, 5, /*byte_high=*/4);
+  status = SaveAndLoad(brighter, dimmer);
+  EXPECT_THAT(std::string(status.message()), HasSubstr("values above 4"));
+  at::Generator d = at::make_generator<at::CPUGeneratorImpl>(3);
+  EXPECT_TRUE(converted.Sample(20, d).equal(sample));
+}
+
 // With every weight 0 the latents are N(0, I) draws and D = 1/2 whatever
 // the noise: the loss is log 2. A mean head biased to c adds, per latent
 // dimension of both encoders, KL = c^2 / 2.
@@ -359,6 +412,9 @@ TEST(Ex2ConvModelTest, OnAWideningStreamOfFramesRarerFramesEarnMore) {
     ex2.ShapeRewards(rollouts);
     ex2.Commit();
   }
+  // Frames are pooled as the bytes they arrived in.
+  EXPECT_EQ(ex2.pool().dtype(), at::kByte);
+  EXPECT_EQ(ex2.pool().size(), kBatches * 2000);
   const auto mean_bonus = [&](int64_t column_low, int64_t column_high) {
     const at::Tensor frames = squares(column_low, column_high, 500);
     return NoveltyBonus(ex2.model(), frames.to(at::kFloat) / 255.0)
