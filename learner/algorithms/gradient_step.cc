@@ -39,14 +39,18 @@ double GradientStep(torch::optim::Optimizer& optimizer,
   return norm;
 }
 
+void AverageFlatGradient(float* gradients, int64_t size,
+                         ReplicaGroup& replicas) {
+  if (replicas.world_size() == 1) return;
+  std::vector<at::Tensor> flat = {at::from_blob(gradients, {size})};
+  replicas.AllReduceSum(flat);
+  flat[0].div_(replicas.world_size());
+}
+
 double AverageAndClipFlatGradient(float* gradients, int64_t size,
                                   double max_grad_norm,
                                   ReplicaGroup& replicas) {
-  if (replicas.world_size() > 1) {
-    std::vector<at::Tensor> flat = {at::from_blob(gradients, {size})};
-    replicas.AllReduceSum(flat);
-    flat[0].div_(replicas.world_size());
-  }
+  AverageFlatGradient(gradients, size, replicas);
   double squares = 0.0;
   for (int64_t i = 0; i < size; ++i) {
     squares += static_cast<double>(gradients[i]) * gradients[i];

@@ -38,6 +38,11 @@ double GradientStep(torch::optim::Optimizer& optimizer,
                     const at::Tensor& loss, double max_grad_norm,
                     ReplicaGroup& replicas);
 
+// The mean of a flat gradient array of `size` floats over `replicas` (one
+// collective; nothing with one replica).
+void AverageFlatGradient(float* gradients, int64_t size,
+                         ReplicaGroup& replicas);
+
 // GradientStep's averaging and clipping for a flat gradient array of
 // `size` floats (FlatActorCritic's): the mean over `replicas` (one
 // collective), then scaled as clip_grad_norm_ scales to `max_grad_norm`.

@@ -206,10 +206,9 @@ std::pair<double, double> Ex2Bonus::FitStep(const at::Tensor& positives,
     accuracy = autograd.accuracy;
     if (!flat_adam_.has_value()) return {loss, accuracy};
   }
-  constexpr double kNoClipping = std::numeric_limits<double>::infinity();
-  AverageAndClipFlatGradient(flat_gradients_.data(),
-                             static_cast<int64_t>(flat_gradients_.size()),
-                             kNoClipping, *replicas_);
+  // EX2 does not clip its gradients, so their norm is never needed.
+  AverageFlatGradient(flat_gradients_.data(),
+                      static_cast<int64_t>(flat_gradients_.size()), *replicas_);
   flat_adam_->Step(*optimizer_, flat_parameters_.data_ptr<float>(),
                    flat_gradients_.data());
   return {loss, accuracy};
