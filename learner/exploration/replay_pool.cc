@@ -26,6 +26,8 @@ void ReplayPool::Reserve(int64_t rows) {
 }
 
 void ReplayPool::Add(const at::Tensor& rows) {
+  TORCH_CHECK(rows.scalar_type() == dtype(), "ReplayPool::Add: rows of ",
+              rows.scalar_type(), " into a pool of ", dtype());
   const int64_t m = rows.size(0);
   total_added_ += m;
   const at::Tensor kept = m > capacity_ ? rows.slice(0, m - capacity_) : rows;
@@ -48,7 +50,10 @@ at::Tensor ReplayPool::Sample(int64_t n, const at::Generator& generator) const {
 
 void ReplayPool::Save(torch::serialize::OutputArchive& archive,
                       const std::string& prefix) const {
-  archive.write(prefix + ".rows", rows_.slice(0, 0, size_));
+  // A slice would write its whole storage: the rows allocated ahead too.
+  archive.write(prefix + ".rows", size_ == rows_.size(0)
+                                      ? rows_
+                                      : rows_.slice(0, 0, size_).clone());
   archive.write(
       prefix + ".counts",
       at::tensor({capacity_, width_, next_, size_, total_added_}, at::kLong));
@@ -113,9 +118,10 @@ absl::StatusOr<at::Tensor> ReplayPool::StoredRows(
         "replay pool entry 'rows' holds non-finite values");
   }
   if (dtype() == at::kFloat) return rows;
-  const at::Tensor bytes =
-      rows.mul(static_cast<double>(byte_high_)).round().clamp(0, byte_high_);
-  const at::Tensor stored = bytes.to(at::kByte);
+  const at::Tensor stored = rows.mul(static_cast<double>(byte_high_))
+                                .round_()
+                                .clamp_(0, byte_high_)
+                                .to(at::kByte);
   // The networks' scaling (NetworkInputs), which must give the rows back.
   const at::Tensor scaled =
       stored.to(at::kFloat).mul_(1.0 / static_cast<double>(byte_high_));

@@ -9,6 +9,7 @@
 #include <sstream>
 #include <vector>
 
+#include "common/nn/networks.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
 #include "learner/exploration/exemplar_model.h"
@@ -156,13 +157,20 @@ TEST(ReplayPoolTest, ByteObservationsArePooledAsBytes) {
   at::Generator b = at::make_generator<at::CPUGeneratorImpl>(3);
   EXPECT_TRUE(copy.Sample(20, b).equal(sample));
 
-  // A checkpoint from before byte pools held the frames as the networks
-  // scale them: loaded into a byte pool, the same bytes.
+  // A float pool of the frames as the networks see them (as every pool
+  // held them before byte pools) draws the same rows, and the networks see
+  // the byte pool's exactly as those.
+  EnvSpec spec;
+  spec.observation_size = 5;
+  spec.observation_high = kHigh;
   ReplayPool legacy(4, 5);
-  legacy.Add(frames.to(at::kFloat).mul_(1.0 / kHigh));
+  legacy.Add(NetworkInputs(spec, frames));
+  at::Generator c = at::make_generator<at::CPUGeneratorImpl>(3);
+  EXPECT_TRUE(NetworkInputs(spec, sample).equal(legacy.Sample(20, c)));
+  // Its checkpoint loaded into a byte pool: the same bytes.
   ReplayPool converted(4, 5, kHigh);
   ASSERT_TRUE(SaveAndLoad(legacy, converted).ok());
-  at::Generator c = at::make_generator<at::CPUGeneratorImpl>(3);
+  c = at::make_generator<at::CPUGeneratorImpl>(3);
   EXPECT_TRUE(converted.Sample(20, c).equal(sample));
 
   // Floats that are no scaled bytes, and bytes above the run's highest
