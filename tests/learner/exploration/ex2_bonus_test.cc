@@ -92,44 +92,6 @@ TEST(ReplayPoolTest, KeepsTheNewestRowsAndCountsEveryRow) {
   EXPECT_EQ(pool.total_added(), 19);
 }
 
-TEST(ReplayPoolTest, SavedPoolLoadsBackAndBadOnesAreRefused) {
-  ReplayPool pool(4, 2);
-  pool.Add(at::arange(12, at::kFloat).reshape({6, 2}));
-  torch::serialize::OutputArchive out;
-  pool.Save(out, "pool");
-  std::ostringstream bytes;
-  out.save_to(bytes);
-  const auto load = [&](ReplayPool& into) {
-    torch::serialize::InputArchive in;
-    std::istringstream stream(bytes.str());
-    in.load_from(stream);
-    return into.Load(in, "pool");
-  };
-  ReplayPool copy(4, 2);
-  ASSERT_TRUE(load(copy).ok());
-  EXPECT_EQ(copy.total_added(), 6);
-  at::Generator a = at::make_generator<at::CPUGeneratorImpl>(3);
-  at::Generator b = at::make_generator<at::CPUGeneratorImpl>(3);
-  EXPECT_TRUE(copy.Sample(50, a).equal(pool.Sample(50, b)));
-  // Another width: refused, naming both shapes.
-  ReplayPool wider(4, 3);
-  const absl::Status status = load(wider);
-  EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument);
-  EXPECT_THAT(std::string(status.message()), HasSubstr("4 rows of 2"));
-  // Non-finite rows are refused.
-  ReplayPool poisoned(4, 2);
-  poisoned.Add(at::full({2, 2}, std::nanf("")));
-  torch::serialize::OutputArchive bad;
-  poisoned.Save(bad, "pool");
-  std::ostringstream bad_bytes;
-  bad.save_to(bad_bytes);
-  torch::serialize::InputArchive in;
-  std::istringstream stream(bad_bytes.str());
-  in.load_from(stream);
-  EXPECT_THAT(std::string(copy.Load(in, "pool").message()),
-              HasSubstr("non-finite"));
-}
-
 // A pool's rows through a checkpoint archive into `into`.
 absl::Status SaveAndLoad(const ReplayPool& from, ReplayPool& into) {
   torch::serialize::OutputArchive out;
@@ -140,6 +102,27 @@ absl::Status SaveAndLoad(const ReplayPool& from, ReplayPool& into) {
   std::istringstream stream(bytes.str());
   in.load_from(stream);
   return into.Load(in, "pool");
+}
+
+TEST(ReplayPoolTest, SavedPoolLoadsBackAndBadOnesAreRefused) {
+  ReplayPool pool(4, 2);
+  pool.Add(at::arange(12, at::kFloat).reshape({6, 2}));
+  ReplayPool copy(4, 2);
+  ASSERT_TRUE(SaveAndLoad(pool, copy).ok());
+  EXPECT_EQ(copy.total_added(), 6);
+  at::Generator a = at::make_generator<at::CPUGeneratorImpl>(3);
+  at::Generator b = at::make_generator<at::CPUGeneratorImpl>(3);
+  EXPECT_TRUE(copy.Sample(50, a).equal(pool.Sample(50, b)));
+  // Another width: refused, naming both shapes.
+  ReplayPool wider(4, 3);
+  const absl::Status status = SaveAndLoad(pool, wider);
+  EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(std::string(status.message()), HasSubstr("4 rows of 2"));
+  // Non-finite rows are refused.
+  ReplayPool poisoned(4, 2);
+  poisoned.Add(at::full({2, 2}, std::nanf("")));
+  EXPECT_THAT(std::string(SaveAndLoad(poisoned, copy).message()),
+              HasSubstr("non-finite"));
 }
 
 TEST(ReplayPoolTest, ByteObservationsArePooledAsBytes) {
