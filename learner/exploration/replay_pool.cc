@@ -6,6 +6,8 @@
 #include <algorithm>
 
 #include "absl/strings/str_cat.h"
+#include "common/env/environment.h"
+#include "common/nn/networks.h"
 #include "learner/checkpoint/archive_io.h"
 
 namespace vantage {
@@ -122,10 +124,11 @@ absl::StatusOr<at::Tensor> ReplayPool::StoredRows(
                                 .round_()
                                 .clamp_(0, byte_high_)
                                 .to(at::kByte);
-  // The networks' scaling (NetworkInputs), which must give the rows back.
-  const at::Tensor scaled =
-      stored.to(at::kFloat).mul_(1.0 / static_cast<double>(byte_high_));
-  if (!at::equal(scaled, rows)) {
+  // The networks' own scaling must give the rows back (it reads only the
+  // spec's highest value).
+  EnvSpec bytes;
+  bytes.observation_high = byte_high_;
+  if (!at::equal(NetworkInputs(bytes, stored), rows)) {
     return absl::InvalidArgumentError(absl::StrCat(
         "replay pool entry 'rows' is float32 but not observations of 0..",
         byte_high_, " scaled by 1/", byte_high_,
